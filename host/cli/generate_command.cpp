@@ -1,0 +1,40 @@
+// `sigmafem generate SCENARIO --out DIR [--seed N] [--vtk-every K]`: synthetic data.
+#include <iostream>
+#include <memory>
+
+#include "host/cli/commands.h"
+#include "host/cli/report.h"
+#include "host/generator/generate.h"
+#include "host/scenario/scenario.h"
+
+namespace sigmafem::cli {
+
+Action add_generate_command(CLI::App& app) {
+  struct Options {
+    std::string scenario;
+    GenerateOptions generate;
+    bool quiet = false;
+  };
+  auto options = std::make_shared<Options>();
+  CLI::App* sub = app.add_subcommand(
+      "generate", "Simulate a scenario with its true stiffnesses and events and write "
+                  "observations.csv, truth.csv and a VTK time series");
+  sub->add_option("scenario", options->scenario, "Scenario JSON file")->required();
+  sub->add_option("--out", options->generate.out_dir, "Output folder (created if missing)")
+      ->required();
+  sub->add_option("--seed", options->generate.seed, "Seed of the observation noise")
+      ->capture_default_str();
+  sub->add_option("--vtk-every", options->generate.vtk_every,
+                  "Write a VTK frame every K steps (0: none; default: the scenario's)")
+      ->check(CLI::NonNegativeNumber);
+  sub->add_flag("--quiet", options->quiet, "No progress line and no summary");
+  return [options]() {
+    const Scenario scenario = load_scenario(options->scenario);
+    options->generate.progress = !options->quiet;
+    const GenerateResult result = generate(scenario, options->generate, std::cerr);
+    if (!options->quiet) print_generate_summary(std::cout, scenario, options->generate, result);
+    return 0;
+  };
+}
+
+}  // namespace sigmafem::cli

@@ -1,0 +1,50 @@
+// `sigmafem info SCENARIO`: what a scenario resolves to (mesh size and quality, node sets),
+// to check a scenario before a long run.
+#include <iostream>
+#include <memory>
+
+#include "host/cli/commands.h"
+#include "host/mesh/mesh.h"
+#include "host/scenario/scenario.h"
+
+namespace sigmafem::cli {
+
+namespace {
+
+void print_nodes(std::ostream& out, const std::vector<int>& nodes) {
+  out << nodes.size() << " nodes [";
+  for (std::size_t i = 0; i < nodes.size(); ++i) out << (i ? " " : "") << nodes[i];
+  out << "]\n";
+}
+
+}  // namespace
+
+Action add_info_command(CLI::App& app) {
+  auto scenario_path = std::make_shared<std::string>();
+  CLI::App* sub = app.add_subcommand("info", "Load a scenario, check it and describe it");
+  sub->add_option("scenario", *scenario_path, "Scenario JSON file")->required();
+  return [scenario_path]() {
+    const Scenario s = load_scenario(*scenario_path);
+    std::cout << "scenario " << s.name << " (" << s.path << ")\n"
+              << "  mesh " << s.mesh_spec.resolved_path << ": " << s.mesh.node_count()
+              << " nodes, " << s.mesh.tetrahedron_count() << " tetrahedra, "
+              << boundary_faces(s.mesh).size() << " boundary faces, volume "
+              << s.mesh_report.total_volume << " m^3, " << s.mesh_report.inverted_reordered
+              << " inverted tetrahedra reordered\n"
+              << "  time " << s.time.steps << " steps of " << s.time.dt << " s\n";
+    for (const Ligament& ligament : s.ligaments) {
+      std::cout << "  ligament " << ligament.name << " " << ligament.stiffness << " N/m: ";
+      print_nodes(std::cout, ligament.nodes);
+    }
+    std::cout << "  control " << s.control.stiffness << " N/m: ";
+    print_nodes(std::cout, s.control.nodes);
+    for (const Event& event : s.events)
+      std::cout << "  event t=" << event.time << " s: " << event.ligament_name << " -> "
+                << event.stiffness << " N/m\n";
+    std::cout << "  observed: ";
+    print_nodes(std::cout, s.observations.nodes);
+    return 0;
+  };
+}
+
+}  // namespace sigmafem::cli

@@ -1,0 +1,37 @@
+// sigmafem command line. Exit codes: 0 success, 1 a run that failed (the simulation), 2 bad
+// input (files, scenario, options), with a message on stderr that says where and what.
+#include <CLI/CLI.hpp>
+#include <iostream>
+#include <map>
+
+#include "host/cli/commands.h"
+#include "host/common/input_error.h"
+
+int main(int argc, char** argv) {
+  CLI::App app{"sigmafem: estimates the stiffness of the ligaments that hold an organ from "
+               "tracked surface points, with an ensemble reduced-order unscented Kalman filter"};
+  app.set_version_flag("--version", std::string("sigmafem ") + SIGMAFEM_VERSION);
+  app.require_subcommand(1);
+  std::map<CLI::App*, sigmafem::cli::Action> actions;
+  for (auto add : {sigmafem::cli::add_generate_command, sigmafem::cli::add_demo_command,
+                   sigmafem::cli::add_info_command}) {
+    const std::size_t before = app.get_subcommands({}).size();
+    sigmafem::cli::Action action = add(app);
+    actions[app.get_subcommands({}).at(before)] = std::move(action);
+  }
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::ParseError& e) {
+    return app.exit(e) == 0 ? 0 : 2;
+  }
+  try {
+    for (CLI::App* sub : app.get_subcommands()) return actions.at(sub)();
+  } catch (const sigmafem::InputError& e) {
+    std::cerr << "sigmafem: error: " << e.what() << '\n';
+    return 2;
+  } catch (const std::exception& e) {
+    std::cerr << "sigmafem: failed: " << e.what() << '\n';
+    return 1;
+  }
+  return 0;
+}

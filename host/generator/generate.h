@@ -1,0 +1,45 @@
+// generate: the synthetic-data generator (`sigmafem generate`). It runs the scenario's
+// experiment on the CPU reference with the true ligament stiffnesses and the events (a cut),
+// and writes what a tracking system would have measured:
+//   <out>/observations.csv  SO position and observed node positions per step, with Gaussian
+//                           noise of the scenario's noise_std (docs/FORMATS.md)
+//   <out>/truth.csv         each ligament's true stiffness per step
+//   <out>/<name>.pvd + <out>/vtk/*.vtu   the organ every vtk_every steps, for ParaView
+// Row k of each CSV is the state after k steps (time k dt); row 0 is the rest state. A step
+// uses the SO position and the ligament stiffnesses at its END time (an event at time T acts
+// on every step that ends at or after T). The same scenario and seed give the same bytes.
+#pragma once
+
+#include <cstdint>
+#include <iosfwd>
+#include <string>
+
+#include "host/scenario/scenario.h"
+
+namespace sigmafem {
+
+struct GenerateOptions {
+  std::string out_dir;
+  std::uint64_t seed = 1;
+  int vtk_every = -1;              // -1: the scenario's output.vtk_every; 0: no VTK
+  bool progress = false;           // a progress line on stderr (when it is a terminal)
+};
+
+struct GenerateResult {
+  int steps = 0;
+  double seconds = 0.0;            // wall time of the simulation and the writing
+  long long cg_iterations = 0;     // summed over steps
+  int max_cg_iterations = 0;       // the most in one step
+  int unconverged_steps = 0;       // steps whose CG hit solver.cg_max_iterations
+  int vtk_frames = 0;
+  double max_displacement = 0.0;   // m, largest node displacement over the run
+};
+
+// Runs the experiment and writes the files. Creates out_dir if needed. Throws InputError if
+// an output cannot be written and std::runtime_error if the simulation fails (non-finite
+// state); in both cases no observations.csv or truth.csv is written. CG steps that hit the
+// iteration cap are reported on `log` with the step and residual, and counted.
+GenerateResult generate(const Scenario& scenario, const GenerateOptions& options,
+                        std::ostream& log);
+
+}  // namespace sigmafem

@@ -1,0 +1,37 @@
+// VtkSeries: a time series of the organ for ParaView: one XML unstructured grid (.vtu) per
+// written frame and a .pvd collection that lists them with their times. Each frame holds
+// the deformed mesh, the displacement, and integer point fields that mark the ligament
+// nodes (ligament index + 1), the observed nodes (observation index + 1) and the control
+// nodes (1), so that ParaView's Threshold shows each group.
+//
+// Frames are written into `<dir>/vtk.partial/` and moved to `<dir>/vtk/` by finish(), with the
+// .pvd written last, so an interrupted run never leaves a series that looks complete.
+#pragma once
+
+#include <Eigen/Core>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include "host/model/model.h"
+
+namespace sigmafem {
+
+class VtkSeries {
+ public:
+  VtkSeries(const Model& model, std::vector<int> observed_nodes, std::string directory,
+            std::string name);
+  // Writes the frame for positions x at time t.
+  void write_frame(double t, const Eigen::VectorXd& x);
+  // Moves the frames into place and writes `<dir>/<name>.pvd`.
+  void finish();
+  int frame_count() const { return static_cast<int>(frames_.size()); }
+
+ private:
+  const Model& model_;
+  std::vector<int> ligament_mark_, observed_mark_, control_mark_;
+  std::string directory_, name_;
+  std::vector<std::pair<double, std::string>> frames_;   // time, file name
+};
+
+}  // namespace sigmafem

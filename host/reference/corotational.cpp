@@ -1,0 +1,108 @@
+#include "host/reference/corotational.h"
+
+#include <Eigen/Dense>
+
+#include "host/model/shared_element.h"
+
+namespace sigmafem {
+namespace {
+
+void gather_corners(const ElementRest& element, const Eigen::VectorXd& v, double out[12]) {
+  for (int c = 0; c < 4; ++c)
+    for (int k = 0; k < 3; ++k) out[3 * c + k] = v[3 * element.nodes[c] + k];
+}
+
+void scatter_add(const ElementRest& element, const double in[12], Eigen::VectorXd& v) {
+  for (int c = 0; c < 4; ++c)
+    for (int k = 0; k < 3; ++k) v[3 * element.nodes[c] + k] += in[3 * c + k];
+}
+
+Eigen::Matrix3d frame_matrix(const double frame[9]) {
+  Eigen::Matrix3d F;
+  for (int r = 0; r < 3; ++r)
+    for (int k = 0; k < 3; ++k) F(r, k) = frame[3 * r + k];
+  return F;
+}
+
+}  // namespace
+
+void element_frames(const Model& model, const Eigen::VectorXd& x, std::vector<Frame>& frames) {
+  frames.resize(model.elements.size());
+  double p[12];
+  for (std::size_t e = 0; e < model.elements.size(); ++e) {
+    gather_corners(model.elements[e], x, p);
+    shared::sf_element_frame(p, frames[e].data());
+  }
+}
+
+void add_element_forces(const Model& model, const std::vector<Frame>& frames,
+                        const Eigen::VectorXd& x, Eigen::VectorXd& f) {
+  double p[12], fe[12];
+  for (std::size_t e = 0; e < model.elements.size(); ++e) {
+    const ElementRest& element = model.elements[e];
+    gather_corners(element, x, p);
+    shared::sf_element_force(frames[e].data(), element.grad.data(), element.vlambda, element.vmu, p,
+                             fe);
+    scatter_add(element, fe, f);
+  }
+}
+
+void element_product(const Model& model, const std::vector<Frame>& frames,
+                     const Eigen::VectorXd& d, Eigen::VectorXd& y) {
+  y.setZero(d.size());
+  double de[12], ye[12];
+  for (std::size_t e = 0; e < model.elements.size(); ++e) {
+    const ElementRest& element = model.elements[e];
+    gather_corners(element, d, de);
+    shared::sf_element_product(frames[e].data(), element.grad.data(), element.vlambda, element.vmu,
+                               de, ye);
+    scatter_add(element, ye, y);
+  }
+}
+
+void element_diagonal(const Model& model, const std::vector<Frame>& frames,
+                      Eigen::VectorXd& diagonal) {
+  diagonal.setZero(model.dof_count());
+  double de[12];
+  for (std::size_t e = 0; e < model.elements.size(); ++e) {
+    const ElementRest& element = model.elements[e];
+    shared::sf_element_diagonal(frames[e].data(), element.grad.data(), element.vlambda, element.vmu,
+                                de);
+    scatter_add(element, de, diagonal);
+  }
+}
+
+Eigen::SparseMatrix<double> assemble_element_stiffness(const Model& model,
+                                                       const std::vector<Frame>& frames) {
+  std::vector<Eigen::Triplet<double>> triplets;
+  triplets.reserve(model.elements.size() * 144);
+  for (std::size_t e = 0; e < model.elements.size(); ++e) {
+    const ElementRest& element = model.elements[e];
+    // Column j of R K_e R^T is the element product of the j-th unit vector: one definition
+    // of the tangent for the matrix-free and the assembled paths.
+    for (int j = 0; j < 12; ++j) {
+      double unit[12] = {0.0}, column[12];
+      unit[j] = 1.0;
+      shared::sf_element_product(frames[e].data(), element.grad.data(), element.vlambda,
+                                 element.vmu, unit, column);
+      const int col = 3 * element.nodes[j / 3] + j % 3;
+      for (int i = 0; i < 12; ++i)
+        triplets.emplace_back(3 * element.nodes[i / 3] + i % 3, col, column[i]);
+    }
+  }
+  Eigen::SparseMatrix<double> K(model.dof_count(), model.dof_count());
+  K.setFromTriplets(triplets.begin(), triplets.end());
+  return K;
+}
+
+Eigen::Matrix3d element_rotation(const Model& model, const std::vector<Frame>& frames, int e) {
+  const ElementRest& element = model.elements[e];
+  double p0[12], rest_frame[9];
+  for (int c = 0; c < 4; ++c)
+    for (int k = 0; k < 3; ++k) p0[3 * c + k] = model.rest_positions[element.nodes[c]][k];
+  shared::sf_element_frame(p0, rest_frame);
+  // world <- current frame <- rest frame coordinates <- world
+  return frame_matrix(frames[e].data()).transpose() * frame_matrix(rest_frame);
+}
+
+}  // namespace sigmafem

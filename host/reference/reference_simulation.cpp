@@ -1,0 +1,110 @@
+#include "host/reference/reference_simulation.h"
+
+#include <Eigen/SparseCholesky>
+#include <stdexcept>
+#include <string>
+
+#include "host/reference/implicit_euler.h"
+
+namespace sigmafem {
+
+ReferenceSimulation::ReferenceSimulation(Model model) : model_(std::move(model)) {
+  for (const SpringSet& ligament : model_.ligaments)
+    ligament_stiffness_.push_back(ligament.stiffness);
+  const int n = model_.node_count();
+  x_.resize(3 * n);
+  for (int i = 0; i < n; ++i) x_.segment<3>(3 * i) = model_.rest_positions[i];
+  v_ = Eigen::VectorXd::Zero(3 * n);
+  dv_ = Eigen::VectorXd::Zero(3 * n);
+}
+
+void ReferenceSimulation::set_ligament_stiffness(const std::vector<double>& stiffness) {
+  if (stiffness.size() != model_.ligaments.size())
+    throw std::invalid_argument("set_ligament_stiffness: expected " +
+                                std::to_string(model_.ligaments.size()) + " values, got " +
+                                std::to_string(stiffness.size()));
+  ligament_stiffness_ = stiffness;
+}
+
+void ReferenceSimulation::set_state(const Eigen::VectorXd& positions,
+                                    const Eigen::VectorXd& velocities) {
+  if (positions.size() != x_.size() || velocities.size() != v_.size())
+    throw std::invalid_argument("set_state: wrong vector size");
+  x_ = positions;
+  v_ = velocities;
+}
+
+Eigen::VectorXd ReferenceSimulation::spring_stiffness() const {
+  Eigen::VectorXd k = Eigen::VectorXd::Zero(model_.node_count());
+  for (std::size_t l = 0; l < model_.ligaments.size(); ++l) {
+    const auto& nodes = model_.ligaments[l].nodes;
+    for (int node : nodes) k[node] += ligament_stiffness_[l] / static_cast<double>(nodes.size());
+  }
+  const auto& control = model_.control.nodes;
+  for (int node : control) k[node] += model_.control.stiffness / static_cast<double>(control.size());
+  return k;
+}
+
+Eigen::VectorXd ReferenceSimulation::forces(const Eigen::VectorXd& x,
+                                            const std::vector<Frame>& frames,
+                                            const Eigen::Vector3d& so_position) const {
+  Eigen::VectorXd f = Eigen::VectorXd::Zero(x.size());
+  add_element_forces(model_, frames, x, f);
+  for (std::size_t l = 0; l < model_.ligaments.size(); ++l) {
+    const auto& nodes = model_.ligaments[l].nodes;
+    const double k = ligament_stiffness_[l] / static_cast<double>(nodes.size());
+    for (int node : nodes)
+      f.segment<3>(3 * node) -= k * (x.segment<3>(3 * node) - model_.rest_positions[node]);
+  }
+  const auto& control = model_.control.nodes;
+  if (!control.empty()) {
+    const double k = model_.control.stiffness / static_cast<double>(control.size());
+    const Eigen::Vector3d shift = so_position - model_.control_start;
+    for (int node : control)
+      f.segment<3>(3 * node) -=
+          k * (x.segment<3>(3 * node) - (model_.rest_positions[node] + shift));
+  }
+  if (!model_.gravity.isZero()) {
+    for (int i = 0; i < model_.node_count(); ++i)
+      f.segment<3>(3 * i) += model_.mass[i] * model_.gravity;
+  }
+  return f;
+}
+
+CgResult ReferenceSimulation::step(const Eigen::Vector3d& so_position) {
+  element_frames(model_, x_, frames_);
+  const Eigen::VectorXd springs = spring_stiffness();
+  const ImplicitEulerSystem system(model_, frames_, springs);
+  const Eigen::VectorXd b = system.right_hand_side(forces(x_, frames_, so_position), v_);
+
+  CgResult result;
+  if (solver_ == LinearSolver::conjugate_gradient) {
+    const Eigen::VectorXd inverse_diagonal = system.diagonal().cwiseInverse();
+    result = conjugate_gradient(system, inverse_diagonal, b, dv_, model_.solver.cg_max_iterations,
+                                model_.solver.cg_tolerance);
+  } else {
+    Eigen::SimplicialLDLT<Eigen::SparseMatrix<double>> ldlt(system.assemble());
+    if (ldlt.info() != Eigen::Success)
+      throw std::runtime_error("direct solve: the implicit Euler matrix is not positive definite");
+    dv_ = ldlt.solve(b);
+    Eigen::VectorXd Adv;
+    system.apply(dv_, Adv);
+    const double b_norm = b.norm();
+    result.relative_residual = b_norm > 0.0 ? (Adv - b).norm() / b_norm : 0.0;
+    result.converged = true;
+  }
+  v_ += dv_;
+  x_ += model_.dt * v_;
+  if (!x_.allFinite() || !v_.allFinite())
+    throw std::runtime_error("simulation step: positions or velocities became non-finite");
+  return result;
+}
+
+double ReferenceSimulation::kinetic_energy() const {
+  double e = 0.0;
+  for (int i = 0; i < model_.node_count(); ++i)
+    e += 0.5 * model_.mass[i] * v_.segment<3>(3 * i).squaredNorm();
+  return e;
+}
+
+}  // namespace sigmafem

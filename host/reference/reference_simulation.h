@@ -1,0 +1,60 @@
+// ReferenceSimulation: one organ simulated on the CPU in double precision, step by step.
+// This is the oracle every device back end is tested against (ARCHITECTURE.md). One step:
+//   1. element frames at x_n (rotations),
+//   2. forces f(x_n): elastic, ligament springs to rest, control spring to the SO target at
+//      the END of the step (so(t_{n+1}); sigmafem's convention), gravity,
+//   3. solve (M + h B + h^2 K) dv = h (f - B v - h K v) by Jacobi-preconditioned CG
+//      warm-started from the last dv (or by a sparse direct solve, to check CG),
+//   4. v += dv, x += h v.
+#pragma once
+
+#include <Eigen/Core>
+#include <vector>
+
+#include "host/model/model.h"
+#include "host/reference/conjugate_gradient.h"
+#include "host/reference/corotational.h"
+
+namespace sigmafem {
+
+enum class LinearSolver { conjugate_gradient, direct };
+
+class ReferenceSimulation {
+ public:
+  // Starts at rest: x = rest positions, v = 0, ligament stiffnesses those of the model.
+  explicit ReferenceSimulation(Model model);
+
+  const Model& model() const { return model_; }
+
+  // Stiffness (N/m, total) of each ligament, in model.ligaments order.
+  void set_ligament_stiffness(const std::vector<double>& stiffness);
+  const std::vector<double>& ligament_stiffness() const { return ligament_stiffness_; }
+
+  void set_linear_solver(LinearSolver solver) { solver_ = solver; }
+
+  // Advances one time step with the SO at `so_position` (the SO at the end of the step).
+  // Throws std::runtime_error if the state becomes non-finite.
+  CgResult step(const Eigen::Vector3d& so_position);
+
+  const Eigen::VectorXd& positions() const { return x_; }
+  const Eigen::VectorXd& velocities() const { return v_; }
+  void set_state(const Eigen::VectorXd& positions, const Eigen::VectorXd& velocities);
+  Eigen::Vector3d node_position(int node) const { return x_.segment<3>(3 * node); }
+
+  // The spring stiffness on each node (ligaments and control), N/m.
+  Eigen::VectorXd spring_stiffness() const;
+  // All forces at positions x with the SO at so_position, for the frames of x.
+  Eigen::VectorXd forces(const Eigen::VectorXd& x, const std::vector<Frame>& frames,
+                         const Eigen::Vector3d& so_position) const;
+  double kinetic_energy() const;
+
+ private:
+  Model model_;
+  std::vector<double> ligament_stiffness_;
+  LinearSolver solver_ = LinearSolver::conjugate_gradient;
+  Eigen::VectorXd x_, v_;
+  Eigen::VectorXd dv_;                 // last velocity change: the CG warm start
+  std::vector<Frame> frames_;
+};
+
+}  // namespace sigmafem

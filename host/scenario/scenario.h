@@ -1,0 +1,144 @@
+// Scenario: one experiment as described by a scenario JSON file (docs/FORMATS.md, format
+// "sigmafem-scenario/1"): the organ mesh, its material, what holds it (ligaments), what
+// moves it (the control spring to the solid object, SO), events, what is observed, and
+// what the filter estimates. load_scenario() parses, checks every field, loads the mesh and
+// resolves node selections to indices; after it returns, everything here is valid.
+#pragma once
+
+#include <Eigen/Core>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "host/mesh/mesh.h"
+
+namespace sigmafem {
+
+struct MeshSpec {
+  std::string file;                 // as written in the scenario
+  std::string resolved_path;        // relative to the scenario's folder
+  double scale = 1.0;
+  Eigen::Vector3d translate = Eigen::Vector3d::Zero();
+};
+
+struct Material {
+  double young_modulus = 0.0;       // Pa
+  double poisson_ratio = 0.0;       // in (-1, 0.5)
+  double density = 0.0;             // kg/m^3
+};
+
+struct Damping {
+  double rayleigh_stiffness = 0.0;  // a in B = a K + b M (s)
+  double rayleigh_mass = 0.0;       // b (1/s)
+};
+
+struct TimeSpec {
+  double dt = 0.0;                  // s, > 0
+  int steps = 0;                    // number of time steps, >= 1
+};
+
+struct SolverSpec {
+  int cg_max_iterations = 1000;
+  double cg_tolerance = 1e-10;      // relative residual |Ax - b| / |b|
+};
+
+struct Ligament {
+  std::string name;
+  std::vector<int> nodes;           // resolved, sorted, unique
+  double stiffness = 0.0;           // N/m, total: each node gets stiffness / nodes.size()
+};
+
+// The SO trajectory so(t). so(0) is the centroid of the control nodes' rest positions.
+struct Trajectory {
+  enum class Type { linear, waypoints, file };
+  Type type = Type::linear;
+  Eigen::Vector3d velocity = Eigen::Vector3d::Zero();     // linear
+  std::vector<double> times;                              // waypoints and file, increasing
+  std::vector<Eigen::Vector3d> positions;                 // waypoints and file
+  std::string file;                                       // file: as written
+  // Position of the SO at time t; `start` is so(0) (used by `linear`). Waypoints are
+  // piecewise linear, held constant before the first and after the last.
+  Eigen::Vector3d position(double t, const Eigen::Vector3d& start) const;
+};
+
+// Reads a trajectory CSV (docs/FORMATS.md): a header `time,x,y,z`, then one row per knot,
+// times strictly increasing, positions absolute (metres); `#` lines and blank lines are
+// skipped. Returns a Trajectory of type `file` with `file` = path. Throws InputError
+// "trajectory PATH line N: problem" on anything else.
+Trajectory read_trajectory_csv(const std::string& path);
+
+struct Control {
+  std::vector<int> nodes;           // resolved, sorted, unique
+  double stiffness = 0.0;           // N/m, total
+  Trajectory trajectory;
+  Eigen::Vector3d start = Eigen::Vector3d::Zero();        // so(0): centroid of rest positions
+};
+
+// At `time`, ligament `ligament` (index into Scenario::ligaments) gets `stiffness`.
+struct Event {
+  double time = 0.0;
+  int ligament = -1;
+  std::string ligament_name;
+  double stiffness = 0.0;
+};
+
+struct Observations {
+  std::vector<int> nodes;           // in scenario order (not sorted), unique
+  double noise_std = 0.0;           // m, >= 0, used by the generator
+};
+
+struct FilterSpec {
+  std::vector<int> estimate;        // indices into Scenario::ligaments
+  std::vector<double> initial_stiffness;   // median prior stiffness per estimated ligament
+  double initial_log_std = 1.0;
+  double parameter_drift_log_std = 0.0;
+  double observation_std = 0.0;
+  std::string sigma_points = "simplex";    // "simplex" or "star"
+};
+
+struct OutputSpec {
+  int vtk_every = 10;               // write a VTK frame every k steps (0: none)
+};
+
+struct Scenario {
+  std::string path;                 // the scenario file
+  std::string format;
+  std::string name;
+  std::string description;          // free text, optional
+  MeshSpec mesh_spec;
+  Mesh mesh;                        // loaded, transformed to metres, oriented and checked
+  MeshQualityReport mesh_report;
+  Material material;
+  Damping damping;
+  Eigen::Vector3d gravity = Eigen::Vector3d::Zero();
+  TimeSpec time;
+  SolverSpec solver;
+  std::vector<Ligament> ligaments;
+  Control control;
+  std::vector<Event> events;        // sorted by time
+  Observations observations;
+  std::optional<FilterSpec> filter;
+  OutputSpec output;
+
+  // Index of the ligament called `name`, or -1.
+  int ligament_index(const std::string& name) const;
+  // Stiffness of every ligament in effect at time t: events with time <= t + 1e-9 applied,
+  // in time order (the slack absorbs rounding when t is computed as step * dt).
+  std::vector<double> ligament_stiffness_at(double t) const;
+};
+
+// Node selection (docs/FORMATS.md `select`), in the mesh's current frame (metres once
+// transformed). Both are inclusive with a slack of kSelectionSlack, so that a node placed
+// exactly on the sphere or the box face is caught despite rounding in scale/translate.
+// Return sorted indices; empty when nothing matches.
+constexpr double kSelectionSlack = 1e-9;  // m
+std::vector<int> select_nodes_near(const Mesh& mesh, const Eigen::Vector3d& near, double radius);
+std::vector<int> select_nodes_in_box(const Mesh& mesh, const Eigen::Vector3d& min,
+                                     const Eigen::Vector3d& max);
+
+// Reads and checks a scenario file. Throws InputError with "scenario FILE: FIELD: problem"
+// for an unknown field, a wrong type, a missing file, a ligament or node index that does not
+// exist, an empty node set, a non-positive dt, and every other invalid value.
+Scenario load_scenario(const std::string& path);
+
+}  // namespace sigmafem

@@ -1,0 +1,39 @@
+/* dialect.h: the only file that knows which language compiles the shared headers.
+ * The shared element math (element.h) is written once in the subset of C that C++, OpenCL C
+ * and Vulkan GLSL all accept; these macros adapt the few places where they differ. */
+#ifndef SIGMAFEM_DIALECT_H
+#define SIGMAFEM_DIALECT_H
+
+#if defined(__cplusplus) /* CPU reference; a test may predefine SF_REAL float */
+#  ifndef SF_REAL
+#    define SF_REAL double
+#  endif
+#  define SF_FN inline
+#  define SF_SQRT(x) std::sqrt(x)
+#  define SF_IN(n, N) const SF_REAL n[N]
+#  define SF_OUT(n, N) SF_REAL n[N]
+#  define SF_LIT(x) static_cast<SF_REAL>(x)
+typedef unsigned int uint;
+#elif defined(__OPENCL_VERSION__) /* OpenCL C on PoCL or a GPU driver */
+#  ifndef SF_REAL
+#    define SF_REAL float
+#  endif
+#  define SF_FN static inline
+#  define SF_SQRT(x) sqrt(x)
+#  define SF_IN(n, N) const SF_REAL n[N]
+#  define SF_OUT(n, N) SF_REAL n[N]
+#  define SF_LIT(x) ((SF_REAL)(x))
+#elif defined(VULKAN) /* GLSL through glslang for Vulkan */
+#  ifndef SF_REAL
+#    define SF_REAL float
+#  endif
+#  define SF_FN
+#  define SF_SQRT(x) sqrt(x)
+#  define SF_IN(n, N) in SF_REAL n[N]
+#  define SF_OUT(n, N) out SF_REAL n[N]
+#  define SF_LIT(x) SF_REAL(x)
+#else
+#  error "dialect.h: expected C++, OpenCL C or Vulkan GLSL"
+#endif
+
+#endif /* SIGMAFEM_DIALECT_H */

@@ -1,0 +1,45 @@
+#!/usr/bin/env bash
+# sigmafem set-up on a Debian machine (bookworm or later):
+#   ./setup.sh run    install what is missing, build, run the main job on the default scenario
+#   ./setup.sh test   install what is missing, build, run the whole test suite: a Release build
+#                     with warnings as errors, then a build with AddressSanitizer and
+#                     UndefinedBehaviorSanitizer
+# Debian packages are the only dependencies; apt-get runs only when one is missing (through
+# sudo when not root).
+set -euo pipefail
+cd "$(dirname "$0")"
+mode=${1:-run}
+case "$mode" in run|test) ;; *) echo "usage: ./setup.sh run|test" >&2; exit 2 ;; esac
+
+packages="g++ cmake ninja-build pkg-config libeigen3-dev nlohmann-json3-dev libcli11-dev
+          libgtest-dev libbenchmark-dev"
+missing=""
+for p in $packages; do
+  dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q 'ok installed' || missing="$missing $p"
+done
+if [ -n "$missing" ]; then
+  echo "== installing:$missing"
+  sudo=""; [ "$(id -u)" -ne 0 ] && sudo="sudo"
+  $sudo apt-get update -qq
+  $sudo env DEBIAN_FRONTEND=noninteractive apt-get install -y -qq --no-install-recommends $missing
+fi
+
+jobs=$(nproc 2>/dev/null || echo 2)
+echo "== building (Release, warnings as errors)"
+cmake -S . -B build -G Ninja -DCMAKE_BUILD_TYPE=Release -DSIGMAFEM_WERROR=ON >/dev/null
+cmake --build build -j "$jobs"
+
+if [ "$mode" = run ]; then
+  echo "== main job: sigmafem demo box"
+  exec build/sigmafem demo box
+fi
+
+echo "== tests (Release)"
+ctest --test-dir build --output-on-failure -j "$jobs"
+echo "== building with AddressSanitizer and UndefinedBehaviorSanitizer"
+cmake -S . -B build-sanitize -G Ninja -DCMAKE_BUILD_TYPE=RelWithDebInfo -DSIGMAFEM_WERROR=ON \
+  -DSIGMAFEM_SANITIZE=ON -DSIGMAFEM_BENCH=OFF >/dev/null
+cmake --build build-sanitize -j "$jobs"
+echo "== tests (sanitizers)"
+ASAN_OPTIONS=detect_leaks=1:abort_on_error=1 UBSAN_OPTIONS=print_stacktrace=1:halt_on_error=1 \
+  ctest --test-dir build-sanitize --output-on-failure -j "$jobs"

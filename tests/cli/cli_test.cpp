@@ -1,0 +1,149 @@
+// The sigmafem program as a user meets it: exit codes, error messages that name the file and
+// the field, and no output file after bad input.
+#include <gtest/gtest.h>
+#include <sys/wait.h>
+
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <functional>
+#include <nlohmann/json.hpp>
+#include <sstream>
+#include <string>
+
+namespace sigmafem {
+namespace {
+namespace fs = std::filesystem;
+using nlohmann::json;
+
+struct CommandRun {
+  int exit_code = -1;
+  std::string output;   // stdout and stderr together
+};
+
+CommandRun run_sigmafem(const std::string& arguments) {
+  const std::string command = std::string(SIGMAFEM_BINARY) + " " + arguments + " 2>&1";
+  CommandRun run;
+  FILE* pipe = popen(command.c_str(), "r");
+  if (!pipe) return run;
+  char buffer[4096];
+  while (std::fgets(buffer, sizeof buffer, pipe)) run.output += buffer;
+  const int status = pclose(pipe);
+  run.exit_code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+  return run;
+}
+
+class CliTest : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    dir_ = fs::temp_directory_path() /
+           (std::string("sigmafem_cli_test_") +
+            ::testing::UnitTest::GetInstance()->current_test_info()->name());
+    fs::remove_all(dir_);
+    fs::create_directories(dir_);
+    const fs::path scenarios = fs::path(SIGMAFEM_SOURCE_DIR) / "scenarios";
+    fs::copy_file(scenarios / "box.msh", dir_ / "box.msh");
+    std::ifstream in(scenarios / "box.json");
+    box_ = json::parse(in);
+  }
+  void TearDown() override { fs::remove_all(dir_); }
+
+  // Writes a variant of box.json changed by `edit` and runs generate on it.
+  CommandRun generate_variant(const std::function<void(json&)>& edit) {
+    json scenario = box_;
+    edit(scenario);
+    std::ofstream(dir_ / "variant.json") << scenario.dump(2);
+    return run_sigmafem("generate " + (dir_ / "variant.json").string() + " --out " +
+                        (dir_ / "out").string() + " --vtk-every 0 --quiet");
+  }
+
+  // Bad input: a non-zero exit, a message naming the file and `field`, no output folder.
+  void expect_rejected(const std::function<void(json&)>& edit, const std::string& field) {
+    const CommandRun run = generate_variant(edit);
+    EXPECT_EQ(run.exit_code, 2) << run.output;
+    EXPECT_NE(run.output.find("variant.json"), std::string::npos)
+        << "the message names the file: " << run.output;
+    EXPECT_NE(run.output.find(field), std::string::npos)
+        << "the message names " << field << ": " << run.output;
+    EXPECT_FALSE(fs::exists(dir_ / "out" / "observations.csv")) << "no output after bad input";
+    EXPECT_FALSE(fs::exists(dir_ / "out")) << "not even the output folder";
+  }
+
+  fs::path dir_;
+  json box_;
+};
+
+TEST_F(CliTest, GenerateWritesItsFilesAndSummary) {
+  json scenario = box_;
+  scenario["time"]["steps"] = 5;
+  std::ofstream(dir_ / "short.json") << scenario.dump(2);
+  const CommandRun run = run_sigmafem("generate " + (dir_ / "short.json").string() + " --out " +
+                                      (dir_ / "out").string() + " --vtk-every 0");
+  ASSERT_EQ(run.exit_code, 0) << run.output;
+  EXPECT_NE(run.output.find("generated 5 steps"), std::string::npos) << run.output;
+  EXPECT_TRUE(fs::exists(dir_ / "out" / "observations.csv"));
+  EXPECT_TRUE(fs::exists(dir_ / "out" / "truth.csv"));
+  EXPECT_FALSE(fs::exists(dir_ / "out" / "observations.csv.partial"));
+}
+
+TEST_F(CliTest, RejectsUnknownField) {
+  expect_rejected([](json& s) { s["material"]["stifness"] = 1.0; }, "stifness");
+}
+
+TEST_F(CliTest, RejectsWrongType) {
+  expect_rejected([](json& s) { s["time"]["dt"] = "0.01"; }, "dt");
+}
+
+TEST_F(CliTest, RejectsMissingMeshFile) {
+  expect_rejected([](json& s) { s["mesh"]["file"] = "no-such-mesh.msh"; }, "no-such-mesh.msh");
+}
+
+TEST_F(CliTest, RejectsUnknownLigamentInEvent) {
+  expect_rejected([](json& s) { s["events"][0]["ligament"] = "no_such_ligament"; },
+                  "no_such_ligament");
+}
+
+TEST_F(CliTest, RejectsNodeIndexOutOfRange) {
+  expect_rejected([](json& s) { s["observations"]["nodes"][0] = 999999; }, "999999");
+}
+
+TEST_F(CliTest, RejectsEmptyNodeSet) {
+  expect_rejected(
+      [](json& s) {
+        s["ligaments"][0].erase("nodes");
+        s["ligaments"][0]["select"] = {{"near", {5.0, 5.0, 5.0}}, {"radius", 0.001}};
+      },
+      "empty");
+}
+
+TEST_F(CliTest, RejectsNonPositiveTimeStep) {
+  expect_rejected([](json& s) { s["time"]["dt"] = 0.0; }, "dt");
+}
+
+TEST_F(CliTest, RejectsMissingScenarioFile) {
+  const CommandRun run = run_sigmafem("generate " + (dir_ / "absent.json").string() + " --out " +
+                               (dir_ / "out").string());
+  EXPECT_EQ(run.exit_code, 2) << run.output;
+  EXPECT_NE(run.output.find("absent.json"), std::string::npos) << run.output;
+  EXPECT_FALSE(fs::exists(dir_ / "out"));
+}
+
+TEST_F(CliTest, RejectsBadOptions) {
+  const CommandRun run = run_sigmafem("generate");
+  EXPECT_NE(run.exit_code, 0) << run.output;
+  EXPECT_NE(run.output.find("scenario"), std::string::npos) << run.output;
+  EXPECT_NE(run_sigmafem("demo nowhere").exit_code, 0);
+  EXPECT_NE(run_sigmafem("no-such-command").exit_code, 0);
+}
+
+TEST_F(CliTest, InfoDescribesTheShippedScenarios) {
+  for (const char* name : {"box", "liver"}) {
+    const CommandRun run =
+        run_sigmafem("info " + (fs::path(SIGMAFEM_SOURCE_DIR) / "scenarios" / name).string() + ".json");
+    EXPECT_EQ(run.exit_code, 0) << run.output;
+    EXPECT_NE(run.output.find("tetrahedra"), std::string::npos) << run.output;
+  }
+}
+
+}  // namespace
+}  // namespace sigmafem
