@@ -3,16 +3,99 @@
 #include <cmath>
 #include <sstream>
 
+#include <fstream>
+#include <limits>
+
+#include "host/common/input_error.h"
+#include "host/data/csv_fields.h"
 #include "host/data/csv_format.h"
 
 namespace sigmafem {
 
+std::vector<std::string> observation_columns(int point_count) {
+  std::vector<std::string> columns = {"step", "time", "so_x", "so_y", "so_z"};
+  for (int p = 0; p < point_count; ++p)
+    for (const char* axis : {"_x", "_y", "_z"}) columns.push_back("p" + std::to_string(p) + axis);
+  return columns;
+}
+
+ObservationTable read_observations_csv(const std::string& path, int point_count, double dt) {
+  const std::string where = "observations " + path;
+  std::ifstream in(path);
+  if (!in) throw InputError(where + ": cannot open the file (missing or unreadable)");
+  const std::vector<std::string> columns = observation_columns(point_count);
+  ObservationTable table;
+  std::vector<std::vector<double>> point_rows;
+  std::vector<Eigen::Vector3d> so_rows;
+  bool header_seen = false;
+  std::string raw;
+  for (int line_number = 1; std::getline(in, raw); ++line_number) {
+    const std::string line = trim(raw);
+    if (line.empty()) continue;
+    if (line[0] == '#') {
+      if (!header_seen) table.comments.push_back(trim(line.substr(1)));
+      continue;
+    }
+    const std::string at = where + " line " + std::to_string(line_number) + ": ";
+    const std::vector<std::string> fields = split_fields(line);
+    if (!header_seen) {
+      if (fields != columns) {
+        std::string expected;
+        for (std::size_t k = 0; k < std::min<std::size_t>(columns.size(), 8); ++k)
+          expected += (k ? "," : "") + columns[k];
+        throw InputError(at + "the header does not match the scenario: expected " +
+                         std::to_string(columns.size()) + " columns (" + expected + ",... for " +
+                         std::to_string(point_count) + " observed points), found " +
+                         std::to_string(fields.size()) + ": \"" + line.substr(0, 120) + "\"");
+      }
+      header_seen = true;
+      continue;
+    }
+    if (fields.size() != columns.size())
+      throw InputError(at + "expected " + std::to_string(columns.size()) + " fields, found " +
+                       std::to_string(fields.size()));
+    std::vector<double> values(columns.size(), std::numeric_limits<double>::quiet_NaN());
+    for (std::size_t k = 0; k < fields.size(); ++k) {
+      const bool point_column = k >= 5;
+      if (fields[k].empty() && point_column) continue;   // not observed at this step
+      if (!parse_double(fields[k], values[k])) {
+        const std::string problem =
+            fields[k].empty() ? "is empty (only observed points may be missing)"
+                              : "is not a finite number: \"" + fields[k] + "\"";
+        throw InputError(at + "column " + columns[k] + " " + problem);
+      }
+    }
+    const int expected_step = static_cast<int>(table.steps.size());
+    if (values[0] != static_cast<double>(expected_step))
+      throw InputError(at + "step " + format_number(values[0]) + " is out of order: expected " +
+                       std::to_string(expected_step) + " (rows are consecutive steps from 0)");
+    const double expected_time = expected_step * dt;
+    if (std::fabs(values[1] - expected_time) > 1e-6 * dt + 1e-9)
+      throw InputError(at + "time " + format_number(values[1]) + " is not step * dt = " +
+                       format_number(expected_time) + " (the scenario's dt is " +
+                       format_number(dt) + " s)");
+    table.steps.push_back(expected_step);
+    table.times.push_back(values[1]);
+    so_rows.emplace_back(values[2], values[3], values[4]);
+    point_rows.emplace_back(values.begin() + 5, values.end());
+  }
+  if (!header_seen) throw InputError(where + ": empty file; expected the header " + columns[0] + ",...");
+  if (table.steps.empty()) throw InputError(where + ": no data rows after the header");
+  const Eigen::Index rows = static_cast<Eigen::Index>(table.steps.size());
+  table.so.resize(rows, 3);
+  table.points.resize(rows, 3 * point_count);
+  for (Eigen::Index k = 0; k < rows; ++k) {
+    table.so.row(k) = so_rows[k].transpose();
+    for (Eigen::Index c = 0; c < 3 * point_count; ++c) table.points(k, c) = point_rows[k][c];
+  }
+  return table;
+}
+
 std::string format_observations_csv(const ObservationTable& table) {
   std::ostringstream out;
   for (const std::string& comment : table.comments) out << "# " << comment << '\n';
-  out << "step,time,so_x,so_y,so_z";
-  for (int p = 0; p < table.point_count(); ++p)
-    out << ",p" << p << "_x,p" << p << "_y,p" << p << "_z";
+  const std::vector<std::string> columns = observation_columns(table.point_count());
+  for (std::size_t k = 0; k < columns.size(); ++k) out << (k ? "," : "") << columns[k];
   out << '\n';
   for (int k = 0; k < table.row_count(); ++k) {
     out << table.steps[k] << ',' << format_number(table.times[k]);
@@ -21,23 +104,6 @@ std::string format_observations_csv(const ObservationTable& table) {
       out << ',';
       if (!std::isnan(table.points(k, c))) out << format_number(table.points(k, c));
     }
-    out << '\n';
-  }
-  return out.str();
-}
-
-std::string format_truth_csv(const std::vector<std::string>& comments,
-                             const std::vector<std::string>& names, const std::vector<int>& steps,
-                             const std::vector<double>& times,
-                             const std::vector<std::vector<double>>& stiffness) {
-  std::ostringstream out;
-  for (const std::string& comment : comments) out << "# " << comment << '\n';
-  out << "step,time";
-  for (const std::string& name : names) out << ',' << name;
-  out << '\n';
-  for (std::size_t k = 0; k < steps.size(); ++k) {
-    out << steps[k] << ',' << format_number(times[k]);
-    for (double value : stiffness[k]) out << ',' << format_number(value);
     out << '\n';
   }
   return out.str();

@@ -20,13 +20,17 @@ struct ObservationTable {
   int point_count() const { return static_cast<int>(points.cols() / 3); }
 };
 
+// Reads an observations file and checks it against the scenario: `point_count` observed
+// points, rows consecutive from step 0, each time equal to step * dt. Throws InputError
+// naming the file, the line and the column for a header that does not match, a field that is
+// not a number, a NaN or infinity written out, a missing SO value, a wrong field count, rows
+// out of order, or a time off the step grid. Empty point fields are kept as NaN (missing).
+ObservationTable read_observations_csv(const std::string& path, int point_count, double dt);
+
+// The header columns of an observations file with `point_count` points.
+std::vector<std::string> observation_columns(int point_count);
+
 // The CSV text of the table (header "step,time,so_x,so_y,so_z,p0_x,...").
 std::string format_observations_csv(const ObservationTable& table);
-
-// Truth (docs/FORMATS.md): "step,time,<names...>" with each ligament's stiffness per step.
-std::string format_truth_csv(const std::vector<std::string>& comments,
-                             const std::vector<std::string>& names, const std::vector<int>& steps,
-                             const std::vector<double>& times,
-                             const std::vector<std::vector<double>>& stiffness);
 
 }  // namespace sigmafem

@@ -12,6 +12,7 @@
 #include "host/common/progress.h"
 #include "host/data/csv_format.h"
 #include "host/data/observation_table.h"
+#include "host/data/truth_table.h"
 #include "host/generator/gaussian_noise.h"
 #include "host/generator/vtk_series.h"
 #include "host/model/model.h"
@@ -42,7 +43,10 @@ GenerateResult generate(const Scenario& scenario, const GenerateOptions& options
   table.comments = comments;
   table.so.resize(steps + 1, 3);
   table.points.resize(steps + 1, 3 * static_cast<Eigen::Index>(observed.size()));
-  std::vector<std::vector<double>> truth;
+  TruthTable truth;
+  truth.comments = comments;
+  for (const Ligament& ligament : scenario.ligaments) truth.names.push_back(ligament.name);
+  truth.stiffness.resize(steps + 1, static_cast<Eigen::Index>(scenario.ligaments.size()));
   GaussianNoise noise(options.seed);
 
   GenerateResult result;
@@ -56,7 +60,10 @@ GenerateResult generate(const Scenario& scenario, const GenerateOptions& options
         table.points(k, static_cast<Eigen::Index>(3 * p + a)) =
             simulation.positions()[3 * observed[p] + a] +
             scenario.observations.noise_std * noise.next();
-    truth.push_back(simulation.ligament_stiffness());
+    truth.steps.push_back(k);
+    truth.times.push_back(t);
+    for (std::size_t l = 0; l < scenario.ligaments.size(); ++l)
+      truth.stiffness(k, static_cast<Eigen::Index>(l)) = simulation.ligament_stiffness()[l];
     for (int i = 0; i < model.node_count(); ++i)
       result.max_displacement =
           std::max(result.max_displacement,
@@ -90,12 +97,10 @@ GenerateResult generate(const Scenario& scenario, const GenerateOptions& options
   }
   progress.finish();
 
-  std::vector<std::string> names;
-  for (const Ligament& ligament : scenario.ligaments) names.push_back(ligament.name);
   const fs::path out(options.out_dir);
   write_file_atomically((out / "observations.csv").string(), format_observations_csv(table));
   write_file_atomically((out / "truth.csv").string(),
-                        format_truth_csv(comments, names, table.steps, table.times, truth));
+                        format_truth_csv(truth));
   if (vtk) {
     vtk->finish();
     result.vtk_frames = vtk->frame_count();

@@ -64,7 +64,7 @@ struct Trajectory {
 // Reads a trajectory CSV (docs/FORMATS.md): a header `time,x,y,z`, then one row per knot,
 // times strictly increasing, positions absolute (metres); `#` lines and blank lines are
 // skipped. Returns a Trajectory of type `file` with `file` = path. Throws InputError
-// "trajectory PATH line N: problem" on anything else.
+// "trajectory CSV PATH line N: problem" on anything else.
 Trajectory read_trajectory_csv(const std::string& path);
 
 struct Control {

@@ -1,0 +1,81 @@
+#include "host/data/truth_table.h"
+
+#include <fstream>
+#include <sstream>
+
+#include "host/common/input_error.h"
+#include "host/data/csv_fields.h"
+#include "host/data/csv_format.h"
+
+namespace sigmafem {
+
+int TruthTable::column(const std::string& name) const {
+  for (std::size_t k = 0; k < names.size(); ++k)
+    if (names[k] == name) return static_cast<int>(k);
+  return -1;
+}
+
+std::string format_truth_csv(const TruthTable& table) {
+  std::ostringstream out;
+  for (const std::string& comment : table.comments) out << "# " << comment << '\n';
+  out << "step,time";
+  for (const std::string& name : table.names) out << ',' << name;
+  out << '\n';
+  for (std::size_t k = 0; k < table.steps.size(); ++k) {
+    out << table.steps[k] << ',' << format_number(table.times[k]);
+    for (Eigen::Index c = 0; c < table.stiffness.cols(); ++c)
+      out << ',' << format_number(table.stiffness(static_cast<Eigen::Index>(k), c));
+    out << '\n';
+  }
+  return out.str();
+}
+
+TruthTable read_truth_csv(const std::string& path) {
+  const std::string where = "truth " + path;
+  std::ifstream in(path);
+  if (!in) throw InputError(where + ": cannot open the file (missing or unreadable)");
+  TruthTable table;
+  std::vector<std::vector<double>> rows;
+  bool header_seen = false;
+  std::string raw;
+  for (int line_number = 1; std::getline(in, raw); ++line_number) {
+    const std::string line = trim(raw);
+    if (line.empty()) continue;
+    if (line[0] == '#') {
+      if (!header_seen) table.comments.push_back(trim(line.substr(1)));
+      continue;
+    }
+    const std::string at = where + " line " + std::to_string(line_number) + ": ";
+    const std::vector<std::string> fields = split_fields(line);
+    if (!header_seen) {
+      if (fields.size() < 3 || fields[0] != "step" || fields[1] != "time")
+        throw InputError(at + "expected the header step,time,<ligament names...>");
+      table.names.assign(fields.begin() + 2, fields.end());
+      header_seen = true;
+      continue;
+    }
+    if (fields.size() != table.names.size() + 2)
+      throw InputError(at + "expected " + std::to_string(table.names.size() + 2) +
+                       " fields, found " + std::to_string(fields.size()));
+    std::vector<double> values(fields.size());
+    for (std::size_t k = 0; k < fields.size(); ++k)
+      if (!parse_double(fields[k], values[k]))
+        throw InputError(at + "column " + (k == 0 ? std::string("step") : k == 1 ? "time" : table.names[k - 2]) +
+                         " is not a finite number: \"" + fields[k] + "\"");
+    if (values[0] != static_cast<double>(rows.size()))
+      throw InputError(at + "step " + fields[0] + " is out of order: expected " +
+                       std::to_string(rows.size()));
+    table.steps.push_back(static_cast<int>(rows.size()));
+    table.times.push_back(values[1]);
+    rows.emplace_back(values.begin() + 2, values.end());
+  }
+  if (rows.empty()) throw InputError(where + ": no data rows");
+  table.stiffness.resize(static_cast<Eigen::Index>(rows.size()),
+                         static_cast<Eigen::Index>(table.names.size()));
+  for (std::size_t k = 0; k < rows.size(); ++k)
+    for (std::size_t c = 0; c < table.names.size(); ++c)
+      table.stiffness(static_cast<Eigen::Index>(k), static_cast<Eigen::Index>(c)) = rows[k][c];
+  return table;
+}
+
+}  // namespace sigmafem

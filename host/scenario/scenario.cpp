@@ -1,0 +1,34 @@
+// Scenario queries that the generator and the filter ask during a run: which ligament has
+// a name, and what stiffness every ligament has at a given time once events are applied.
+#include "host/scenario/scenario.h"
+
+namespace sigmafem {
+
+namespace {
+// Times in a run are computed as step * dt, which can land a hair below an event time
+// written as a round number (750 * 0.01 = 7.4999999999999991); the slack keeps such an
+// event on its intended step. 1e-9 s is far below any dt anyone will use.
+constexpr double kEventTimeSlack = 1e-9;
+}  // namespace
+
+int Scenario::ligament_index(const std::string& ligament_name) const {
+  for (size_t i = 0; i < ligaments.size(); ++i) {
+    if (ligaments[i].name == ligament_name) return static_cast<int>(i);
+  }
+  return -1;
+}
+
+std::vector<double> Scenario::ligament_stiffness_at(double t) const {
+  std::vector<double> stiffness;
+  stiffness.reserve(ligaments.size());
+  for (const Ligament& ligament : ligaments) stiffness.push_back(ligament.stiffness);
+  // Events are sorted by time (stable, so equal times keep file order): the last one that
+  // has happened for a ligament wins.
+  for (const Event& event : events) {
+    if (event.time > t + kEventTimeSlack) break;
+    stiffness[static_cast<size_t>(event.ligament)] = event.stiffness;
+  }
+  return stiffness;
+}
+
+}  // namespace sigmafem

@@ -1,0 +1,720 @@
+// load_scenario(): reads a scenario JSON file (docs/FORMATS.md, "sigmafem-scenario/1"),
+// checks every field, loads the mesh and resolves node sets to indices.
+//
+// Every problem is an InputError "scenario FILE: FIELD: what is wrong", FIELD being the
+// path of the field as a user would point at it (`time.dt`, `ligaments[1] "middle".stiffness`,
+// `events[0].ligament`), so a message can be acted on without reading this code. Unknown
+// fields are errors at every level: in a hand-written file a typo ("stifness") would
+// otherwise silently fall back to a default. Units are SI throughout.
+#include <algorithm>
+#include <climits>
+#include <cmath>
+#include <cstdint>
+#include <filesystem>
+#include <fstream>
+#include <nlohmann/json.hpp>
+#include <set>
+#include <sstream>
+
+#include "host/common/input_error.h"
+#include "host/scenario/scenario.h"
+
+namespace sigmafem {
+
+namespace {
+
+using nlohmann::json;
+namespace fs = std::filesystem;
+
+constexpr const char* kFormat = "sigmafem-scenario/1";
+
+// ---------------------------------------------------------------------------------------
+// Text helpers for messages.
+
+std::string format_number(double value) {
+  std::ostringstream out;
+  out << value;  // %g-like, 6 significant digits: enough to recognise the value written
+  return out.str();
+}
+
+std::string format_vector(const Eigen::Vector3d& v) {
+  return "[" + format_number(v.x()) + ", " + format_number(v.y()) + ", " + format_number(v.z()) +
+         "]";
+}
+
+std::string in_quotes(const std::string& s) {
+  return "\"" + s + "\"";
+}
+
+std::string join(const std::vector<std::string>& items) {
+  std::string out;
+  for (const std::string& item : items) out += (out.empty() ? "" : ", ") + item;
+  return out;
+}
+
+// What a JSON value is, for "expected X, found Y".
+std::string describe(const json& value) {
+  constexpr size_t kMaxShown = 40;
+  switch (value.type()) {
+    case json::value_t::null:
+      return "null";
+    case json::value_t::boolean:
+      return value.dump() + " (a boolean)";
+    case json::value_t::string: {
+      std::string text = value.dump();
+      if (text.size() > kMaxShown) text = text.substr(0, kMaxShown) + "...\"";
+      return text + " (a string)";
+    }
+    case json::value_t::array:
+      return "an array of " + std::to_string(value.size()) + " elements";
+    case json::value_t::object:
+      return "an object";
+    default:
+      return value.dump();  // the numbers
+  }
+}
+
+// Levenshtein distance, to suggest the field or ligament a typo meant.
+size_t edit_distance(const std::string& a, const std::string& b) {
+  std::vector<size_t> row(b.size() + 1);
+  for (size_t j = 0; j <= b.size(); ++j) row[j] = j;
+  for (size_t i = 1; i <= a.size(); ++i) {
+    size_t diagonal = row[0];
+    row[0] = i;
+    for (size_t j = 1; j <= b.size(); ++j) {
+      const size_t above = row[j];
+      row[j] = std::min({row[j] + 1, row[j - 1] + 1, diagonal + (a[i - 1] == b[j - 1] ? 0 : 1)});
+      diagonal = above;
+    }
+  }
+  return row[b.size()];
+}
+
+// " (did you mean "x"?)" when one candidate is within two edits, else "".
+std::string suggestion(const std::string& word, const std::vector<std::string>& candidates) {
+  std::string best;
+  size_t best_distance = 3;
+  for (const std::string& candidate : candidates) {
+    const size_t d = edit_distance(word, candidate);
+    if (d < best_distance && d < candidate.size()) {
+      best = candidate;
+      best_distance = d;
+    }
+  }
+  return best.empty() ? "" : " (did you mean " + in_quotes(best) + "?)";
+}
+
+std::string child(const std::string& path, const std::string& key) {
+  return path.empty() ? key : path + "." + key;
+}
+
+std::string element(const std::string& path, size_t index) {
+  return path + "[" + std::to_string(index) + "]";
+}
+
+// ---------------------------------------------------------------------------------------
+// Reading the file.
+
+// nlohmann keeps the last of two equal keys without a word; in a hand-written scenario a
+// repeated key is a mistake (an edit made in one place and not the other), so the parser
+// callback tracks where it is and reports the repeated key by its field path.
+class DuplicateKeyCheck {
+ public:
+  // Returns the path of a key that repeats, or "" if the event is fine.
+  std::string on_event(json::parse_event_t event, const json& parsed) {
+    switch (event) {
+      case json::parse_event_t::object_start:
+        frames_.push_back({true, {}, {}, 0});
+        break;
+      case json::parse_event_t::array_start:
+        frames_.push_back({false, {}, {}, 0});
+        break;
+      case json::parse_event_t::key: {
+        Frame& top = frames_.back();
+        top.key = parsed.get<std::string>();
+        if (!top.keys.insert(top.key).second) return path();
+        break;
+      }
+      case json::parse_event_t::value:
+        next_element();
+        break;
+      case json::parse_event_t::object_end:
+      case json::parse_event_t::array_end:
+        frames_.pop_back();
+        next_element();
+        break;
+    }
+    return "";
+  }
+
+ private:
+  struct Frame {
+    bool is_object;
+    std::set<std::string> keys;  // objects: keys seen so far
+    std::string key;             // objects: the key being read
+    size_t index;                // arrays: index of the element being read
+  };
+
+  void next_element() {
+    if (!frames_.empty() && !frames_.back().is_object) ++frames_.back().index;
+  }
+
+  std::string path() const {
+    std::string out;
+    for (const Frame& frame : frames_) {
+      out = frame.is_object ? child(out, frame.key) : element(out, frame.index);
+    }
+    return out;
+  }
+
+  std::vector<Frame> frames_;
+};
+
+// nlohmann reports a byte offset (1-based, the last character it read); people count lines.
+std::string line_and_column(const std::string& text, size_t byte) {
+  const size_t end = std::min(byte > 0 ? byte - 1 : 0, text.size());
+  size_t line = 1;
+  size_t line_start = 0;
+  for (size_t i = 0; i < end; ++i) {
+    if (text[i] == '\n') {
+      ++line;
+      line_start = i + 1;
+    }
+  }
+  return "line " + std::to_string(line) + ", column " + std::to_string(end - line_start + 1);
+}
+
+// nlohmann's what() is "[json.exception.parse_error.101] parse error at line 3, column 5:
+// syntax error while parsing ..."; keep the part after the location.
+std::string parse_problem(const std::string& what) {
+  const size_t at = what.find("parse error");
+  const size_t colon = at == std::string::npos ? at : what.find(": ", at);
+  return colon == std::string::npos ? what : what.substr(colon + 2);
+}
+
+// ---------------------------------------------------------------------------------------
+// Field access with checks. All of them throw with the field's path.
+
+class Checker {
+ public:
+  explicit Checker(std::string file) : file_(std::move(file)) {}
+
+  [[noreturn]] void fail(const std::string& path, const std::string& what) const {
+    throw InputError("scenario " + file_ + ": " + path + ": " + what);
+  }
+
+  // A problem with the file as a whole, before any field can be named.
+  [[noreturn]] void fail_file(const std::string& what) const {
+    throw InputError("scenario " + file_ + ": " + what);
+  }
+
+  void require(bool ok, const std::string& path, const std::string& what) const {
+    if (!ok) fail(path, what);
+  }
+
+  // `value` must be an object with only `allowed` keys and every `required` one. The root
+  // object's path is "", and its unknown or missing fields are named alone ("meshh").
+  void check_object(const json& value, const std::string& path,
+                    const std::vector<std::string>& allowed,
+                    const std::vector<std::string>& required) const {
+    require(value.is_object(), path.empty() ? "(top level)" : path,
+            "expected an object {...}, found " + describe(value));
+    for (const auto& item : value.items()) {
+      if (std::find(allowed.begin(), allowed.end(), item.key()) == allowed.end()) {
+        fail(child(path, item.key()), "unknown field" + suggestion(item.key(), allowed) +
+                                          "; allowed here: " + join(allowed));
+      }
+    }
+    for (const std::string& key : required) {
+      require(value.contains(key), child(path, key), "missing required field");
+    }
+  }
+
+  double number(const json& value, const std::string& path) const {
+    require(value.is_number(), path, "expected a number, found " + describe(value));
+    const double x = value.get<double>();
+    // A literal such as 1e999 parses to infinity; no scenario quantity may be infinite.
+    require(std::isfinite(x), path, "expected a finite number, found " + value.dump());
+    return x;
+  }
+
+  // Integers may be written 1500 or 1.5e3, but not 1500.5.
+  int integer(const json& value, const std::string& path) const {
+    const std::string found = "expected an integer, found " + describe(value);
+    require(value.is_number(), path, found);
+    const double x = value.is_number_unsigned()  ? static_cast<double>(value.get<std::uint64_t>())
+                     : value.is_number_integer() ? static_cast<double>(value.get<std::int64_t>())
+                                                 : value.get<double>();
+    require(std::isfinite(x) && x == std::floor(x), path, found);
+    require(x >= INT_MIN && x <= INT_MAX, path, "integer " + value.dump() + " is out of range");
+    return static_cast<int>(x);
+  }
+
+  std::string string(const json& value, const std::string& path) const {
+    require(value.is_string(), path, "expected a string \"...\", found " + describe(value));
+    return value.get<std::string>();
+  }
+
+  Eigen::Vector3d vector3(const json& value, const std::string& path) const {
+    require(value.is_array() && value.size() == 3, path,
+            "expected an array of 3 numbers [x, y, z], found " + describe(value));
+    Eigen::Vector3d v;
+    for (size_t k = 0; k < 3; ++k)
+      v[static_cast<Eigen::Index>(k)] = number(value[k], element(path, k));
+    return v;
+  }
+
+  const json& array(const json& value, const std::string& path) const {
+    require(value.is_array(), path, "expected an array [...], found " + describe(value));
+    return value;
+  }
+
+  // Optional members of an already checked object: the fallback when absent.
+  double number_or(const json& object, const std::string& path, const std::string& key,
+                   double fallback) const {
+    return object.contains(key) ? number(object.at(key), child(path, key)) : fallback;
+  }
+  int integer_or(const json& object, const std::string& path, const std::string& key,
+                 int fallback) const {
+    return object.contains(key) ? integer(object.at(key), child(path, key)) : fallback;
+  }
+
+  // Range checks: the message shows the rule and the value found.
+  void positive(double x, const std::string& path) const {
+    require(x > 0.0, path, "must be > 0, found " + format_number(x));
+  }
+  void non_negative(double x, const std::string& path) const {
+    require(x >= 0.0, path, "must be >= 0, found " + format_number(x));
+  }
+
+ private:
+  std::string file_;
+};
+
+// A list of node indices: integers in range, each once. Keeps the order written.
+std::vector<int> node_indices(const Checker& c, const json& value, const std::string& path,
+                              const Mesh& mesh) {
+  c.array(value, path);
+  std::vector<int> nodes;
+  std::set<int> seen;
+  for (size_t i = 0; i < value.size(); ++i) {
+    const std::string at = element(path, i);
+    const int node = c.integer(value[i], at);
+    c.require(node >= 0 && node < mesh.node_count(), at,
+              "node " + std::to_string(node) + " does not exist; the mesh has " +
+                  std::to_string(mesh.node_count()) + " nodes (indices 0 to " +
+                  std::to_string(mesh.node_count() - 1) + ")");
+    // A repeat is a slip, and it would also change n in the per-node stiffness k/n.
+    c.require(seen.insert(node).second, at, "node " + std::to_string(node) + " is listed twice");
+    nodes.push_back(node);
+  }
+  return nodes;
+}
+
+// The node set of a ligament or of the control: `nodes` or `select` (near + radius, or box),
+// in the transformed frame. Returns sorted, unique indices; an empty set is an error.
+std::vector<int> node_set(const Checker& c, const json& owner, const std::string& path,
+                          const Mesh& mesh) {
+  const bool has_nodes = owner.contains("nodes");
+  const bool has_select = owner.contains("select");
+  c.require(!(has_nodes && has_select), path, "give either \"nodes\" or \"select\", not both");
+  c.require(
+      has_nodes || has_select, path,
+      "missing node set: give \"nodes\" (node indices) or \"select\" (near + radius, or box)");
+  std::vector<int> nodes;
+  std::string asked;   // the selection, for the empty-set message
+  std::string advice;  // what to change
+  if (has_nodes) {
+    nodes = node_indices(c, owner.at("nodes"), child(path, "nodes"), mesh);
+    std::sort(nodes.begin(), nodes.end());
+    asked = "\"nodes\" is an empty list";
+    advice = "list at least one node";
+  } else {
+    const std::string select_path = child(path, "select");
+    const json& select = owner.at("select");
+    c.check_object(select, select_path, {"near", "radius", "box"}, {});
+    const bool has_sphere = select.contains("near") || select.contains("radius");
+    const bool has_box = select.contains("box");
+    c.require(!(has_sphere && has_box), select_path,
+              "give either \"near\" + \"radius\" or \"box\", not both");
+    c.require(has_sphere || has_box, select_path,
+              "empty selection: give \"near\" + \"radius\" or \"box\": {\"min\", \"max\"}");
+    if (has_sphere) {
+      c.check_object(select, select_path, {"near", "radius"}, {"near", "radius"});
+      const Eigen::Vector3d near = c.vector3(select.at("near"), child(select_path, "near"));
+      const double radius = c.number(select.at("radius"), child(select_path, "radius"));
+      c.positive(radius, child(select_path, "radius"));
+      nodes = select_nodes_near(mesh, near, radius);
+      asked = "near " + format_vector(near) + ", radius " + format_number(radius) + " m";
+      advice = "enlarge radius or list nodes";
+    } else {
+      const std::string box_path = child(select_path, "box");
+      const json& box = select.at("box");
+      c.check_object(box, box_path, {"min", "max"}, {"min", "max"});
+      const Eigen::Vector3d min = c.vector3(box.at("min"), child(box_path, "min"));
+      const Eigen::Vector3d max = c.vector3(box.at("max"), child(box_path, "max"));
+      c.require((min.array() <= max.array()).all(), box_path,
+                "min " + format_vector(min) + " exceeds max " + format_vector(max) +
+                    " in some coordinate");
+      nodes = select_nodes_in_box(mesh, min, max);
+      asked = "box min " + format_vector(min) + ", max " + format_vector(max) + " m";
+      advice = "enlarge the box or list nodes";
+    }
+    // With a mesh scale set, a selection written in file units is the usual cause.
+    advice += " (selections are in metres, after mesh scale and translate)";
+  }
+  c.require(!nodes.empty(), path, "node set is empty (" + asked + "); " + advice);
+  return nodes;
+}
+
+// A ligament name becomes a CSV column header (truth and estimates files) and is looked
+// up by events and the filter; keep it to characters that survive that.
+bool valid_name(const std::string& name) {
+  if (name.empty() || name.front() == ' ' || name.back() == ' ') return false;
+  return std::none_of(name.begin(), name.end(), [](char ch) {
+    return ch == ',' || ch == '"' || static_cast<unsigned char>(ch) < 0x20;
+  });
+}
+
+// Index of the ligament called `name`, or a failure naming the ligaments there are.
+int ligament_by_name(const Checker& c, const std::vector<Ligament>& ligaments, const json& value,
+                     const std::string& path) {
+  const std::string name = c.string(value, path);
+  std::vector<std::string> names;
+  for (size_t i = 0; i < ligaments.size(); ++i) {
+    if (ligaments[i].name == name) return static_cast<int>(i);
+    names.push_back(ligaments[i].name);
+  }
+  c.fail(path, "no ligament named " + in_quotes(name) + suggestion(name, names) +
+                   "; ligaments: " + (names.empty() ? "(none)" : join(names)));
+}
+
+std::string read_text(const Checker& c, const std::string& path) {
+  std::error_code error;
+  if (!fs::exists(path, error)) c.fail_file("file not found");
+  if (fs::is_directory(path, error)) c.fail_file("is a folder, expected a JSON file");
+  std::ifstream in(path, std::ios::binary);
+  if (!in) c.fail_file("file cannot be opened for reading");
+  std::ostringstream text;
+  text << in.rdbuf();
+  return text.str();
+}
+
+json parse_json(const Checker& c, const std::string& text) {
+  DuplicateKeyCheck duplicates;
+  const json::parser_callback_t callback = [&](int /*depth*/, json::parse_event_t event,
+                                               json& parsed) {
+    const std::string repeated = duplicates.on_event(event, parsed);
+    if (!repeated.empty()) c.fail(repeated, "duplicate key; each field may appear once");
+    return true;
+  };
+  try {
+    return json::parse(text, callback);
+  } catch (const json::parse_error& e) {
+    c.fail(line_and_column(text, e.byte), "invalid JSON: " + parse_problem(e.what()));
+  }
+}
+
+// Paths in a scenario are relative to its folder, so a scenario and its files move together.
+std::string resolve(const std::string& scenario_path, const std::string& file) {
+  return (fs::path(scenario_path).parent_path() / file).lexically_normal().string();
+}
+
+// ---------------------------------------------------------------------------------------
+// The sections, in the order of docs/FORMATS.md.
+
+void read_mesh_section(const Checker& c, const json& root, const std::string& scenario_path,
+                       Scenario& s) {
+  const json& spec = root.at("mesh");
+  c.check_object(spec, "mesh", {"file", "scale", "translate"}, {"file"});
+  s.mesh_spec.file = c.string(spec.at("file"), "mesh.file");
+  c.require(!s.mesh_spec.file.empty(), "mesh.file", "empty file name");
+  s.mesh_spec.scale = c.number_or(spec, "mesh", "scale", 1.0);
+  c.positive(s.mesh_spec.scale, "mesh.scale");
+  if (spec.contains("translate"))
+    s.mesh_spec.translate = c.vector3(spec.at("translate"), "mesh.translate");
+  s.mesh_spec.resolved_path = resolve(scenario_path, s.mesh_spec.file);
+  std::error_code error;
+  c.require(fs::is_regular_file(s.mesh_spec.resolved_path, error), "mesh.file",
+            "file not found: " + s.mesh_spec.resolved_path +
+                " (mesh paths are relative to the scenario's folder)");
+  try {
+    s.mesh = read_mesh(s.mesh_spec.resolved_path);
+    transform_mesh(s.mesh, s.mesh_spec.scale, s.mesh_spec.translate);
+    s.mesh_report = orient_and_check(s.mesh, s.mesh_spec.resolved_path);
+  } catch (const InputError& e) {
+    c.fail("mesh.file", e.what());
+  }
+}
+
+void read_physics(const Checker& c, const json& root, Scenario& s) {
+  const json& material = root.at("material");
+  c.check_object(material, "material", {"young_modulus", "poisson_ratio", "density"},
+                 {"young_modulus", "poisson_ratio", "density"});
+  s.material.young_modulus = c.number(material.at("young_modulus"), "material.young_modulus");
+  c.positive(s.material.young_modulus, "material.young_modulus");
+  s.material.poisson_ratio = c.number(material.at("poisson_ratio"), "material.poisson_ratio");
+  // nu = 0.5 is incompressible: the linear elastic stiffness has lambda -> infinity.
+  c.require(s.material.poisson_ratio > -1.0 && s.material.poisson_ratio < 0.5,
+            "material.poisson_ratio",
+            "must be in (-1, 0.5), found " + format_number(s.material.poisson_ratio));
+  s.material.density = c.number(material.at("density"), "material.density");
+  c.positive(s.material.density, "material.density");
+
+  if (root.contains("damping")) {
+    const json& damping = root.at("damping");
+    c.check_object(damping, "damping", {"rayleigh_stiffness", "rayleigh_mass"}, {});
+    s.damping.rayleigh_stiffness = c.number_or(damping, "damping", "rayleigh_stiffness", 0.0);
+    c.non_negative(s.damping.rayleigh_stiffness, "damping.rayleigh_stiffness");
+    s.damping.rayleigh_mass = c.number_or(damping, "damping", "rayleigh_mass", 0.0);
+    c.non_negative(s.damping.rayleigh_mass, "damping.rayleigh_mass");
+  }
+  if (root.contains("gravity")) s.gravity = c.vector3(root.at("gravity"), "gravity");
+
+  const json& time = root.at("time");
+  c.check_object(time, "time", {"dt", "steps"}, {"dt", "steps"});
+  s.time.dt = c.number(time.at("dt"), "time.dt");
+  c.positive(s.time.dt, "time.dt");
+  s.time.steps = c.integer(time.at("steps"), "time.steps");
+  c.require(s.time.steps >= 1, "time.steps", "must be >= 1, found " + std::to_string(s.time.steps));
+
+  if (root.contains("solver")) {
+    const json& solver = root.at("solver");
+    c.check_object(solver, "solver", {"cg_max_iterations", "cg_tolerance"}, {});
+    s.solver.cg_max_iterations =
+        c.integer_or(solver, "solver", "cg_max_iterations", s.solver.cg_max_iterations);
+    c.require(s.solver.cg_max_iterations >= 1, "solver.cg_max_iterations",
+              "must be >= 1, found " + std::to_string(s.solver.cg_max_iterations));
+    s.solver.cg_tolerance = c.number_or(solver, "solver", "cg_tolerance", s.solver.cg_tolerance);
+    // A relative residual: 1 or more would accept the warm start unchanged.
+    c.require(s.solver.cg_tolerance > 0.0 && s.solver.cg_tolerance < 1.0, "solver.cg_tolerance",
+              "must be in (0, 1), found " + format_number(s.solver.cg_tolerance));
+  }
+}
+
+void read_ligaments(const Checker& c, const json& root, Scenario& s) {
+  if (!root.contains("ligaments")) return;
+  const json& ligaments = c.array(root.at("ligaments"), "ligaments");
+  for (size_t i = 0; i < ligaments.size(); ++i) {
+    const json& item = ligaments[i];
+    // Name the ligament in its path as soon as it is known: "ligaments[1] "middle"".
+    std::string path = element("ligaments", i);
+    if (item.is_object() && item.contains("name") && item.at("name").is_string()) {
+      path += " " + in_quotes(item.at("name").get<std::string>());
+    }
+    c.check_object(item, path, {"name", "nodes", "select", "stiffness"}, {"name", "stiffness"});
+    Ligament ligament;
+    ligament.name = c.string(item.at("name"), child(path, "name"));
+    c.require(valid_name(ligament.name), child(path, "name"),
+              "not a usable name: it must be non-empty, without commas, quotes, control "
+              "characters or edge spaces (it becomes a CSV column header)");
+    c.require(s.ligament_index(ligament.name) < 0, child(path, "name"),
+              "duplicate ligament name (also ligaments[" +
+                  std::to_string(s.ligament_index(ligament.name)) + "]); names must be unique");
+    ligament.nodes = node_set(c, item, path, s.mesh);
+    ligament.stiffness = c.number(item.at("stiffness"), child(path, "stiffness"));
+    c.non_negative(ligament.stiffness, child(path, "stiffness"));
+    s.ligaments.push_back(std::move(ligament));
+  }
+}
+
+Trajectory read_trajectory(const Checker& c, const json& value, const std::string& path,
+                           const std::string& scenario_path) {
+  c.check_object(value, path, {"type", "velocity", "times", "positions", "file"}, {"type"});
+  const std::string type = c.string(value.at("type"), child(path, "type"));
+  Trajectory trajectory;
+  if (type == "linear") {
+    c.check_object(value, path, {"type", "velocity"}, {"velocity"});
+    trajectory.type = Trajectory::Type::linear;
+    trajectory.velocity = c.vector3(value.at("velocity"), child(path, "velocity"));
+  } else if (type == "waypoints") {
+    c.check_object(value, path, {"type", "times", "positions"}, {"times", "positions"});
+    trajectory.type = Trajectory::Type::waypoints;
+    const std::string times_path = child(path, "times");
+    const std::string positions_path = child(path, "positions");
+    const json& times = c.array(value.at("times"), times_path);
+    const json& positions = c.array(value.at("positions"), positions_path);
+    c.require(!times.empty(), times_path, "needs at least one waypoint");
+    c.require(times.size() == positions.size(), positions_path,
+              std::to_string(positions.size()) + " positions for " + std::to_string(times.size()) +
+                  " times; give one position [x, y, z] per time");
+    for (size_t i = 0; i < times.size(); ++i) {
+      const double t = c.number(times[i], element(times_path, i));
+      c.require(trajectory.times.empty() || t > trajectory.times.back(), element(times_path, i),
+                "time " + format_number(t) + " does not come after the previous time " +
+                    (trajectory.times.empty() ? "" : format_number(trajectory.times.back())) +
+                    "; times must strictly increase");
+      trajectory.times.push_back(t);
+      trajectory.positions.push_back(c.vector3(positions[i], element(positions_path, i)));
+    }
+  } else if (type == "file") {
+    c.check_object(value, path, {"type", "file"}, {"file"});
+    const std::string file_path = child(path, "file");
+    const std::string file = c.string(value.at("file"), file_path);
+    c.require(!file.empty(), file_path, "empty file name");
+    const std::string resolved = resolve(scenario_path, file);
+    std::error_code error;
+    c.require(fs::is_regular_file(resolved, error), file_path,
+              "file not found: " + resolved + " (paths are relative to the scenario's folder)");
+    try {
+      trajectory = read_trajectory_csv(resolved);
+    } catch (const InputError& e) {
+      c.fail(file_path, e.what());
+    }
+    trajectory.file = file;
+  } else {
+    c.fail(child(path, "type"), "unknown trajectory type " + in_quotes(type) +
+                                    suggestion(type, {"linear", "waypoints", "file"}) +
+                                    "; expected linear, waypoints or file");
+  }
+  return trajectory;
+}
+
+void read_control(const Checker& c, const json& root, const std::string& scenario_path,
+                  Scenario& s) {
+  const json& control = root.at("control");
+  c.check_object(control, "control", {"nodes", "select", "stiffness", "trajectory"},
+                 {"stiffness", "trajectory"});
+  s.control.nodes = node_set(c, control, "control", s.mesh);
+  s.control.stiffness = c.number(control.at("stiffness"), "control.stiffness");
+  c.non_negative(s.control.stiffness, "control.stiffness");
+  s.control.trajectory =
+      read_trajectory(c, control.at("trajectory"), "control.trajectory", scenario_path);
+  // so(0): the SO's offsets to its nodes are taken at rest, so at t = 0 no spring pulls.
+  Eigen::Vector3d sum = Eigen::Vector3d::Zero();
+  for (int node : s.control.nodes) sum += s.mesh.nodes[static_cast<size_t>(node)];
+  s.control.start = sum / static_cast<double>(s.control.nodes.size());
+}
+
+void read_events(const Checker& c, const json& root, Scenario& s) {
+  if (!root.contains("events")) return;
+  const json& events = c.array(root.at("events"), "events");
+  for (size_t i = 0; i < events.size(); ++i) {
+    const std::string path = element("events", i);
+    c.check_object(events[i], path, {"time", "ligament", "stiffness"},
+                   {"time", "ligament", "stiffness"});
+    Event event;
+    event.time = c.number(events[i].at("time"), child(path, "time"));
+    c.non_negative(event.time, child(path, "time"));
+    event.ligament =
+        ligament_by_name(c, s.ligaments, events[i].at("ligament"), child(path, "ligament"));
+    event.ligament_name = s.ligaments[static_cast<size_t>(event.ligament)].name;
+    event.stiffness = c.number(events[i].at("stiffness"), child(path, "stiffness"));
+    c.non_negative(event.stiffness, child(path, "stiffness"));
+    s.events.push_back(std::move(event));
+  }
+  // Stable: two events at the same time apply in the order written, the last one winning.
+  std::stable_sort(s.events.begin(), s.events.end(),
+                   [](const Event& a, const Event& b) { return a.time < b.time; });
+}
+
+void read_observations(const Checker& c, const json& root, Scenario& s) {
+  if (!root.contains("observations")) return;
+  const json& observations = root.at("observations");
+  c.check_object(observations, "observations", {"nodes", "noise_std"}, {});
+  if (observations.contains("nodes")) {
+    // Scenario order is kept: it is the column order of the observations CSV.
+    s.observations.nodes = node_indices(c, observations.at("nodes"), "observations.nodes", s.mesh);
+  }
+  s.observations.noise_std = c.number_or(observations, "observations", "noise_std", 0.0);
+  c.non_negative(s.observations.noise_std, "observations.noise_std");
+}
+
+void read_filter(const Checker& c, const json& root, Scenario& s) {
+  if (!root.contains("filter")) return;
+  const json& filter = root.at("filter");
+  c.check_object(filter, "filter",
+                 {"estimate", "initial_stiffness", "initial_log_std", "parameter_drift_log_std",
+                  "observation_std", "sigma_points"},
+                 {"estimate", "initial_stiffness", "observation_std"});
+  FilterSpec spec;
+  const json& estimate = c.array(filter.at("estimate"), "filter.estimate");
+  c.require(!estimate.empty(), "filter.estimate", "empty: name at least one ligament to estimate");
+  for (size_t i = 0; i < estimate.size(); ++i) {
+    const std::string path = element("filter.estimate", i);
+    const int index = ligament_by_name(c, s.ligaments, estimate[i], path);
+    c.require(
+        std::find(spec.estimate.begin(), spec.estimate.end(), index) == spec.estimate.end(), path,
+        "ligament " + in_quotes(s.ligaments[static_cast<size_t>(index)].name) + " is listed twice");
+    spec.estimate.push_back(index);
+  }
+  const json& initial = c.array(filter.at("initial_stiffness"), "filter.initial_stiffness");
+  c.require(initial.size() == estimate.size(), "filter.initial_stiffness",
+            std::to_string(initial.size()) + " values for " + std::to_string(estimate.size()) +
+                " estimated ligaments; give one per name in filter.estimate, same order");
+  for (size_t i = 0; i < initial.size(); ++i) {
+    const std::string path = element("filter.initial_stiffness", i);
+    const double k = c.number(initial[i], path);
+    // The filter works on log-stiffness: the prior median must be positive.
+    c.positive(k, path);
+    spec.initial_stiffness.push_back(k);
+  }
+  spec.initial_log_std = c.number_or(filter, "filter", "initial_log_std", spec.initial_log_std);
+  c.positive(spec.initial_log_std, "filter.initial_log_std");
+  spec.parameter_drift_log_std =
+      c.number_or(filter, "filter", "parameter_drift_log_std", spec.parameter_drift_log_std);
+  c.non_negative(spec.parameter_drift_log_std, "filter.parameter_drift_log_std");
+  // The filter divides by this variance: zero would claim perfect measurements.
+  spec.observation_std = c.number(filter.at("observation_std"), "filter.observation_std");
+  c.positive(spec.observation_std, "filter.observation_std");
+  if (filter.contains("sigma_points")) {
+    spec.sigma_points = c.string(filter.at("sigma_points"), "filter.sigma_points");
+    c.require(spec.sigma_points == "simplex" || spec.sigma_points == "star", "filter.sigma_points",
+              "unknown sigma-point set " + in_quotes(spec.sigma_points) +
+                  suggestion(spec.sigma_points, {"simplex", "star"}) +
+                  "; expected simplex (p+1 points) or star (2p points)");
+  }
+  c.require(!s.observations.nodes.empty(), "filter",
+            "the filter needs observed nodes, and observations.nodes is empty");
+  s.filter = std::move(spec);
+}
+
+void read_output(const Checker& c, const json& root, Scenario& s) {
+  if (!root.contains("output")) return;
+  const json& output = root.at("output");
+  c.check_object(output, "output", {"vtk_every"}, {});
+  s.output.vtk_every = c.integer_or(output, "output", "vtk_every", s.output.vtk_every);
+  c.require(s.output.vtk_every >= 0, "output.vtk_every",
+            "must be >= 0 (0: no VTK frames), found " + std::to_string(s.output.vtk_every));
+}
+
+}  // namespace
+
+Scenario load_scenario(const std::string& path) {
+  const Checker c(path);
+  const json root = parse_json(c, read_text(c, path));
+  c.require(root.is_object(), "(top level)",
+            "expected a JSON object {...}, found " + describe(root));
+
+  Scenario s;
+  s.path = path;
+  // The format first: a file of another format or version would otherwise be reported as
+  // a list of unknown fields.
+  c.require(root.contains("format"), "format",
+            "missing required field; a scenario starts with \"format\": \"" + std::string(kFormat) +
+                "\"");
+  s.format = c.string(root.at("format"), "format");
+  c.require(s.format == kFormat, "format",
+            "this program reads " + in_quotes(kFormat) + ", found " + in_quotes(s.format));
+  c.check_object(root, "",
+                 {"format", "name", "description", "mesh", "material", "damping", "gravity", "time",
+                  "solver", "ligaments", "control", "events", "observations", "filter", "output"},
+                 {"format", "mesh", "material", "time", "control"});
+
+  s.name =
+      root.contains("name") ? c.string(root.at("name"), "name") : fs::path(path).stem().string();
+  c.require(!s.name.empty(), "name", "empty; leave the field out to use the file name");
+  if (root.contains("description")) s.description = c.string(root.at("description"), "description");
+
+  read_mesh_section(c, root, path, s);
+  read_physics(c, root, s);
+  read_ligaments(c, root, s);
+  read_control(c, root, path, s);
+  read_events(c, root, s);
+  read_observations(c, root, s);
+  read_filter(c, root, s);
+  read_output(c, root, s);
+  return s;
+}
+
+}  // namespace sigmafem
