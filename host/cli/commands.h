@@ -11,6 +11,7 @@ namespace sigmafem::cli {
 using Action = std::function<int()>;
 
 Action add_generate_command(CLI::App& app);
+Action add_estimate_command(CLI::App& app);
 Action add_demo_command(CLI::App& app);
 Action add_info_command(CLI::App& app);
 

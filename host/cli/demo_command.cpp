@@ -1,12 +1,13 @@
 // `sigmafem demo [box|liver] [--out DIR]`: the main job on a shipped scenario, from a build
-// or an installed copy. It generates the scenario's synthetic data (the filter, issue 3,
-// will run on it here too).
+// or an installed copy: generate the scenario's synthetic data into <out>/data, estimate the
+// ligament stiffnesses from it into <out>/estimate, and print where the plots are.
 #include <cstdlib>
 #include <filesystem>
 #include <iostream>
 #include <memory>
 
 #include "host/cli/commands.h"
+#include "host/cli/estimation_job.h"
 #include "host/cli/report.h"
 #include "host/common/input_error.h"
 #include "host/generator/generate.h"
@@ -41,6 +42,8 @@ Action add_demo_command(CLI::App& app) {
     std::string scenario = "box";
     std::string out_dir;
     std::uint64_t seed = 1;
+    std::string backend = "cpu";
+    std::string sigma_points;
   };
   auto options = std::make_shared<Options>();
   CLI::App* sub = app.add_subcommand("demo", "Run the main job on a shipped scenario");
@@ -49,17 +52,32 @@ Action add_demo_command(CLI::App& app) {
       ->capture_default_str();
   sub->add_option("--out", options->out_dir, "Output folder (default: sigmafem-demo/<scenario>)");
   sub->add_option("--seed", options->seed, "Seed of the observation noise")->capture_default_str();
+  sub->add_option("--backend", options->backend, "Where the filter's ensemble runs")
+      ->check(CLI::IsMember(std::vector<std::string>{"cpu"}))
+      ->capture_default_str();
+  sub->add_option("--sigma", options->sigma_points, "Sigma-point set (default: the scenario's)")
+      ->check(CLI::IsMember(std::vector<std::string>{"simplex", "star"}));
   return [options]() {
     const Scenario scenario = load_scenario(find_shipped_scenario(options->scenario));
+    const fs::path out =
+        options->out_dir.empty() ? fs::path("sigmafem-demo") / options->scenario : fs::path(options->out_dir);
     GenerateOptions generate_options;
-    generate_options.out_dir =
-        options->out_dir.empty() ? "sigmafem-demo/" + options->scenario : options->out_dir;
+    generate_options.out_dir = (out / "data").string();
     generate_options.seed = options->seed;
     generate_options.progress = true;
-    std::cout << "sigmafem demo: scenario " << scenario.path << '\n';
+    std::cout << "sigmafem demo: scenario " << scenario.path << "\n1. synthetic data\n";
     const GenerateResult result = generate(scenario, generate_options, std::cerr);
     print_generate_summary(std::cout, scenario, generate_options, result);
-    return 0;
+
+    std::cout << "2. estimation\n";
+    EstimationJob job;
+    job.data_dir = generate_options.out_dir;
+    job.out_dir = (out / "estimate").string();
+    job.backend = options->backend;
+    job.sigma_points = options->sigma_points;
+    const auto summary = run_estimation_job(scenario, job);
+    print_estimation_summary(std::cout, summary, job.out_dir);
+    return summary["complete"].get<bool>() ? 0 : 1;
   };
 }
 

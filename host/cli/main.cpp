@@ -13,7 +13,8 @@ int main(int argc, char** argv) {
   app.set_version_flag("--version", std::string("sigmafem ") + SIGMAFEM_VERSION);
   app.require_subcommand(1);
   std::map<CLI::App*, sigmafem::cli::Action> actions;
-  for (auto add : {sigmafem::cli::add_generate_command, sigmafem::cli::add_demo_command,
+  for (auto add : {sigmafem::cli::add_generate_command, sigmafem::cli::add_estimate_command,
+                   sigmafem::cli::add_demo_command,
                    sigmafem::cli::add_info_command}) {
     const std::size_t before = app.get_subcommands({}).size();
     sigmafem::cli::Action action = add(app);

@@ -1,0 +1,58 @@
+// Ensemble: what the filter needs from the simulations, and all it knows of them.
+// One object holds the S sigma-point simulations of one organ on one back end (the CPU
+// reference, OpenCL, Vulkan); the big per-sigma state (positions, velocities, the state
+// block of the ROUKF factor L) stays inside it. Per filter step the filter
+//   1. recenter(): re-samples every sigma point's state around the corrected estimate,
+//   2. set_parameters(): hands over the S parameter vectors,
+//   3. advance(): all S simulations advance one time step with the SO at its measured position,
+//   4. predicted_observations(): reads back only the observed positions (3m x S numbers).
+// filter/ never includes mesh or device headers; host/ includes nothing of filter/ but this.
+#pragma once
+
+#include <Eigen/Core>
+#include <vector>
+
+namespace sigmafem {
+
+// Per-sigma outcome of one advance(): the linear solver's work and status.
+struct StepReport {
+  std::vector<int> cg_iterations;          // per sigma point
+  std::vector<double> relative_residual;   // per sigma point
+  std::vector<unsigned> converged;         // per sigma point: 1 converged, 0 hit the cap
+  int unconverged_count() const {
+    int n = 0;
+    for (unsigned c : converged) n += c == 0u;
+    return n;
+  }
+};
+
+// The ROUKF's re-sampling of the state (docs/ROUKF.md, steps 1-2), done where the states are.
+// With X_i the sigma states left by the last advance():
+//   mean = alpha sum_i X_i,  L = alpha sum_i X_i I_i^T        (prediction: mean and factor)
+//   X_hat = mean + L correction                                (correction of the last step)
+//   L <- L factor                                              (sampling: L C, C C^T = U^-1)
+//   X_i = X_hat + L I_i, and every velocity = alpha sum_i V_i (re-sampled sigma states)
+// Before the first advance all sigma states are equal, so L is zero and X_i = X_hat.
+struct Recentering {
+  double alpha = 0.0;                 // the weight of every sigma point
+  Eigen::MatrixXd directions;         // p x S: column i is I_i
+  Eigen::VectorXd correction;         // p: the Kalman correction in the factor's coordinates
+  Eigen::MatrixXd factor;             // p x p: C
+};
+
+class Ensemble {
+ public:
+  virtual ~Ensemble() = default;
+  virtual int sigma_count() const = 0;                                  // S
+  virtual int parameter_count() const = 0;                              // p
+  virtual int observation_count() const = 0;                            // 3m
+  // p x S, column s = sigma point s's parameters (log-stiffness of the estimated ligaments).
+  virtual void set_parameters(const Eigen::MatrixXd& theta) = 0;
+  // One time step for all S with the SO at `so_position` (the SO at the end of the step).
+  virtual StepReport advance(const Eigen::Vector3d& so_position) = 0;
+  // 3m x S: the observed nodes' positions of every sigma point.
+  virtual void predicted_observations(Eigen::MatrixXd& y) const = 0;
+  virtual void recenter(const Recentering& recentering) = 0;
+};
+
+}  // namespace sigmafem

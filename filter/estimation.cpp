@@ -1,0 +1,63 @@
+#include "filter/estimation.h"
+
+#include <chrono>
+#include <cmath>
+#include <sstream>
+#include <stdexcept>
+
+namespace sigmafem {
+
+EstimationRun run_estimation(Ensemble& ensemble, const EstimationOptions& options,
+                             const std::vector<double>& times, const Eigen::MatrixX3d& so,
+                             const Eigen::MatrixXd& points,
+                             const std::function<void(const EstimationStep&)>& on_step) {
+  Roukf filter(options.roukf, ensemble);
+  ChangeDetector detector(options.detector);
+  EstimationRun run;
+  for (Eigen::Index k = 1; k < so.rows(); ++k) {
+    const auto start = std::chrono::steady_clock::now();
+    EstimationStep step;
+    step.step = static_cast<int>(k);
+    step.time = times[static_cast<std::size_t>(k)];
+    RoukfStep result;
+    try {
+      result = filter.step(so.row(k).transpose(), points.row(k).transpose());
+    } catch (const std::runtime_error& e) {
+      run.complete = false;
+      run.stop_reason = "step " + std::to_string(k) + ": " + e.what();
+      break;
+    }
+    step.log_std = result.theta_covariance.diagonal().cwiseSqrt();
+    step.stiffness = result.theta.array().exp();
+    step.stiffness_std = step.stiffness.cwiseProduct(step.log_std);
+    step.innovation_rms = result.innovation_rms;
+    step.normalised_innovation = result.normalised_innovation;
+    step.observed_rows = result.observed_rows;
+    for (std::size_t s = 0; s < result.ensemble.cg_iterations.size(); ++s)
+      step.max_cg_iterations = std::max(step.max_cg_iterations, result.ensemble.cg_iterations[s]);
+    step.unconverged_sigma_points = result.ensemble.unconverged_count();
+    step.change_detected = detector.update(result.normalised_innovation, result.observed_rows);
+    if (step.change_detected) {
+      filter.inflate(options.detector.inflation_log_std);
+      ++run.changes_detected;
+    }
+    step.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    run.steps.push_back(step);
+    if (on_step) on_step(step);
+    for (Eigen::Index j = 0; j < step.stiffness.size(); ++j) {
+      const double k_j = step.stiffness[j];
+      if (!(k_j >= options.min_stiffness && k_j <= options.max_stiffness)) {
+        std::ostringstream reason;
+        reason << "step " << k << ": the estimate of parameter " << j << " is " << k_j
+               << " N/m, outside " << options.min_stiffness << ".." << options.max_stiffness
+               << " N/m: the filter diverged";
+        run.complete = false;
+        run.stop_reason = reason.str();
+        return run;
+      }
+    }
+  }
+  return run;
+}
+
+}  // namespace sigmafem

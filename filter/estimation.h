@@ -1,0 +1,55 @@
+// run_estimation: the filter loop over a whole data set. For each row k >= 1 of the data it
+// runs one ROUKF step with the SO at so(k) and the measured points y(k), runs the change
+// detector on the innovations, and reports the estimate. Row 0 is the rest state the
+// ensemble starts from (no step). It stops early, keeping what it has, when the filter
+// diverges (non-finite numbers, or a stiffness outside the physical range).
+#pragma once
+
+#include <Eigen/Core>
+#include <functional>
+#include <string>
+#include <vector>
+
+#include "filter/change_detector.h"
+#include "filter/ensemble.h"
+#include "filter/roukf.h"
+
+namespace sigmafem {
+
+struct EstimationOptions {
+  RoukfOptions roukf;
+  ChangeDetectorOptions detector;
+  double min_stiffness = 1e-6;     // N/m: below or above this range the filter has diverged
+  double max_stiffness = 1e9;
+};
+
+struct EstimationStep {
+  int step = 0;
+  double time = 0.0;
+  Eigen::VectorXd stiffness;       // exp(theta_hat): the median estimate, N/m
+  Eigen::VectorXd stiffness_std;   // exp(theta_hat) * std(theta): first-order std, N/m
+  Eigen::VectorXd log_std;         // std(theta)
+  double innovation_rms = 0.0;     // m
+  double normalised_innovation = 0.0;
+  int observed_rows = 0;
+  bool change_detected = false;
+  int max_cg_iterations = 0;       // over the sigma points
+  int unconverged_sigma_points = 0;
+  double seconds = 0.0;            // wall time of the filter step
+};
+
+struct EstimationRun {
+  std::vector<EstimationStep> steps;   // one per data row after the first
+  bool complete = true;
+  std::string stop_reason;             // why it stopped early ("" when complete)
+  int changes_detected = 0;
+};
+
+// `times` (rows), `so` (rows x 3) and `points` (rows x 3m, NaN = missing) are the data;
+// `on_step` (may be empty) sees every step as it is made, e.g. for a progress line.
+EstimationRun run_estimation(Ensemble& ensemble, const EstimationOptions& options,
+                             const std::vector<double>& times, const Eigen::MatrixX3d& so,
+                             const Eigen::MatrixXd& points,
+                             const std::function<void(const EstimationStep&)>& on_step);
+
+}  // namespace sigmafem

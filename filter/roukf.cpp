@@ -1,0 +1,159 @@
+#include "filter/roukf.h"
+
+#include <Eigen/Cholesky>
+#include <Eigen/LU>
+#include <cmath>
+#include <limits>
+#include <stdexcept>
+#include <string>
+
+namespace sigmafem {
+
+Roukf::Roukf(const RoukfOptions& options, Ensemble& ensemble)
+    : options_(options),
+      ensemble_(ensemble),
+      points_(make_sigma_points(options.sigma_points,
+                                static_cast<int>(options.initial_theta.size()))) {
+  const int p = points_.parameter_count();
+  if (ensemble.parameter_count() != p || ensemble.sigma_count() != points_.count())
+    throw std::invalid_argument("Roukf: the ensemble has " +
+                                std::to_string(ensemble.parameter_count()) + " parameters and " +
+                                std::to_string(ensemble.sigma_count()) + " sigma points; the " +
+                                to_string(points_.set) + " set needs " + std::to_string(p) +
+                                " and " + std::to_string(points_.count()));
+  if (!(options.observation_std > 0.0))
+    throw std::invalid_argument("Roukf: observation_std must be positive");
+  theta_ = options.initial_theta;
+  // L = [0; I_p], U^-1 = diag(sigma^2): the state is known, the parameters are not.
+  L_theta_ = Eigen::MatrixXd::Identity(p, p);
+  U_inv_ = Eigen::MatrixXd::Identity(p, p) * (options.initial_log_std * options.initial_log_std);
+  correction_ = Eigen::VectorXd::Zero(p);
+}
+
+Eigen::MatrixXd Roukf::theta_covariance() const {
+  return L_theta_ * U_inv_ * L_theta_.transpose();
+}
+
+void Roukf::inflate(double log_std) { pending_variance_ += log_std * log_std; }
+
+void Roukf::add_theta_variance(double variance) {
+  // P_theta + v I = L_theta (U^-1 + v L_theta^-1 L_theta^-T) L_theta^T: only U^-1 changes.
+  const Eigen::MatrixXd LtL = L_theta_.transpose() * L_theta_;
+  U_inv_ += variance * LtL.inverse();
+  U_inv_ = 0.5 * (U_inv_ + U_inv_.transpose());   // keep it exactly symmetric for chol
+}
+
+RoukfStep Roukf::step(const Eigen::Vector3d& so_position, const Eigen::VectorXd& y) {
+  const int p = points_.parameter_count(), r = points_.count();
+  const Eigen::MatrixXd& I = points_.directions;   // p x r
+  const double alpha = points_.alpha;
+  if (y.size() != ensemble_.observation_count())
+    throw std::invalid_argument("Roukf::step: expected " +
+                                std::to_string(ensemble_.observation_count()) +
+                                " observation values, got " + std::to_string(y.size()));
+
+  const double q = options_.parameter_drift_log_std;
+  if (q > 0.0 || pending_variance_ > 0.0) add_theta_variance(q * q + pending_variance_);
+  pending_variance_ = 0.0;
+
+  // Sampling.
+  const Eigen::LLT<Eigen::MatrixXd> llt(U_inv_);
+  if (llt.info() != Eigen::Success)
+    throw std::runtime_error("ROUKF: U^-1 is not positive definite (the filter diverged)");
+  const Eigen::MatrixXd C = llt.matrixL();
+  L_theta_ = L_theta_ * C;
+  Recentering recentering;
+  recentering.alpha = alpha;
+  recentering.directions = I;
+  recentering.correction = correction_;
+  recentering.factor = C;
+  ensemble_.recenter(recentering);
+  const Eigen::MatrixXd theta_i = theta_.replicate(1, r) + L_theta_ * I;   // p x r
+
+  // Prediction.
+  RoukfStep result;
+  ensemble_.set_parameters(theta_i);
+  result.ensemble = ensemble_.advance(so_position);
+  Eigen::MatrixXd predicted;
+  ensemble_.predicted_observations(predicted);   // 3m x r
+
+  // Innovations on the observed rows.
+  std::vector<int> rows;
+  for (int k = 0; k < y.size(); ++k)
+    if (!std::isnan(y[k])) rows.push_back(k);
+  const int m = static_cast<int>(rows.size());
+  Eigen::MatrixXd Z(m, r);
+  for (int j = 0; j < m; ++j) Z.row(j) = y[rows[j]] - predicted.row(rows[j]).array();
+  result.observed_rows = m;
+
+  // Prediction of the parameter block: theta does not evolve, so the mean stays theta_hat and
+  // L_theta = alpha sum theta_i I_i^T (= L_theta for both sets, computed as the definition).
+  theta_ = alpha * theta_i.rowwise().sum();
+  L_theta_ = alpha * theta_i * I.transpose();
+
+  if (m == 0) {
+    // Nothing observed: the prior is the posterior (U = I, the old U^-1 is already in L).
+    U_inv_ = Eigen::MatrixXd::Identity(p, p);
+    correction_ = Eigen::VectorXd::Zero(p);
+    result.innovation_rms = std::numeric_limits<double>::quiet_NaN();
+  } else {
+    const Eigen::VectorXd z_bar = alpha * Z.rowwise().sum();
+    result.innovation = z_bar;
+    result.innovation_rms = std::sqrt(z_bar.squaredNorm() / m);
+    result.normalised_innovation = correct(Z);
+    theta_ += L_theta_ * correction_;
+  }
+  result.theta = theta_;
+  result.theta_covariance = theta_covariance();
+  if (!theta_.allFinite() || !result.theta_covariance.allFinite())
+    throw std::runtime_error("ROUKF: the estimate became non-finite");
+  return result;
+}
+
+double Roukf::correct(const Eigen::MatrixXd& Z) {
+  const int p = points_.parameter_count(), r = points_.count();
+  const Eigen::MatrixXd& I = points_.directions;   // p x r (I^T is the r x p of ROUKF.md)
+  const double alpha = points_.alpha;
+  const double r_inv = 1.0 / (options_.observation_std * options_.observation_std);
+  const Eigen::VectorXd z_bar = alpha * Z.rowwise().sum();
+
+  Eigen::MatrixXd HL_t;   // p x m: HL^T
+  Eigen::MatrixXd U;
+  if (points_.set == SigmaPointSet::simplex) {
+    const Eigen::MatrixXd HL = alpha * Z * I.transpose();   // m x p
+    HL_t = HL.transpose();
+    U = Eigen::MatrixXd::Identity(p, p) + r_inv * HL_t * HL;
+  } else {
+    // Star: centred innovations and the generalised correction (docs/ROUKF.md, step 4).
+    const Eigen::MatrixXd Zc = Z.colwise() - z_bar;                       // m x r
+    const Eigen::MatrixXd D_m = r_inv * Zc.transpose() * Zc;              // r x r
+    const Eigen::MatrixXd Ir = Eigen::MatrixXd::Identity(r, r);
+    const Eigen::MatrixXd D_v = alpha * alpha * I.transpose() * I;        // r x r
+    const Eigen::MatrixXd A = Ir + D_m * (alpha * Ir - D_v);
+    const Eigen::PartialPivLU<Eigen::MatrixXd> A_lu(A);
+    U = Eigen::MatrixXd::Identity(p, p) +
+        alpha * alpha * I * A_lu.solve(D_m * I.transpose());
+    const Eigen::MatrixXd G = alpha * (Ir + alpha * D_m).partialPivLu().solve(
+                                          Ir + D_v * A_lu.solve(D_m)) * I.transpose();  // r x p
+    HL_t = G.transpose() * Zc.transpose();                                // p x m
+  }
+  U = 0.5 * (U + U.transpose());
+  const Eigen::LLT<Eigen::MatrixXd> U_llt(U);
+  U_inv_ = U_llt.solve(Eigen::MatrixXd::Identity(p, p));
+  const Eigen::VectorXd HLt_Rinv_z = r_inv * HL_t * z_bar;
+  correction_ = -U_inv_ * HLt_Rinv_z;
+  return normalised_innovation(Z, z_bar, r_inv);
+}
+
+double Roukf::normalised_innovation(const Eigen::MatrixXd& Z, const Eigen::VectorXd& z_bar,
+                                    double r_inv) const {
+  // S = H P^- H^T + R with H P^- H^T = HL HL^T, HL = alpha sum Z_i I_i^T (for either set);
+  // Woodbury: S^-1 = R^-1 - R^-1 HL (I + HL^T R^-1 HL)^-1 HL^T R^-1.
+  const int p = points_.parameter_count();
+  const Eigen::MatrixXd HL = points_.alpha * Z * points_.directions.transpose();
+  const Eigen::MatrixXd U = Eigen::MatrixXd::Identity(p, p) + r_inv * HL.transpose() * HL;
+  const Eigen::VectorXd w = r_inv * HL.transpose() * z_bar;
+  return r_inv * z_bar.squaredNorm() - w.dot(U.ldlt().solve(w));
+}
+
+}  // namespace sigmafem

@@ -1,0 +1,82 @@
+// Roukf: the reduced-order unscented Kalman filter for parameters (docs/ROUKF.md; Moireau and
+// Chapelle 2011), as sigmafem uses it: theta = log of the estimated stiffnesses, covariance
+// in factored form P = L U^-1 L^T, only p x p matrices on the host (the state block of L
+// lives in the Ensemble), simplex or star sigma points, random-walk parameter drift.
+//
+// One step(so, y):
+//   drift      U^-1 += q^2 (L_theta^T L_theta)^-1, i.e. P_theta + q^2 I with the state block
+//              following along the regression of the state on theta
+//   sampling   C = chol(U^-1), L <- L C; ensemble re-samples its states (Recentering);
+//              theta_i = theta_hat + L_theta I_i
+//   prediction every sigma point advances one step (ensemble)
+//   innovation Z_i = y - H(x_i^-), rows with missing data (NaN) dropped
+//   correction simplex: HL = alpha sum Z_i I_i^T, U = I + HL^T R^-1 HL,
+//              k = -U^-1 HL^T R^-1 z_bar; theta_hat += L_theta k (the ensemble applies
+//              L_x k at the next re-sampling); star: the generalised correction of ROUKF.md.
+#pragma once
+
+#include <Eigen/Core>
+#include <vector>
+
+#include "filter/ensemble.h"
+#include "filter/sigma_points.h"
+
+namespace sigmafem {
+
+struct RoukfOptions {
+  SigmaPointSet sigma_points = SigmaPointSet::simplex;
+  Eigen::VectorXd initial_theta;        // p: prior mean of theta (log of the median stiffness)
+  double initial_log_std = 1.0;         // prior standard deviation of each theta
+  double parameter_drift_log_std = 0.0; // q: random-walk std of theta per step
+  double observation_std = 1e-3;        // sqrt of R's diagonal
+};
+
+struct RoukfStep {
+  Eigen::VectorXd theta;                // corrected theta_hat
+  Eigen::MatrixXd theta_covariance;     // L_theta U^-1 L_theta^T
+  Eigen::VectorXd innovation;           // z_bar on the observed rows (observed - predicted mean)
+  int observed_rows = 0;                // rows of y that were not missing
+  double innovation_rms = 0.0;          // sqrt(mean z_bar^2) over the observed rows (NaN if none)
+  double normalised_innovation = 0.0;   // z_bar^T S^-1 z_bar, S = H P^- H^T + R (chi^2, m dof)
+  StepReport ensemble;
+};
+
+class Roukf {
+ public:
+  // The ensemble must have sigma_count() equal to the size of the chosen sigma-point set.
+  Roukf(const RoukfOptions& options, Ensemble& ensemble);
+
+  // One filter step with the SO at `so_position` and the measurement `y` (3m, NaN = missing).
+  RoukfStep step(const Eigen::Vector3d& so_position, const Eigen::VectorXd& y);
+
+  // Widens the parameter uncertainty by `log_std` (added in quadrature, like drift) before
+  // the next sampling: the change detector's response to a sudden change.
+  void inflate(double log_std);
+
+  const SigmaPoints& sigma_points() const { return points_; }
+  const Eigen::VectorXd& theta() const { return theta_; }
+  Eigen::MatrixXd theta_covariance() const;
+  // The ROUKF factors, for tests against an exact Kalman filter.
+  const Eigen::MatrixXd& theta_factor() const { return L_theta_; }
+  const Eigen::MatrixXd& U_inverse() const { return U_inv_; }
+  const Eigen::VectorXd& last_correction() const { return correction_; }
+
+ private:
+  void add_theta_variance(double variance);
+  // Kalman correction from the innovations Z (m x r) of the observed rows: sets U_inv_ and
+  // correction_, and returns the normalised innovation squared.
+  double correct(const Eigen::MatrixXd& Z);
+  double normalised_innovation(const Eigen::MatrixXd& Z, const Eigen::VectorXd& z_bar,
+                               double r_inv) const;
+
+  RoukfOptions options_;
+  Ensemble& ensemble_;
+  SigmaPoints points_;
+  Eigen::VectorXd theta_;               // theta_hat
+  Eigen::MatrixXd L_theta_;             // p x p
+  Eigen::MatrixXd U_inv_;               // p x p
+  Eigen::VectorXd correction_;          // k of the last correction, applied at re-sampling
+  double pending_variance_ = 0.0;       // inflation to add before the next sampling
+};
+
+}  // namespace sigmafem

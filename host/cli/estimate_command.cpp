@@ -1,0 +1,41 @@
+// `sigmafem estimate SCENARIO --data DIR --out DIR [--backend cpu] [--sigma simplex|star]`.
+#include <iostream>
+#include <memory>
+
+#include "host/cli/commands.h"
+#include "host/cli/estimation_job.h"
+#include "host/scenario/scenario.h"
+
+namespace sigmafem::cli {
+
+Action add_estimate_command(CLI::App& app) {
+  struct Options {
+    std::string scenario;
+    EstimationJob job;
+    bool quiet = false;
+  };
+  auto options = std::make_shared<Options>();
+  CLI::App* sub = app.add_subcommand(
+      "estimate", "Estimate the ligament stiffnesses from observations with the ROUKF and write "
+                  "estimates.csv, summary.json, stiffness.png and innovation.png");
+  sub->add_option("scenario", options->scenario, "Scenario JSON file (with a filter block)")->required();
+  sub->add_option("--data", options->job.data_dir, "Folder with observations.csv (and truth.csv)")
+      ->required();
+  sub->add_option("--out", options->job.out_dir, "Output folder (created if missing)")->required();
+  sub->add_option("--backend", options->job.backend, "Where the ensemble runs")
+      ->check(CLI::IsMember(std::vector<std::string>{"cpu"}))
+      ->capture_default_str();
+  sub->add_option("--sigma", options->job.sigma_points,
+                  "Sigma-point set (default: the scenario's filter.sigma_points)")
+      ->check(CLI::IsMember(std::vector<std::string>{"simplex", "star"}));
+  sub->add_flag("--quiet", options->quiet, "No progress line and no summary");
+  return [options]() {
+    const Scenario scenario = load_scenario(options->scenario);
+    options->job.progress = !options->quiet;
+    const nlohmann::ordered_json summary = run_estimation_job(scenario, options->job);
+    if (!options->quiet) print_estimation_summary(std::cout, summary, options->job.out_dir);
+    return summary["complete"].get<bool>() ? 0 : 1;
+  };
+}
+
+}  // namespace sigmafem::cli

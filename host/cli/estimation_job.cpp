@@ -1,0 +1,124 @@
+#include "host/cli/estimation_job.h"
+
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+#include <memory>
+#include <optional>
+
+#include "filter/estimation.h"
+#include "host/cli/estimation_report.h"
+#include "host/common/input_error.h"
+#include "host/common/progress.h"
+#include "host/data/observation_table.h"
+#include "host/data/truth_table.h"
+#include "host/ensemble/cpu_ensemble.h"
+#include "host/model/model.h"
+
+namespace sigmafem::cli {
+namespace fs = std::filesystem;
+using json = nlohmann::ordered_json;
+
+namespace {
+
+std::unique_ptr<Ensemble> make_ensemble(const std::string& backend, const Scenario& scenario,
+                                        int sigma_count) {
+  if (backend == "cpu")
+    return std::make_unique<CpuEnsemble>(make_model(scenario), scenario.filter->estimate,
+                                         scenario.observations.nodes, sigma_count);
+  throw InputError("--backend " + backend + ": not available in this build (available: cpu)");
+}
+
+}  // namespace
+
+json run_estimation_job(const Scenario& scenario, const EstimationJob& job) {
+  const auto start = std::chrono::steady_clock::now();
+  if (!scenario.filter)
+    throw InputError("scenario " + scenario.path + ": filter: missing; estimate needs a filter "
+                     "block naming the ligaments to estimate and the prior");
+  const FilterSpec& spec = *scenario.filter;
+  const fs::path data(job.data_dir);
+  const ObservationTable table =
+      read_observations_csv((data / "observations.csv").string(),
+                            static_cast<int>(scenario.observations.nodes.size()), scenario.time.dt);
+  if (table.row_count() < 2)
+    throw InputError("observations " + (data / "observations.csv").string() +
+                     ": needs at least two rows (the rest state and one step)");
+  std::optional<TruthTable> truth;
+  if (fs::exists(data / "truth.csv")) truth = read_truth_csv((data / "truth.csv").string());
+
+  EstimationOptions options;
+  const std::string set_name = job.sigma_points.empty() ? spec.sigma_points : job.sigma_points;
+  options.roukf.sigma_points = parse_sigma_point_set(set_name);
+  options.roukf.initial_theta.resize(static_cast<Eigen::Index>(spec.estimate.size()));
+  for (std::size_t j = 0; j < spec.estimate.size(); ++j)
+    options.roukf.initial_theta[static_cast<Eigen::Index>(j)] = std::log(spec.initial_stiffness[j]);
+  options.roukf.initial_log_std = spec.initial_log_std;
+  options.roukf.parameter_drift_log_std = spec.parameter_drift_log_std;
+  options.roukf.observation_std = spec.observation_std;
+  const int p = static_cast<int>(spec.estimate.size());
+  const int sigma_count = options.roukf.sigma_points == SigmaPointSet::simplex ? p + 1 : 2 * p + 1;
+
+  fs::create_directories(job.out_dir);
+  std::unique_ptr<Ensemble> ensemble = make_ensemble(job.backend, scenario, sigma_count);
+  Progress progress("estimate " + scenario.name + ": step", table.row_count() - 1, job.progress);
+  const EstimationRun run = run_estimation(
+      *ensemble, options, table.times, table.so, table.points, [&](const EstimationStep& step) {
+        char detail[160];
+        std::snprintf(detail, sizeof detail, "innovation %.3f mm", 1e3 * step.innovation_rms);
+        progress.update(step.step, detail);
+      });
+  progress.finish();
+
+  EstimationReport report;
+  report.scenario_name = scenario.name;
+  report.data_dir = job.data_dir;
+  report.out_dir = job.out_dir;
+  report.backend = job.backend;
+  report.sigma_points = to_string(options.roukf.sigma_points);
+  report.sigma_count = sigma_count;
+  for (int l : spec.estimate) report.names.push_back(scenario.ligaments[l].name);
+  report.truth = truth;
+  report.total_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  return write_estimation_report(report, run);
+}
+
+void print_estimation_summary(std::ostream& out, const json& summary, const std::string& out_dir) {
+  char line[256];
+  std::snprintf(line, sizeof line, "estimated '%s' over %d filter steps (%s, %s sigma points x%d): %.2f ms per step\n",
+                summary["scenario"].get<std::string>().c_str(), summary["filter_steps"].get<int>(),
+                summary["backend"].get<std::string>().c_str(),
+                summary["sigma_points"].get<std::string>().c_str(), summary["sigma_count"].get<int>(),
+                summary["timing"]["filter_step_mean_ms"].get<double>());
+  out << line;
+  if (!summary["complete"].get<bool>())
+    out << "  INCOMPLETE: " << summary["stop_reason"].get<std::string>() << '\n';
+  for (const auto& [name, value] : summary["final"].items()) {
+    std::snprintf(line, sizeof line, "  %-12s %10.2f N/m  +- %.2f (1 std)\n", name.c_str(),
+                  value["stiffness_n_per_m"].get<double>(), value["std_n_per_m"].get<double>());
+    out << line;
+  }
+  if (summary["errors"].is_object()) {
+    for (const auto& [phase, e] : summary["errors"].items()) {
+      std::snprintf(line, sizeof line, "  %-11s mean |error| %.2f N/m over its last 20%%, truth inside +-2 std %.0f%%",
+                    phase.c_str(), e["mean_abs_error_n_per_m"].get<double>(),
+                    100.0 * e["coverage_2std"].get<double>());
+      out << line;
+      if (e.contains("steps_to_follow"))
+        out << ", followed the change in "
+            << (e["steps_to_follow"].is_null() ? std::string("(never)")
+                                                : std::to_string(e["steps_to_follow"].get<int>()) + " steps");
+      out << '\n';
+    }
+  }
+  const fs::path dir(out_dir);
+  out << "  " << (dir / "estimates.csv").string() << "\n  " << (dir / "summary.json").string() << '\n';
+  if (summary["plots"].contains("skipped"))
+    out << "  plots skipped: " << summary["plots"]["skipped"].get<std::string>() << '\n';
+  else
+    out << "  " << summary["plots"]["stiffness"].get<std::string>() << "\n  "
+        << summary["plots"]["innovation"].get<std::string>() << '\n';
+}
+
+}  // namespace sigmafem::cli

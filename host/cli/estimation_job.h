@@ -1,0 +1,29 @@
+// The estimation job shared by `sigmafem estimate` and `sigmafem demo`: read the data, build
+// the ensemble on the chosen back end, run the filter, write the outputs.
+#pragma once
+
+#include <nlohmann/json.hpp>
+#include <string>
+
+#include "host/scenario/scenario.h"
+
+namespace sigmafem::cli {
+
+struct EstimationJob {
+  std::string data_dir;
+  std::string out_dir;
+  std::string backend = "cpu";
+  std::string sigma_points;        // "" = the scenario's filter.sigma_points
+  bool progress = true;
+};
+
+// Runs the job; returns the summary written to summary.json. Throws InputError for bad input
+// (a scenario without a filter block, data that does not match the scenario, ...). A filter
+// that diverges is not an exception: the summary says "complete": false and why.
+nlohmann::ordered_json run_estimation_job(const Scenario& scenario, const EstimationJob& job);
+
+// A few lines for the terminal: final estimates, errors against the truth, where the files are.
+void print_estimation_summary(std::ostream& out, const nlohmann::ordered_json& summary,
+                              const std::string& out_dir);
+
+}  // namespace sigmafem::cli

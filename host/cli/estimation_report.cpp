@@ -1,0 +1,205 @@
+#include "host/cli/estimation_report.h"
+
+#include <cmath>
+#include <filesystem>
+#include <sstream>
+
+#include "host/cli/plot.h"
+#include "host/common/atomic_file.h"
+#include "host/data/csv_format.h"
+
+namespace sigmafem::cli {
+namespace fs = std::filesystem;
+using json = nlohmann::ordered_json;
+
+std::optional<Eigen::MatrixXd> truth_at_steps(const TruthTable& truth,
+                                              const std::vector<std::string>& names,
+                                              const std::vector<int>& steps) {
+  Eigen::MatrixXd values(static_cast<Eigen::Index>(steps.size()),
+                         static_cast<Eigen::Index>(names.size()));
+  for (std::size_t j = 0; j < names.size(); ++j) {
+    const int column = truth.column(names[j]);
+    if (column < 0) return std::nullopt;
+    for (std::size_t k = 0; k < steps.size(); ++k) {
+      if (steps[k] >= truth.stiffness.rows()) return std::nullopt;
+      values(static_cast<Eigen::Index>(k), static_cast<Eigen::Index>(j)) =
+          truth.stiffness(steps[k], column);
+    }
+  }
+  return values;
+}
+
+namespace {
+
+std::string estimates_csv(const EstimationReport& report, const EstimationRun& run) {
+  std::ostringstream out;
+  out << "# scenario " << report.scenario_name << ", data " << report.data_dir << ", backend "
+      << report.backend << ", " << report.sigma_points << " sigma points (" << report.sigma_count
+      << ")\n";
+  if (!run.complete) out << "# incomplete: " << run.stop_reason << '\n';
+  out << "step,time";
+  for (const std::string& name : report.names) out << ',' << name << ',' << name << "_std";
+  out << ",innovation_rms,normalised_innovation,change_detected\n";
+  for (const EstimationStep& step : run.steps) {
+    out << step.step << ',' << format_number(step.time);
+    for (Eigen::Index j = 0; j < step.stiffness.size(); ++j)
+      out << ',' << format_number(step.stiffness[j]) << ',' << format_number(step.stiffness_std[j]);
+    out << ',' << (std::isnan(step.innovation_rms) ? "" : format_number(step.innovation_rms)) << ','
+        << format_number(step.normalised_innovation) << ',' << (step.change_detected ? 1 : 0)
+        << '\n';
+  }
+  return out.str();
+}
+
+void plot_stiffness(const EstimationReport& report, const EstimationRun& run,
+                    const std::optional<Eigen::MatrixXd>& truth, const std::string& png) {
+  PlotData data;
+  data.columns = {"time"};
+  for (const std::string& name : report.names) {
+    data.columns.push_back(name);
+    data.columns.push_back(name + "_low");
+    data.columns.push_back(name + "_high");
+    data.columns.push_back(name + "_truth");
+  }
+  for (std::size_t k = 0; k < run.steps.size(); ++k) {
+    const EstimationStep& step = run.steps[k];
+    std::vector<double> row = {step.time};
+    for (Eigen::Index j = 0; j < step.stiffness.size(); ++j) {
+      row.push_back(step.stiffness[j]);
+      row.push_back(std::max(0.0, step.stiffness[j] - 2.0 * step.stiffness_std[j]));
+      row.push_back(step.stiffness[j] + 2.0 * step.stiffness_std[j]);
+      row.push_back(truth ? (*truth)(static_cast<Eigen::Index>(k), j) : NAN);
+    }
+    data.rows.push_back(row);
+  }
+  std::ostringstream script;
+  script << "set output $output\nset title 'Estimated ligament stiffness (" << report.scenario_name
+         << ", " << report.sigma_points << " sigma points): median with +-2 std band"
+         << (truth ? ", truth dashed" : "") << "'\n"
+         << "set xlabel 'time (s)'\nset ylabel 'stiffness (N/m)'\nset grid\nset key outside right\n"
+         << "set datafile missing 'nan'\n"
+         << "set yrange [0:*]\n"
+         << "colors = '#1f77b4 #d62728 #2ca02c #9467bd #ff7f0e #8c564b #e377c2 #7f7f7f'\n"
+         << "plot ";
+  for (std::size_t j = 0; j < report.names.size(); ++j) {
+    const int base = 2 + 4 * static_cast<int>(j);
+    const std::string color = "word(colors, " + std::to_string(j % 8 + 1) + ")";
+    script << (j ? ", " : "") << "$data using 1:" << base + 1 << ':' << base + 2
+           << " with filledcurves fs transparent solid 0.2 noborder lc rgb " << color
+           << " notitle, $data using 1:" << base << " with lines lw 2 lc rgb " << color
+           << " title '" << report.names[j] << "'";
+    if (truth)
+      script << ", $data using 1:" << base + 3 << " with lines dt 2 lw 1.5 lc rgb " << color
+             << " title '" << report.names[j] << " truth'";
+  }
+  script << '\n';
+  render_plot(data, script.str(), png);
+}
+
+void plot_innovation(const EstimationReport& report, const EstimationRun& run, const std::string& png) {
+  PlotData data;
+  data.columns = {"time", "innovation_rms_mm", "change"};
+  for (const EstimationStep& step : run.steps)
+    data.rows.push_back({step.time, 1e3 * step.innovation_rms, step.change_detected ? 1e3 * step.innovation_rms : NAN});
+  std::ostringstream script;
+  script << "set output $output\nset title 'Innovation RMS (observed - predicted position), "
+         << report.scenario_name << "'\nset xlabel 'time (s)'\nset ylabel 'innovation RMS (mm)'\n"
+         << "set logscale y\nset grid\nset datafile missing 'nan'\n"
+         << "plot $data using 1:2 with lines lw 2 lc rgb '#1f77b4' title 'innovation RMS', "
+         << "$data using 1:3 with points pt 7 ps 1.5 lc rgb '#d62728' title 'change detected'\n";
+  render_plot(data, script.str(), png);
+}
+
+json phase_json(const PhaseErrors& phase, const std::vector<std::string>& names) {
+  json j = {{"first_step", phase.first_step},
+            {"last_step", phase.last_step},
+            {"mean_abs_error_n_per_m", phase.mean_abs_error},
+            {"coverage_2std", phase.coverage}};
+  json final_error = json::object();
+  for (std::size_t k = 0; k < names.size(); ++k) final_error[names[k]] = phase.final_error[k];
+  j["final_abs_error_n_per_m"] = final_error;
+  if (phase.name != "before_cut" && phase.name != "phase_0")
+    j["steps_to_follow"] = phase.steps_to_follow >= 0 ? json(phase.steps_to_follow) : json(nullptr);
+  return j;
+}
+
+}  // namespace
+
+nlohmann::ordered_json write_estimation_report(const EstimationReport& report, const EstimationRun& run) {
+  const fs::path out(report.out_dir);
+  write_file_atomically((out / "estimates.csv").string(), estimates_csv(report, run));
+
+  std::vector<int> steps;
+  for (const EstimationStep& step : run.steps) steps.push_back(step.step);
+  std::optional<Eigen::MatrixXd> truth;
+  if (report.truth) truth = truth_at_steps(*report.truth, report.names, steps);
+
+  json summary;
+  summary["scenario"] = report.scenario_name;
+  summary["data"] = report.data_dir;
+  summary["backend"] = report.backend;
+  summary["sigma_points"] = report.sigma_points;
+  summary["sigma_count"] = report.sigma_count;
+  summary["complete"] = run.complete;
+  summary["stop_reason"] = run.complete ? json(nullptr) : json(run.stop_reason);
+  summary["filter_steps"] = run.steps.size();
+  json final_estimates = json::object();
+  double max_seconds = 0.0, sum_seconds = 0.0;
+  int max_cg = 0, unconverged = 0;
+  json changes = json::array();
+  for (const EstimationStep& step : run.steps) {
+    max_seconds = std::max(max_seconds, step.seconds);
+    sum_seconds += step.seconds;
+    max_cg = std::max(max_cg, step.max_cg_iterations);
+    unconverged += step.unconverged_sigma_points;
+    if (step.change_detected) changes.push_back(step.step);
+  }
+  if (!run.steps.empty()) {
+    const EstimationStep& last = run.steps.back();
+    for (std::size_t j = 0; j < report.names.size(); ++j) {
+      const auto jj = static_cast<Eigen::Index>(j);
+      final_estimates[report.names[j]] = {{"stiffness_n_per_m", last.stiffness[jj]},
+                                          {"std_n_per_m", last.stiffness_std[jj]},
+                                          {"log_std", last.log_std[jj]}};
+    }
+  }
+  summary["final"] = final_estimates;
+  const double steps_count = std::max<double>(1.0, static_cast<double>(run.steps.size()));
+  summary["timing"] = {{"filter_step_mean_ms", 1e3 * sum_seconds / steps_count},
+                       {"filter_step_max_ms", 1e3 * max_seconds},
+                       {"total_s", report.total_seconds}};
+  summary["cg"] = {{"max_iterations", max_cg}, {"unconverged_sigma_steps", unconverged}};
+  summary["changes_detected_at_steps"] = changes;
+  if (truth) {
+    Eigen::MatrixXd estimate(static_cast<Eigen::Index>(run.steps.size()),
+                             static_cast<Eigen::Index>(report.names.size()));
+    Eigen::MatrixXd std_dev(estimate.rows(), estimate.cols());
+    for (std::size_t k = 0; k < run.steps.size(); ++k) {
+      estimate.row(static_cast<Eigen::Index>(k)) = run.steps[k].stiffness.transpose();
+      std_dev.row(static_cast<Eigen::Index>(k)) = run.steps[k].stiffness_std.transpose();
+    }
+    json errors = json::object();
+    for (const PhaseErrors& phase : error_figures(steps, estimate, std_dev, *truth))
+      errors[phase.name] = phase_json(phase, report.names);
+    summary["errors"] = errors;
+  } else {
+    summary["errors"] = nullptr;
+  }
+
+  json plots = json::object();
+  if (run.steps.empty()) {
+    plots["skipped"] = "no filter step";
+  } else if (!gnuplot_available()) {
+    plots["skipped"] = "gnuplot (with the pngcairo terminal) is not installed: apt-get install gnuplot-nox";
+  } else {
+    plot_stiffness(report, run, truth, (out / "stiffness.png").string());
+    plot_innovation(report, run, (out / "innovation.png").string());
+    plots["stiffness"] = (out / "stiffness.png").string();
+    plots["innovation"] = (out / "innovation.png").string();
+  }
+  summary["plots"] = plots;
+  write_file_atomically((out / "summary.json").string(), summary.dump(2) + "\n");
+  return summary;
+}
+
+}  // namespace sigmafem::cli

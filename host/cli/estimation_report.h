@@ -1,0 +1,39 @@
+// The outputs of `sigmafem estimate` (docs/FORMATS.md): estimates.csv, summary.json and two
+// PNG plots (estimated stiffness with a +-2 std band against the truth, one line per
+// ligament, as the seed paper's Figures 3 and 4; innovation RMS over the steps).
+#pragma once
+
+#include <nlohmann/json.hpp>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "filter/estimation.h"
+#include "filter/error_figures.h"
+#include "host/data/truth_table.h"
+
+namespace sigmafem::cli {
+
+struct EstimationReport {
+  std::string scenario_name;
+  std::string data_dir;
+  std::string out_dir;
+  std::string backend;
+  std::string sigma_points;
+  int sigma_count = 0;
+  std::vector<std::string> names;             // estimated ligaments
+  std::optional<TruthTable> truth;            // when the data folder has truth.csv
+  double total_seconds = 0.0;
+};
+
+// The truth of the estimated ligaments at the estimate's steps (rows x p), or nullopt if
+// `truth` lacks a ligament or a step.
+std::optional<Eigen::MatrixXd> truth_at_steps(const TruthTable& truth,
+                                              const std::vector<std::string>& names,
+                                              const std::vector<int>& steps);
+
+// Writes every output into report.out_dir (atomically, file by file) and returns the
+// summary. Plots are skipped with a note in the summary when gnuplot is missing.
+nlohmann::ordered_json write_estimation_report(const EstimationReport& report, const EstimationRun& run);
+
+}  // namespace sigmafem::cli

@@ -1,0 +1,103 @@
+#include "host/ensemble/cpu_ensemble.h"
+
+#include <algorithm>
+#include <cmath>
+#include <stdexcept>
+#include <string>
+#include <thread>
+
+namespace sigmafem {
+namespace {
+
+// Runs body(s) for s = 0..count-1 on up to `threads` threads, in interleaved chunks.
+template <class Body>
+void parallel_for(int count, int threads, const Body& body) {
+  const int workers = std::max(1, std::min(threads, count));
+  if (workers == 1) {
+    for (int s = 0; s < count; ++s) body(s);
+    return;
+  }
+  std::vector<std::thread> pool;
+  std::vector<std::exception_ptr> errors(workers);
+  for (int w = 0; w < workers; ++w) {
+    pool.emplace_back([&, w]() {
+      try {
+        for (int s = w; s < count; s += workers) body(s);
+      } catch (...) {
+        errors[w] = std::current_exception();
+      }
+    });
+  }
+  for (std::thread& thread : pool) thread.join();
+  for (const std::exception_ptr& error : errors)
+    if (error) std::rethrow_exception(error);
+}
+
+}  // namespace
+
+CpuEnsemble::CpuEnsemble(const Model& model, std::vector<int> estimated, std::vector<int> observed,
+                         int sigma_count, int threads)
+    : estimated_(std::move(estimated)), observed_(std::move(observed)) {
+  if (sigma_count < 1) throw std::invalid_argument("CpuEnsemble: need at least one sigma point");
+  for (int l : estimated_)
+    if (l < 0 || l >= static_cast<int>(model.ligaments.size()))
+      throw std::invalid_argument("CpuEnsemble: no ligament " + std::to_string(l));
+  simulations_.assign(sigma_count, ReferenceSimulation(model));
+  const int cores = static_cast<int>(std::thread::hardware_concurrency());
+  threads_ = threads > 0 ? threads : std::max(1, cores);
+}
+
+void CpuEnsemble::set_parameters(const Eigen::MatrixXd& theta) {
+  if (theta.rows() != parameter_count() || theta.cols() != sigma_count())
+    throw std::invalid_argument("CpuEnsemble::set_parameters: expected a " +
+                                std::to_string(parameter_count()) + " x " +
+                                std::to_string(sigma_count()) + " matrix");
+  for (int s = 0; s < sigma_count(); ++s) {
+    std::vector<double> stiffness = simulations_[s].ligament_stiffness();
+    for (int j = 0; j < parameter_count(); ++j) stiffness[estimated_[j]] = std::exp(theta(j, s));
+    simulations_[s].set_ligament_stiffness(stiffness);
+  }
+}
+
+StepReport CpuEnsemble::advance(const Eigen::Vector3d& so_position) {
+  const int S = sigma_count();
+  StepReport report;
+  report.cg_iterations.resize(S);
+  report.relative_residual.resize(S);
+  report.converged.resize(S);
+  parallel_for(S, threads_, [&](int s) {
+    const CgResult cg = simulations_[s].step(so_position);
+    report.cg_iterations[s] = cg.iterations;
+    report.relative_residual[s] = cg.relative_residual;
+    report.converged[s] = cg.converged ? 1u : 0u;
+  });
+  return report;
+}
+
+void CpuEnsemble::predicted_observations(Eigen::MatrixXd& y) const {
+  y.resize(observation_count(), sigma_count());
+  for (int s = 0; s < sigma_count(); ++s)
+    for (std::size_t k = 0; k < observed_.size(); ++k)
+      y.block<3, 1>(3 * static_cast<Eigen::Index>(k), s) = simulations_[s].node_position(observed_[k]);
+}
+
+void CpuEnsemble::recenter(const Recentering& r) {
+  const int S = sigma_count();
+  const Eigen::Index n = simulations_[0].positions().size();
+  Eigen::MatrixXd X(n, S);
+  Eigen::VectorXd velocity = Eigen::VectorXd::Zero(n);
+  for (int s = 0; s < S; ++s) {
+    X.col(s) = simulations_[s].positions();
+    velocity += r.alpha * simulations_[s].velocities();
+  }
+  // docs/ROUKF.md steps 1-2 (see Recentering): mean and factor of the predicted states, the
+  // correction, then the new factor L C and the re-sampled states.
+  const Eigen::VectorXd mean = r.alpha * X.rowwise().sum();
+  const Eigen::MatrixXd L = r.alpha * X * r.directions.transpose();   // n x p
+  const Eigen::VectorXd x_hat = mean + L * r.correction;
+  const Eigen::MatrixXd LC = L * r.factor;
+  for (int s = 0; s < S; ++s)
+    simulations_[s].set_state(x_hat + LC * r.directions.col(s), velocity);
+}
+
+}  // namespace sigmafem

@@ -1,0 +1,44 @@
+// CpuEnsemble: the Ensemble (filter/ensemble.h) on the CPU reference: one ReferenceSimulation
+// per sigma point, in double precision. It is the back end the device ensembles are checked
+// against, and the one that runs anywhere. Sigma points are independent, so they run on
+// worker threads (one per core, at most S); each one's arithmetic is unchanged by that, so
+// results do not depend on the thread count.
+//
+// Parameters: theta = log of the stiffness of the estimated ligaments (in the given order);
+// the other ligaments keep the model's stiffness.
+#pragma once
+
+#include <Eigen/Core>
+#include <vector>
+
+#include "filter/ensemble.h"
+#include "host/model/model.h"
+#include "host/reference/reference_simulation.h"
+
+namespace sigmafem {
+
+class CpuEnsemble : public Ensemble {
+ public:
+  // `estimated`: indices into model.ligaments; `observed`: node indices; `threads` 0 = cores.
+  CpuEnsemble(const Model& model, std::vector<int> estimated, std::vector<int> observed,
+              int sigma_count, int threads = 0);
+
+  int sigma_count() const override { return static_cast<int>(simulations_.size()); }
+  int parameter_count() const override { return static_cast<int>(estimated_.size()); }
+  int observation_count() const override { return 3 * static_cast<int>(observed_.size()); }
+  void set_parameters(const Eigen::MatrixXd& theta) override;
+  StepReport advance(const Eigen::Vector3d& so_position) override;
+  void predicted_observations(Eigen::MatrixXd& y) const override;
+  void recenter(const Recentering& recentering) override;
+
+  // Sigma point s's simulation (tests compare it with a lone ReferenceSimulation).
+  const ReferenceSimulation& simulation(int s) const { return simulations_[s]; }
+
+ private:
+  std::vector<ReferenceSimulation> simulations_;
+  std::vector<int> estimated_;
+  std::vector<int> observed_;
+  int threads_;
+};
+
+}  // namespace sigmafem

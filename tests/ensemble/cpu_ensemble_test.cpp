@@ -1,0 +1,95 @@
+// CpuEnsemble: each sigma point is the CPU reference with its own stiffnesses, and the
+// re-sampling (Recentering) does what docs/ROUKF.md says.
+#include "host/ensemble/cpu_ensemble.h"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+
+#include "host/model/model.h"
+#include "host/reference/reference_simulation.h"
+#include "host/scenario/scenario.h"
+
+namespace sigmafem {
+namespace {
+
+class CpuEnsembleTest : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    scenario_ = load_scenario(std::string(SIGMAFEM_SOURCE_DIR) + "/scenarios/box.json");
+    model_ = make_model(scenario_);
+  }
+  Eigen::Vector3d so(int step) const {
+    return scenario_.control.trajectory.position(step * scenario_.time.dt, scenario_.control.start);
+  }
+  Scenario scenario_;
+  Model model_;
+};
+
+TEST_F(CpuEnsembleTest, EachSigmaPointIsTheReferenceWithItsStiffness) {
+  const std::vector<int> estimated = {0, 2};
+  CpuEnsemble ensemble(model_, estimated, scenario_.observations.nodes, 3, 2);
+  Eigen::MatrixXd theta(2, 3);
+  theta << std::log(100.0), std::log(150.0), std::log(400.0),
+           std::log(50.0), std::log(200.0), std::log(250.0);
+  ensemble.set_parameters(theta);
+  for (int k = 1; k <= 10; ++k) ensemble.advance(so(k));
+  Eigen::MatrixXd y;
+  ensemble.predicted_observations(y);
+  for (int s = 0; s < 3; ++s) {
+    ReferenceSimulation alone(model_);
+    std::vector<double> stiffness = alone.ligament_stiffness();
+    stiffness[0] = std::exp(theta(0, s));
+    stiffness[2] = std::exp(theta(1, s));
+    alone.set_ligament_stiffness(stiffness);
+    for (int k = 1; k <= 10; ++k) alone.step(so(k));
+    // Same arithmetic on a worker thread: the same bits.
+    EXPECT_EQ(alone.positions(), ensemble.simulation(s).positions()) << "sigma point " << s;
+    for (std::size_t o = 0; o < scenario_.observations.nodes.size(); ++o)
+      EXPECT_EQ(Eigen::Vector3d(y.block(3 * static_cast<Eigen::Index>(o), s, 3, 1)),
+                alone.node_position(scenario_.observations.nodes[o]))
+          << "observation " << o << " of sigma point " << s;
+  }
+}
+
+TEST_F(CpuEnsembleTest, RecenteringResamplesAroundTheCorrectedMean) {
+  const int S = 3;
+  CpuEnsemble ensemble(model_, {1}, scenario_.observations.nodes, S);
+  Eigen::MatrixXd theta(1, S);
+  theta << std::log(100.0), std::log(300.0), std::log(900.0);
+  ensemble.set_parameters(theta);
+  for (int k = 1; k <= 20; ++k) ensemble.advance(so(k));
+  Eigen::MatrixXd X(model_.dof_count(), S);
+  Eigen::VectorXd mean_velocity = Eigen::VectorXd::Zero(model_.dof_count());
+  for (int s = 0; s < S; ++s) {
+    X.col(s) = ensemble.simulation(s).positions();
+    mean_velocity += ensemble.simulation(s).velocities() / S;
+  }
+  Recentering r;
+  r.alpha = 1.0 / S;
+  r.directions = Eigen::MatrixXd(1, S);
+  r.directions << -1.2, 0.0, 1.2;
+  r.correction = Eigen::VectorXd::Constant(1, 0.3);
+  r.factor = Eigen::MatrixXd::Constant(1, 1, 0.5);
+  ensemble.recenter(r);
+  const Eigen::VectorXd mean = X.rowwise().mean();
+  const Eigen::VectorXd L = r.alpha * X * r.directions.transpose();
+  const Eigen::VectorXd x_hat = mean + 0.3 * L;
+  for (int s = 0; s < S; ++s) {
+    const Eigen::VectorXd expected = x_hat + 0.5 * L * r.directions(0, s);
+    EXPECT_LT((ensemble.simulation(s).positions() - expected).norm(), 1e-12 * expected.norm())
+        << "re-sampled positions of sigma point " << s;
+    EXPECT_LT((ensemble.simulation(s).velocities() - mean_velocity).norm(),
+              1e-12 * (1.0 + mean_velocity.norm()))
+        << "velocities are the mean velocity, sigma point " << s;
+  }
+}
+
+TEST_F(CpuEnsembleTest, RejectsWrongShapes) {
+  CpuEnsemble ensemble(model_, {0, 1}, scenario_.observations.nodes, 3);
+  EXPECT_THROW(ensemble.set_parameters(Eigen::MatrixXd::Zero(3, 3)), std::invalid_argument);
+  EXPECT_THROW(CpuEnsemble(model_, {7}, scenario_.observations.nodes, 3), std::invalid_argument);
+}
+
+}  // namespace
+}  // namespace sigmafem
