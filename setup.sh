@@ -12,7 +12,7 @@ mode=${1:-run}
 case "$mode" in run|test) ;; *) echo "usage: ./setup.sh run|test" >&2; exit 2 ;; esac
 
 packages="g++ cmake ninja-build pkg-config libeigen3-dev nlohmann-json3-dev libcli11-dev
-          libgtest-dev libbenchmark-dev"
+          libgtest-dev libbenchmark-dev gnuplot-nox"
 missing=""
 for p in $packages; do
   dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q 'ok installed' || missing="$missing $p"

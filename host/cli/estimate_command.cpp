@@ -13,6 +13,7 @@ Action add_estimate_command(CLI::App& app) {
     std::string scenario;
     EstimationJob job;
     bool quiet = false;
+    double observation_std = 0.0;
   };
   auto options = std::make_shared<Options>();
   CLI::App* sub = app.add_subcommand(
@@ -28,9 +29,15 @@ Action add_estimate_command(CLI::App& app) {
   sub->add_option("--sigma", options->job.sigma_points,
                   "Sigma-point set (default: the scenario's filter.sigma_points)")
       ->check(CLI::IsMember(std::vector<std::string>{"simplex", "star"}));
+  sub->add_option("--observation-std", options->observation_std,
+                  "Observation noise std the filter assumes, metres (default: the scenario's "
+                  "filter.observation_std)")
+      ->check(CLI::PositiveNumber);
   sub->add_flag("--quiet", options->quiet, "No progress line and no summary");
   return [options]() {
-    const Scenario scenario = load_scenario(options->scenario);
+    Scenario scenario = load_scenario(options->scenario);
+    if (options->observation_std > 0.0 && scenario.filter)
+      scenario.filter->observation_std = options->observation_std;
     options->job.progress = !options->quiet;
     const nlohmann::ordered_json summary = run_estimation_job(scenario, options->job);
     if (!options->quiet) print_estimation_summary(std::cout, summary, options->job.out_dir);

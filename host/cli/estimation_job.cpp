@@ -57,6 +57,12 @@ json run_estimation_job(const Scenario& scenario, const EstimationJob& job) {
   options.roukf.initial_log_std = spec.initial_log_std;
   options.roukf.parameter_drift_log_std = spec.parameter_drift_log_std;
   options.roukf.observation_std = spec.observation_std;
+  const ChangeDetectionSpec& detection = spec.change_detection;
+  if (detection.enabled) options.detector.enabled = *detection.enabled;
+  if (detection.window) options.detector.window = *detection.window;
+  if (detection.false_alarm) options.detector.false_alarm = *detection.false_alarm;
+  if (detection.hold_off) options.detector.hold_off = *detection.hold_off;
+  if (detection.inflation_log_std) options.detector.inflation_log_std = *detection.inflation_log_std;
   const int p = static_cast<int>(spec.estimate.size());
   const int sigma_count = options.roukf.sigma_points == SigmaPointSet::simplex ? p + 1 : 2 * p + 1;
 

@@ -14,6 +14,7 @@ Action add_generate_command(CLI::App& app) {
     std::string scenario;
     GenerateOptions generate;
     bool quiet = false;
+    double noise_std = -1.0;
   };
   auto options = std::make_shared<Options>();
   CLI::App* sub = app.add_subcommand(
@@ -27,9 +28,13 @@ Action add_generate_command(CLI::App& app) {
   sub->add_option("--vtk-every", options->generate.vtk_every,
                   "Write a VTK frame every K steps (0: none; default: the scenario's)")
       ->check(CLI::NonNegativeNumber);
+  sub->add_option("--noise-std", options->noise_std,
+                  "Observation noise std in metres (default: the scenario's observations.noise_std)")
+      ->check(CLI::NonNegativeNumber);
   sub->add_flag("--quiet", options->quiet, "No progress line and no summary");
   return [options]() {
-    const Scenario scenario = load_scenario(options->scenario);
+    Scenario scenario = load_scenario(options->scenario);
+    if (options->noise_std >= 0.0) scenario.observations.noise_std = options->noise_std;
     options->generate.progress = !options->quiet;
     const GenerateResult result = generate(scenario, options->generate, std::cerr);
     if (!options->quiet) print_generate_summary(std::cout, scenario, options->generate, result);

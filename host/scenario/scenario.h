@@ -87,6 +87,16 @@ struct Observations {
   double noise_std = 0.0;           // m, >= 0, used by the generator
 };
 
+// filter.change_detection: settings of the filter's cut detector (filter/change_detector.h);
+// a field left out keeps the detector's default.
+struct ChangeDetectionSpec {
+  std::optional<bool> enabled;
+  std::optional<int> window;
+  std::optional<double> false_alarm;
+  std::optional<int> hold_off;
+  std::optional<double> inflation_log_std;
+};
+
 struct FilterSpec {
   std::vector<int> estimate;        // indices into Scenario::ligaments
   std::vector<double> initial_stiffness;   // median prior stiffness per estimated ligament
@@ -94,6 +104,7 @@ struct FilterSpec {
   double parameter_drift_log_std = 0.0;
   double observation_std = 0.0;
   std::string sigma_points = "simplex";    // "simplex" or "star"
+  ChangeDetectionSpec change_detection;
 };
 
 struct OutputSpec {

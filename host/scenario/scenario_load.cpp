@@ -625,7 +625,7 @@ void read_filter(const Checker& c, const json& root, Scenario& s) {
   const json& filter = root.at("filter");
   c.check_object(filter, "filter",
                  {"estimate", "initial_stiffness", "initial_log_std", "parameter_drift_log_std",
-                  "observation_std", "sigma_points"},
+                  "observation_std", "sigma_points", "change_detection"},
                  {"estimate", "initial_stiffness", "observation_std"});
   FilterSpec spec;
   const json& estimate = c.array(filter.at("estimate"), "filter.estimate");
@@ -663,6 +663,35 @@ void read_filter(const Checker& c, const json& root, Scenario& s) {
               "unknown sigma-point set " + in_quotes(spec.sigma_points) +
                   suggestion(spec.sigma_points, {"simplex", "star"}) +
                   "; expected simplex (p+1 points) or star (2p points)");
+  }
+  if (filter.contains("change_detection")) {
+    const json& detection = filter.at("change_detection");
+    const std::string path = "filter.change_detection";
+    c.check_object(detection, path,
+                   {"enabled", "window", "false_alarm", "hold_off", "inflation_log_std"}, {});
+    ChangeDetectionSpec& d = spec.change_detection;
+    if (detection.contains("enabled")) {
+      c.require(detection.at("enabled").is_boolean(), child(path, "enabled"),
+                "expected true or false, found " + detection.at("enabled").dump());
+      d.enabled = detection.at("enabled").get<bool>();
+    }
+    if (detection.contains("window")) {
+      d.window = c.integer(detection.at("window"), child(path, "window"));
+      c.require(*d.window >= 1, child(path, "window"), "must be at least 1 step");
+    }
+    if (detection.contains("false_alarm")) {
+      d.false_alarm = c.number(detection.at("false_alarm"), child(path, "false_alarm"));
+      c.require(*d.false_alarm > 0.0 && *d.false_alarm < 0.5, child(path, "false_alarm"),
+                "must be a probability in (0, 0.5)");
+    }
+    if (detection.contains("hold_off")) {
+      d.hold_off = c.integer(detection.at("hold_off"), child(path, "hold_off"));
+      c.require(*d.hold_off >= 0, child(path, "hold_off"), "must not be negative");
+    }
+    if (detection.contains("inflation_log_std")) {
+      d.inflation_log_std = c.number(detection.at("inflation_log_std"), child(path, "inflation_log_std"));
+      c.non_negative(*d.inflation_log_std, child(path, "inflation_log_std"));
+    }
   }
   c.require(!s.observations.nodes.empty(), "filter",
             "the filter needs observed nodes, and observations.nodes is empty");
