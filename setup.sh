@@ -41,5 +41,8 @@ cmake -S . -B build-sanitize -G Ninja -DCMAKE_BUILD_TYPE=RelWithDebInfo -DSIGMAF
   -DSIGMAFEM_SANITIZE=ON -DSIGMAFEM_BENCH=OFF >/dev/null
 cmake --build build-sanitize -j "$jobs"
 echo "== tests (sanitizers)"
+# The 1500-step box estimations run about 30x slower under the sanitizers (over 13 minutes
+# each on 2 cores); they ran above in the Release build, and EstimationLoop covers the same
+# code here in 80 steps.
 ASAN_OPTIONS=detect_leaks=1:abort_on_error=1 UBSAN_OPTIONS=print_stacktrace=1:halt_on_error=1 \
-  ctest --test-dir build-sanitize --output-on-failure -j "$jobs"
+  ctest --test-dir build-sanitize --output-on-failure -j "$jobs" -E BoxEstimation

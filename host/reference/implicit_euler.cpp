@@ -13,7 +13,12 @@ ImplicitEulerSystem::ImplicitEulerSystem(const Model& model, const std::vector<F
   dof_mass_.resize(3 * n);
   dof_spring_.resize(3 * n);
   for (int i = 0; i < n; ++i) {
-    dof_mass_.segment<3>(3 * i).setConstant(model.mass[i]);
+    // A node that no tetrahedron uses (mesh.h keeps them, so that indices stay the file's)
+    // has no mass and, without a spring, no stiffness: its rows of A would be zero. A unit
+    // placeholder mass makes them the identity; with no force on the node, dv = 0 and it
+    // stays where it is. Its real mass (zero) still counts everywhere else.
+    const bool isolated = model.mass[i] == 0.0 && spring_stiffness_[i] == 0.0;
+    dof_mass_.segment<3>(3 * i).setConstant(isolated ? 1.0 : model.mass[i]);
     dof_spring_.segment<3>(3 * i).setConstant(spring_stiffness_[i]);
   }
 }

@@ -11,6 +11,8 @@
 #include <sstream>
 #include <string>
 
+#include "temp_path.h"
+
 namespace sigmafem {
 namespace {
 namespace fs = std::filesystem;
@@ -36,9 +38,8 @@ CommandRun run_sigmafem(const std::string& arguments) {
 class CliTest : public ::testing::Test {
  protected:
   void SetUp() override {
-    dir_ = fs::temp_directory_path() /
-           (std::string("sigmafem_cli_test_") +
-            ::testing::UnitTest::GetInstance()->current_test_info()->name());
+    dir_ = test::unique_temp_path(std::string("sigmafem_cli_test_") +
+                                  ::testing::UnitTest::GetInstance()->current_test_info()->name());
     fs::remove_all(dir_);
     fs::create_directories(dir_);
     const fs::path scenarios = fs::path(SIGMAFEM_SOURCE_DIR) / "scenarios";
@@ -134,6 +135,54 @@ TEST_F(CliTest, RejectsBadOptions) {
   EXPECT_NE(run.output.find("scenario"), std::string::npos) << run.output;
   EXPECT_NE(run_sigmafem("demo nowhere").exit_code, 0);
   EXPECT_NE(run_sigmafem("no-such-command").exit_code, 0);
+}
+
+TEST_F(CliTest, EstimateWritesEstimatesSummaryAndPlots) {
+  json scenario = box_;
+  scenario["time"]["steps"] = 30;
+  std::ofstream(dir_ / "short.json") << scenario.dump(2);
+  const std::string short_json = (dir_ / "short.json").string();
+  ASSERT_EQ(run_sigmafem("generate " + short_json + " --out " + (dir_ / "data").string() +
+                         " --vtk-every 0 --quiet").exit_code, 0);
+  const CommandRun run = run_sigmafem("estimate " + short_json + " --data " + (dir_ / "data").string() +
+                                      " --out " + (dir_ / "estimate").string());
+  ASSERT_EQ(run.exit_code, 0) << run.output;
+  EXPECT_NE(run.output.find("estimated 'box' over 30 filter steps"), std::string::npos) << run.output;
+  const fs::path out = dir_ / "estimate";
+  EXPECT_TRUE(fs::exists(out / "estimates.csv"));
+  std::ifstream summary_file(out / "summary.json");
+  const json summary = json::parse(summary_file);
+  EXPECT_TRUE(summary["complete"].get<bool>());
+  EXPECT_EQ(summary["filter_steps"].get<int>(), 30);
+  EXPECT_TRUE(summary["errors"].is_object()) << "truth.csv was in the data folder";
+  EXPECT_TRUE(summary["final"].contains("middle"));
+  if (summary["plots"].contains("skipped")) {
+    GTEST_SKIP() << "plots not checked: " << summary["plots"]["skipped"];
+  }
+  for (const char* png : {"stiffness.png", "innovation.png"}) {
+    std::ifstream in(out / png, std::ios::binary);
+    char magic[8] = {};
+    in.read(magic, 8);
+    EXPECT_EQ(std::string(magic + 1, 3), "PNG") << png << " is a PNG file";
+  }
+}
+
+TEST_F(CliTest, EstimateRejectsDataOfAnotherScenario) {
+  // Liver data (12 points, other columns' values) against the box: the header matches in
+  // count, so make the point count differ by dropping one observed node from the box.
+  json scenario = box_;
+  scenario["time"]["steps"] = 5;
+  std::ofstream(dir_ / "short.json") << scenario.dump(2);
+  ASSERT_EQ(run_sigmafem("generate " + (dir_ / "short.json").string() + " --out " +
+                         (dir_ / "data").string() + " --vtk-every 0 --quiet").exit_code, 0);
+  scenario["observations"]["nodes"].erase(0);
+  std::ofstream(dir_ / "other.json") << scenario.dump(2);
+  const CommandRun run = run_sigmafem("estimate " + (dir_ / "other.json").string() + " --data " +
+                                      (dir_ / "data").string() + " --out " + (dir_ / "estimate").string());
+  EXPECT_EQ(run.exit_code, 2) << run.output;
+  EXPECT_NE(run.output.find("observations.csv line"), std::string::npos) << run.output;
+  EXPECT_NE(run.output.find("header does not match"), std::string::npos) << run.output;
+  EXPECT_FALSE(fs::exists(dir_ / "estimate" / "estimates.csv"));
 }
 
 TEST_F(CliTest, InfoDescribesTheShippedScenarios) {

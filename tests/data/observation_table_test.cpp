@@ -1,5 +1,6 @@
 // The observations file: what is written reads back, and a file that does not match the
 // scenario is rejected with the file, the line and the column in the message.
+#include "temp_path.h"
 #include "host/data/observation_table.h"
 
 #include <gtest/gtest.h>
@@ -17,7 +18,7 @@ namespace fs = std::filesystem;
 class ObservationTableTest : public ::testing::Test {
  protected:
   void SetUp() override {
-    path_ = fs::temp_directory_path() / "sigmafem_observation_table_test.csv";
+    path_ = test::unique_temp_path("sigmafem_observation_table_test").string() + ".csv";
     table_.comments = {"scenario test"};
     for (int k = 0; k < 3; ++k) {
       table_.steps.push_back(k);

@@ -9,6 +9,7 @@
 #include <random>
 #include <sstream>
 
+#include "temp_path.h"
 #include "filter/error_figures.h"
 #include "filter/estimation.h"
 #include "host/data/observation_table.h"
@@ -45,9 +46,7 @@ const BoxData& box_data(bool noise_free, bool with_cut) {
     slot->scenario = load_scenario(std::string(SIGMAFEM_SOURCE_DIR) + "/scenarios/box.json");
     if (noise_free) slot->scenario.observations.noise_std = 0.0;
     if (!with_cut) slot->scenario.events.clear();
-    const fs::path dir = fs::temp_directory_path() /
-                         ("sigmafem_estimation_box_test_" + std::to_string(noise_free) +
-                          std::to_string(with_cut));
+    const fs::path dir = test::unique_temp_path("sigmafem_estimation_box_test");
     GenerateOptions options;
     options.out_dir = dir.string();
     options.vtk_every = 0;
@@ -162,6 +161,45 @@ TEST(BoxEstimation, HandlesMissingObservations) {
   int fewer = 0;
   for (const EstimationStep& step : box.run.steps) fewer += step.observed_rows < points.cols();
   EXPECT_GT(fewer, 1000) << "most steps had missing rows";
+}
+
+}  // namespace
+}  // namespace sigmafem
+
+namespace sigmafem {
+namespace {
+
+TEST(EstimationLoop, ShortBoxRunMovesTowardsTheTruth) {
+  // The whole loop (ensemble, ROUKF, detector) over 80 steps: short enough for the sanitizer
+  // build, where the 1500-step runs above take over ten minutes each (setup.sh skips them
+  // there). From the 2x prior, every estimate must get closer to its truth.
+  Scenario scenario = load_scenario(std::string(SIGMAFEM_SOURCE_DIR) + "/scenarios/box.json");
+  scenario.observations.noise_std = 0.0;
+  scenario.time.steps = 80;
+  const fs::path dir = test::unique_temp_path("sigmafem_estimation_loop_test");
+  GenerateOptions generate_options;
+  generate_options.out_dir = dir.string();
+  generate_options.vtk_every = 0;
+  std::ostringstream log;
+  generate(scenario, generate_options, log);
+  const ObservationTable data = read_observations_csv(
+      (dir / "observations.csv").string(), static_cast<int>(scenario.observations.nodes.size()),
+      scenario.time.dt);
+  fs::remove_all(dir);
+  const EstimationOptions options =
+      filter_options(scenario, SigmaPointSet::simplex, kNoiseFreeObservationStd);
+  CpuEnsemble ensemble(make_model(scenario), scenario.filter->estimate, scenario.observations.nodes, 4);
+  const EstimationRun run = run_estimation(ensemble, options, data.times, data.so, data.points, {});
+  ASSERT_TRUE(run.complete) << run.stop_reason;
+  ASSERT_EQ(run.steps.size(), 80u);
+  for (std::size_t j = 0; j < scenario.filter->estimate.size(); ++j) {
+    const double truth = scenario.ligaments[static_cast<std::size_t>(scenario.filter->estimate[j])].stiffness;
+    const double prior_error = std::fabs(scenario.filter->initial_stiffness[j] - truth);
+    const double final_error = std::fabs(run.steps.back().stiffness[static_cast<Eigen::Index>(j)] - truth);
+    // Convergence itself is the long tests' job; after 80 steps each error has fallen by about half.
+    EXPECT_LT(final_error, 0.75 * prior_error) << "ligament " << j;
+    EXPECT_TRUE(run.steps.back().stiffness_std.allFinite());
+  }
 }
 
 }  // namespace

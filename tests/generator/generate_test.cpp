@@ -1,5 +1,6 @@
 // The synthetic-data generator: determinism (same seed, same bytes), the noise it adds, and
 // the timing of events (a cut changes the data from its step on, and not before).
+#include "temp_path.h"
 #include "host/generator/generate.h"
 
 #include <gtest/gtest.h>
@@ -48,9 +49,8 @@ std::vector<std::vector<double>> read_rows(const fs::path& path) {
 class GenerateTest : public ::testing::Test {
  protected:
   void SetUp() override {
-    dir_ = fs::temp_directory_path() /
-           ("sigmafem_generate_test_" + std::to_string(::testing::UnitTest::GetInstance()->random_seed()) +
-            "_" + ::testing::UnitTest::GetInstance()->current_test_info()->name());
+    dir_ = test::unique_temp_path(std::string("sigmafem_generate_test_") +
+                                  ::testing::UnitTest::GetInstance()->current_test_info()->name());
     fs::remove_all(dir_);
     scenario_ = load_scenario(std::string(SIGMAFEM_SOURCE_DIR) + "/scenarios/box.json");
     scenario_.time.steps = 60;  // short runs: the properties do not depend on the length

@@ -26,6 +26,7 @@
 #include <string>
 #include <vector>
 
+#include "temp_path.h"
 #include "host/common/input_error.h"
 #include "host/mesh/mesh.h"
 
@@ -45,9 +46,7 @@ inline std::string box_msh() { return source_file("scenarios/box.msh"); }
 class TempDir {
  public:
   TempDir() {
-    static std::atomic<int> counter{0};
-    path_ = std::filesystem::temp_directory_path() /
-            ("sigmafem-mesh-test-" + std::to_string(::getpid()) + "-" + std::to_string(counter++));
+    path_ = test::unique_temp_path("sigmafem-mesh-test");
     std::filesystem::create_directories(path_);
   }
   ~TempDir() {

@@ -13,6 +13,7 @@
 #include <string>
 #include <vector>
 
+#include "temp_path.h"
 #include "host/model/model.h"
 #include "host/reference/reference_simulation.h"
 #include "host/scenario/scenario.h"
@@ -50,7 +51,7 @@ double half_unit_of_last_digit(const std::string& printed) {
 
 TEST(SofaReference, ReproducesSofaToItsPrintedDigits) {
   const fs::path source = fs::path(SIGMAFEM_SHARED_DIR) / "data";
-  const fs::path dir = fs::temp_directory_path() / "sigmafem_sofa_reference_test";
+  const fs::path dir = test::unique_temp_path("sigmafem_sofa_reference_test");
   fs::remove_all(dir);
   fs::create_directories(dir);
   // scenario.json names its mesh and trajectory relative to itself (the data README says so).
