@@ -2,8 +2,11 @@
 
 #include <charconv>
 #include <cmath>
+#include <fstream>
 #include <sstream>
 #include <system_error>
+
+#include "host/common/input_error.h"
 
 namespace sigmafem {
 
@@ -29,6 +32,30 @@ bool parse_double(const std::string& text, double& value) {
   const char* last = text.data() + text.size();
   const auto result = std::from_chars(first, last, value);
   return result.ec == std::errc() && result.ptr == last && std::isfinite(value);
+}
+
+std::vector<std::string> read_csv_file(
+    const std::string& path, const std::string& where,
+    const std::function<void(const std::vector<std::string>&, const std::string&, bool)>& on_line) {
+  std::ifstream in(path);
+  if (!in) throw InputError(where + ": cannot open the file (missing or unreadable)");
+  std::vector<std::string> comments;
+  bool header_seen = false, row_seen = false;
+  std::string raw;
+  for (int line_number = 1; std::getline(in, raw); ++line_number) {
+    const std::string line = trim(raw);
+    if (line.empty()) continue;
+    if (line[0] == '#') {
+      if (!header_seen) comments.push_back(trim(line.substr(1)));
+      continue;
+    }
+    on_line(split_fields(line), where + " line " + std::to_string(line_number) + ": ", !header_seen);
+    row_seen = header_seen;
+    header_seen = true;
+  }
+  if (!header_seen) throw InputError(where + ": empty file; expected a header line");
+  if (!row_seen) throw InputError(where + ": no data rows after the header");
+  return comments;
 }
 
 }  // namespace sigmafem

@@ -3,7 +3,6 @@
 #include <cmath>
 #include <sstream>
 
-#include <fstream>
 #include <limits>
 
 #include "host/common/input_error.h"
@@ -20,36 +19,20 @@ std::vector<std::string> observation_columns(int point_count) {
 }
 
 ObservationTable read_observations_csv(const std::string& path, int point_count, double dt) {
-  const std::string where = "observations " + path;
-  std::ifstream in(path);
-  if (!in) throw InputError(where + ": cannot open the file (missing or unreadable)");
   const std::vector<std::string> columns = observation_columns(point_count);
   ObservationTable table;
   std::vector<std::vector<double>> point_rows;
   std::vector<Eigen::Vector3d> so_rows;
-  bool header_seen = false;
-  std::string raw;
-  for (int line_number = 1; std::getline(in, raw); ++line_number) {
-    const std::string line = trim(raw);
-    if (line.empty()) continue;
-    if (line[0] == '#') {
-      if (!header_seen) table.comments.push_back(trim(line.substr(1)));
-      continue;
-    }
-    const std::string at = where + " line " + std::to_string(line_number) + ": ";
-    const std::vector<std::string> fields = split_fields(line);
-    if (!header_seen) {
-      if (fields != columns) {
-        std::string expected;
-        for (std::size_t k = 0; k < std::min<std::size_t>(columns.size(), 8); ++k)
-          expected += (k ? "," : "") + columns[k];
-        throw InputError(at + "the header does not match the scenario: expected " +
-                         std::to_string(columns.size()) + " columns (" + expected + ",... for " +
-                         std::to_string(point_count) + " observed points), found " +
-                         std::to_string(fields.size()) + ": \"" + line.substr(0, 120) + "\"");
-      }
-      header_seen = true;
-      continue;
+  auto on_line = [&](const std::vector<std::string>& fields, const std::string& at, bool is_header) {
+    if (is_header) {
+      if (fields == columns) return;
+      std::string expected;
+      for (std::size_t k = 0; k < std::min<std::size_t>(columns.size(), 8); ++k)
+        expected += (k ? "," : "") + columns[k];
+      throw InputError(at + "the header does not match the scenario: expected " +
+                       std::to_string(columns.size()) + " columns (" + expected + ",... for " +
+                       std::to_string(point_count) + " observed points), found " +
+                       std::to_string(fields.size()));
     }
     if (fields.size() != columns.size())
       throw InputError(at + "expected " + std::to_string(columns.size()) + " fields, found " +
@@ -78,9 +61,8 @@ ObservationTable read_observations_csv(const std::string& path, int point_count,
     table.times.push_back(values[1]);
     so_rows.emplace_back(values[2], values[3], values[4]);
     point_rows.emplace_back(values.begin() + 5, values.end());
-  }
-  if (!header_seen) throw InputError(where + ": empty file; expected the header " + columns[0] + ",...");
-  if (table.steps.empty()) throw InputError(where + ": no data rows after the header");
+  };
+  table.comments = read_csv_file(path, "observations " + path, on_line);
   const Eigen::Index rows = static_cast<Eigen::Index>(table.steps.size());
   table.so.resize(rows, 3);
   table.points.resize(rows, 3 * point_count);

@@ -1,6 +1,5 @@
 #include "host/data/truth_table.h"
 
-#include <fstream>
 #include <sstream>
 
 #include "host/common/input_error.h"
@@ -31,28 +30,14 @@ std::string format_truth_csv(const TruthTable& table) {
 }
 
 TruthTable read_truth_csv(const std::string& path) {
-  const std::string where = "truth " + path;
-  std::ifstream in(path);
-  if (!in) throw InputError(where + ": cannot open the file (missing or unreadable)");
   TruthTable table;
   std::vector<std::vector<double>> rows;
-  bool header_seen = false;
-  std::string raw;
-  for (int line_number = 1; std::getline(in, raw); ++line_number) {
-    const std::string line = trim(raw);
-    if (line.empty()) continue;
-    if (line[0] == '#') {
-      if (!header_seen) table.comments.push_back(trim(line.substr(1)));
-      continue;
-    }
-    const std::string at = where + " line " + std::to_string(line_number) + ": ";
-    const std::vector<std::string> fields = split_fields(line);
-    if (!header_seen) {
+  auto on_line = [&](const std::vector<std::string>& fields, const std::string& at, bool is_header) {
+    if (is_header) {
       if (fields.size() < 3 || fields[0] != "step" || fields[1] != "time")
         throw InputError(at + "expected the header step,time,<ligament names...>");
       table.names.assign(fields.begin() + 2, fields.end());
-      header_seen = true;
-      continue;
+      return;
     }
     if (fields.size() != table.names.size() + 2)
       throw InputError(at + "expected " + std::to_string(table.names.size() + 2) +
@@ -68,8 +53,8 @@ TruthTable read_truth_csv(const std::string& path) {
     table.steps.push_back(static_cast<int>(rows.size()));
     table.times.push_back(values[1]);
     rows.emplace_back(values.begin() + 2, values.end());
-  }
-  if (rows.empty()) throw InputError(where + ": no data rows");
+  };
+  table.comments = read_csv_file(path, "truth " + path, on_line);
   table.stiffness.resize(static_cast<Eigen::Index>(rows.size()),
                          static_cast<Eigen::Index>(table.names.size()));
   for (std::size_t k = 0; k < rows.size(); ++k)

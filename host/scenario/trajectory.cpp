@@ -33,39 +33,27 @@ Eigen::Vector3d Trajectory::position(double t, const Eigen::Vector3d& start) con
 
 
 Trajectory read_trajectory_csv(const std::string& path) {
-  const std::string where = "trajectory CSV " + path;
-  std::ifstream in(path);
-  if (!in) throw InputError(where + ": cannot open the file (missing or unreadable)");
-
   static const char* const kColumns[] = {"time", "x", "y", "z"};
   Trajectory trajectory;
   trajectory.type = Trajectory::Type::file;
   trajectory.file = path;
-  bool header_seen = false;
-  std::string raw;
-  for (int line_number = 1; std::getline(in, raw); ++line_number) {
-    const std::string line = trim(raw);
-    if (line.empty() || line[0] == '#') continue;
-    const std::string at = where + " line " + std::to_string(line_number) + ": ";
-    const std::vector<std::string> fields = split_fields(line);
-    if (!header_seen) {
+  auto on_line = [&](const std::vector<std::string>& fields, const std::string& at, bool is_header) {
+    if (is_header) {
       // The header is required: without it a file of x,y,z,time columns would load silently.
-      if (fields != std::vector<std::string>(std::begin(kColumns), std::end(kColumns))) {
-        throw InputError(at + "expected the header \"time,x,y,z\", found \"" + line + "\"");
-      }
-      header_seen = true;
-      continue;
+      if (fields != std::vector<std::string>(std::begin(kColumns), std::end(kColumns)))
+        throw InputError(at + "expected the header \"time,x,y,z\", found " +
+                         std::to_string(fields.size()) + " columns starting \"" +
+                         (fields.empty() ? std::string() : fields[0]) + "\"");
+      return;
     }
-    if (fields.size() != 4) {
+    if (fields.size() != 4)
       throw InputError(at + "expected 4 comma-separated numbers (time,x,y,z), found " +
-                       std::to_string(fields.size()) + " fields: \"" + line + "\"");
-    }
+                       std::to_string(fields.size()) + " fields");
     double values[4];
     for (size_t k = 0; k < 4; ++k) {
-      if (!parse_double(fields[k], values[k])) {
+      if (!parse_double(fields[k], values[k]))
         throw InputError(at + "column " + kColumns[k] + " is not a finite number: \"" + fields[k] +
                          "\"");
-      }
     }
     if (!trajectory.times.empty() && !(values[0] > trajectory.times.back())) {
       std::ostringstream what;
@@ -75,11 +63,8 @@ Trajectory read_trajectory_csv(const std::string& path) {
     }
     trajectory.times.push_back(values[0]);
     trajectory.positions.emplace_back(values[1], values[2], values[3]);
-  }
-  if (!header_seen) throw InputError(where + ": empty file; expected the header \"time,x,y,z\"");
-  if (trajectory.times.empty()) {
-    throw InputError(where + ": no data rows after the header \"time,x,y,z\"");
-  }
+  };
+  read_csv_file(path, "trajectory CSV " + path, on_line);
   return trajectory;
 }
 

@@ -142,7 +142,7 @@ TEST(ReadMesh, ChoosesTheReaderByContentNotByExtension) {
 
 TEST(ReadMesh, MissingFileIsAnInputErrorNamingIt) {
   TempDir dir;
-  const std::string path = dir.path("no-such-mesh.msh");
+  const std::string path = dir.file("no-such-mesh.msh");
   try {
     read_mesh(path);
     FAIL() << "reading a missing file should throw";
@@ -155,7 +155,7 @@ TEST(ReadMesh, MissingFileIsAnInputErrorNamingIt) {
 TEST(ReadMesh, DirectoryIsAnInputError) {
   TempDir dir;
   try {
-    read_mesh(dir.path(""));
+    read_mesh(dir.path());
     FAIL() << "reading a directory should throw";
   } catch (const InputError& error) {
     EXPECT_NE(std::string(error.what()).find("is a directory"), std::string::npos) << error.what();

@@ -42,33 +42,6 @@ inline std::string liver_msh() { return shared_data("data/liver/liver.msh"); }
 inline std::string liver2_msh() { return shared_data("data/liver/liver2.msh"); }
 inline std::string box_msh() { return source_file("scenarios/box.msh"); }
 
-// A fresh folder under the system temporary folder, removed with everything in it.
-class TempDir {
- public:
-  TempDir() {
-    path_ = test::unique_temp_path("sigmafem-mesh-test");
-    std::filesystem::create_directories(path_);
-  }
-  ~TempDir() {
-    std::error_code ignored;
-    std::filesystem::remove_all(path_, ignored);
-  }
-  TempDir(const TempDir&) = delete;
-  TempDir& operator=(const TempDir&) = delete;
-
-  // Writes `content` byte for byte to `name` in this folder and returns its path.
-  std::string write(const std::string& name, const std::string& content) const {
-    const std::string file = (path_ / name).string();
-    std::ofstream out(file, std::ios::binary);
-    out << content;
-    EXPECT_TRUE(out.good()) << "could not write test file " << file;
-    return file;
-  }
-  std::string path(const std::string& name) const { return (path_ / name).string(); }
-
- private:
-  std::filesystem::path path_;
-};
 
 // The id a writer gives node i of n: decreasing and not starting at 1.
 inline long long node_id(const Mesh& mesh, int i) { return 2LL * (mesh.node_count() - i) + 5; }

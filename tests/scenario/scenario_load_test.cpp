@@ -16,6 +16,7 @@
 #include <set>
 #include <sstream>
 
+#include "temp_path.h"
 #include "host/common/input_error.h"
 #include "host/scenario/scenario.h"
 
@@ -23,40 +24,12 @@ namespace sigmafem {
 namespace {
 
 namespace fs = std::filesystem;
+using test::TempDir;
 using nlohmann::json;
 
 const std::string kSourceDir = SIGMAFEM_SOURCE_DIR;
 const std::string kSharedDir = SIGMAFEM_SHARED_DIR;
 
-// A fresh folder per test, removed afterwards.
-class TempDir {
- public:
-  TempDir() {
-    std::string pattern = (fs::temp_directory_path() / "sigmafem_scenario_XXXXXX").string();
-    if (mkdtemp(pattern.data()) == nullptr) throw std::runtime_error("mkdtemp failed");
-    path_ = pattern;
-  }
-  ~TempDir() {
-    std::error_code ignored;
-    fs::remove_all(path_, ignored);
-  }
-  TempDir(const TempDir&) = delete;
-  TempDir& operator=(const TempDir&) = delete;
-  const std::string& path() const { return path_; }
-  std::string file(const std::string& name) const { return (fs::path(path_) / name).string(); }
-  std::string write(const std::string& name, const std::string& text) const {
-    fs::create_directories(fs::path(file(name)).parent_path());
-    std::ofstream(file(name), std::ios::binary) << text;
-    return file(name);
-  }
-  void copy(const std::string& from, const std::string& name) const {
-    fs::create_directories(fs::path(file(name)).parent_path());
-    fs::copy_file(from, file(name), fs::copy_options::overwrite_existing);
-  }
-
- private:
-  std::string path_;
-};
 
 // A valid scenario on box.msh using every section; the node counts below were read off
 // the mesh (see box.json's description for the geometry).

@@ -7,6 +7,7 @@
 #include <filesystem>
 #include <fstream>
 
+#include "temp_path.h"
 #include "host/common/input_error.h"
 #include "host/scenario/scenario.h"
 
@@ -14,30 +15,8 @@ namespace sigmafem {
 namespace {
 
 namespace fs = std::filesystem;
+using test::TempDir;
 
-// A fresh folder per test, removed afterwards.
-class TempDir {
- public:
-  TempDir() {
-    std::string pattern = (fs::temp_directory_path() / "sigmafem_trajectory_XXXXXX").string();
-    if (mkdtemp(pattern.data()) == nullptr) throw std::runtime_error("mkdtemp failed");
-    path_ = pattern;
-  }
-  ~TempDir() {
-    std::error_code ignored;
-    fs::remove_all(path_, ignored);
-  }
-  TempDir(const TempDir&) = delete;
-  TempDir& operator=(const TempDir&) = delete;
-  std::string write(const std::string& name, const std::string& text) const {
-    const std::string file = (fs::path(path_) / name).string();
-    std::ofstream(file, std::ios::binary) << text;
-    return file;
-  }
-
- private:
-  std::string path_;
-};
 
 // Knots whose midpoints are exact in binary, so "between" can be compared with ==.
 Trajectory three_waypoints() {
