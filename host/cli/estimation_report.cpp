@@ -77,8 +77,14 @@ void plot_stiffness(const EstimationReport& report, const EstimationRun& run,
          << ", " << report.sigma_points << " sigma points): median with +-2 std band"
          << (truth ? ", truth dashed" : "") << "'\n"
          << "set xlabel 'time (s)'\nset ylabel 'stiffness (N/m)'\nset grid\nset key outside right\n"
-         << "set datafile missing 'nan'\n"
-         << "set yrange [0:*]\n"
+         << "set datafile missing 'nan'\n";
+  // With a truth, the first seconds' wide prior would squash the rest of the plot: show up
+  // to 2.5 times the largest true stiffness (the estimates start at most 2x off here).
+  if (truth)
+    script << "set yrange [0:" << format_number(2.5 * truth->maxCoeff()) << "]\n";
+  else
+    script << "set yrange [0:*]\n";
+  script
          << "colors = '#1f77b4 #d62728 #2ca02c #9467bd #ff7f0e #8c564b #e377c2 #7f7f7f'\n"
          << "plot ";
   for (std::size_t j = 0; j < report.names.size(); ++j) {
