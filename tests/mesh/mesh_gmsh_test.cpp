@@ -24,20 +24,10 @@ const std::string kNodes41 =
 const std::string kElements41 = "$Elements\n1 1 1 1\n3 1 4 1\n1 1 2 3 4\n$EndElements\n";
 const std::string kHeader41 = "$MeshFormat\n4.1 0 8\n$EndMeshFormat\n";
 
-std::string replace(std::string text, const std::string& from, const std::string& to) {
-  const std::size_t at = text.find(from);
-  EXPECT_NE(at, std::string::npos) << "test setup: " << from << " not in the text";
-  if (at != std::string::npos) text.replace(at, from.size(), to);
-  return text;
-}
-
 void expect_error(const std::string& content, const std::string& expected) {
-  const std::string message = test::read_error("bad.msh", content);
-  EXPECT_EQ(message.rfind("mesh ", 0), 0u) << message;
-  EXPECT_NE(message.find("bad.msh: "), std::string::npos) << "names the file: " << message;
-  EXPECT_NE(message.find(expected), std::string::npos)
-      << "expected \"" << expected << "\" in: " << message;
+  test::expect_read_error("bad.msh", content, expected);
 }
+using test::replace;
 
 Mesh read_text(const std::string& content) {
   test::TempDir dir;

@@ -295,4 +295,22 @@ inline void expect_closed_outward_surface(const Mesh& mesh,
       << what << ": divergence theorem, the volume enclosed by the outward surface";
 }
 
+// `text` with the first `from` replaced by `to` (a test-setup failure if `from` is absent).
+inline std::string replace(std::string text, const std::string& from, const std::string& to) {
+  const std::size_t at = text.find(from);
+  EXPECT_NE(at, std::string::npos) << "test setup: " << from << " not in the text";
+  if (at != std::string::npos) text.replace(at, from.size(), to);
+  return text;
+}
+
+// Reading `content` as file `name` must fail with "mesh <path>/<name>: ..." containing `expected`.
+inline void expect_read_error(const std::string& name, const std::string& content,
+                              const std::string& expected) {
+  const std::string message = read_error(name, content);
+  EXPECT_EQ(message.rfind("mesh ", 0), 0u) << message;
+  EXPECT_NE(message.find(name + ": "), std::string::npos) << "names the file: " << message;
+  EXPECT_NE(message.find(expected), std::string::npos)
+      << "expected \"" << expected << "\" in: " << message;
+}
+
 }  // namespace sigmafem::test

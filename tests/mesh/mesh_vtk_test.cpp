@@ -26,20 +26,10 @@ Mesh one_tetrahedron() {
   return mesh;
 }
 
-std::string replace(std::string text, const std::string& from, const std::string& to) {
-  const std::size_t at = text.find(from);
-  EXPECT_NE(at, std::string::npos) << "test setup: " << from << " not in the text";
-  if (at != std::string::npos) text.replace(at, from.size(), to);
-  return text;
-}
-
 void expect_error(const std::string& content, const std::string& expected) {
-  const std::string message = test::read_error("bad.vtk", content);
-  EXPECT_EQ(message.rfind("mesh ", 0), 0u) << message;
-  EXPECT_NE(message.find("bad.vtk: "), std::string::npos) << "names the file: " << message;
-  EXPECT_NE(message.find(expected), std::string::npos)
-      << "expected \"" << expected << "\" in: " << message;
+  test::expect_read_error("bad.vtk", content, expected);
 }
+using test::replace;
 
 TEST(VtkReader, MinimalAsciiFileReads) {
   test::TempDir dir;
