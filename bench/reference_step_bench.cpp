@@ -4,11 +4,9 @@
 // element's matrix-free product in one CG iteration. Results: bench/RESULTS.md.
 #include <benchmark/benchmark.h>
 
-#include <map>
-#include <memory>
 #include <string>
 
-#include "host/mesh/mesh.h"
+#include "bench/bench_scenarios.h"
 #include "host/model/model.h"
 #include "host/reference/corotational.h"
 #include "host/reference/reference_simulation.h"
@@ -17,19 +15,7 @@
 namespace sigmafem {
 namespace {
 
-// A scenario, refined `refinements` times; ligament, control and observed node indices stay
-// valid because refinement keeps the old nodes first.
-const Scenario& scenario(const std::string& name, int refinements) {
-  static std::map<std::string, std::unique_ptr<Scenario>> cache;
-  const std::string key = name + "/" + std::to_string(refinements);
-  auto& slot = cache[key];
-  if (!slot) {
-    slot = std::make_unique<Scenario>(
-        load_scenario(std::string(SIGMAFEM_SOURCE_DIR) + "/scenarios/" + name + ".json"));
-    for (int r = 0; r < refinements; ++r) slot->mesh = refine_uniform(slot->mesh);
-  }
-  return *slot;
-}
+using bench::scenario;
 
 // Warmed-up simulation: 20 steps in, so that the organ is deformed and CG warm-starts.
 ReferenceSimulation warmed_up(const Scenario& s, int& step) {

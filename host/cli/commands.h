@@ -14,5 +14,6 @@ Action add_generate_command(CLI::App& app);
 Action add_estimate_command(CLI::App& app);
 Action add_demo_command(CLI::App& app);
 Action add_info_command(CLI::App& app);
+Action add_devices_command(CLI::App& app);
 
 }  // namespace sigmafem::cli

@@ -6,6 +6,7 @@
 #include <iostream>
 #include <memory>
 
+#include "host/cli/backend_options.h"
 #include "host/cli/commands.h"
 #include "host/cli/estimation_job.h"
 #include "host/cli/report.h"
@@ -42,7 +43,7 @@ Action add_demo_command(CLI::App& app) {
     std::string scenario = "box";
     std::string out_dir;
     std::uint64_t seed = 1;
-    std::string backend = "cpu";
+    BackendChoice backend;
     std::string sigma_points;
   };
   auto options = std::make_shared<Options>();
@@ -52,9 +53,7 @@ Action add_demo_command(CLI::App& app) {
       ->capture_default_str();
   sub->add_option("--out", options->out_dir, "Output folder (default: sigmafem-demo/<scenario>)");
   sub->add_option("--seed", options->seed, "Seed of the observation noise")->capture_default_str();
-  sub->add_option("--backend", options->backend, "Where the filter's ensemble runs")
-      ->check(CLI::IsMember(std::vector<std::string>{"cpu"}))
-      ->capture_default_str();
+  add_backend_options(sub, options->backend);
   sub->add_option("--sigma", options->sigma_points, "Sigma-point set (default: the scenario's)")
       ->check(CLI::IsMember(std::vector<std::string>{"simplex", "star"}));
   return [options]() {
@@ -65,6 +64,8 @@ Action add_demo_command(CLI::App& app) {
     generate_options.out_dir = (out / "data").string();
     generate_options.seed = options->seed;
     generate_options.progress = true;
+    generate_options.backend = options->backend.backend;
+    generate_options.device = options->backend.device_options();
     std::cout << "sigmafem demo: scenario " << scenario.path << "\n1. synthetic data\n";
     const GenerateResult result = generate(scenario, generate_options, std::cerr);
     print_generate_summary(std::cout, scenario, generate_options, result);
@@ -73,7 +74,8 @@ Action add_demo_command(CLI::App& app) {
     EstimationJob job;
     job.data_dir = generate_options.out_dir;
     job.out_dir = (out / "estimate").string();
-    job.backend = options->backend;
+    job.backend = options->backend.backend;
+    job.device = options->backend.device_options();
     job.sigma_points = options->sigma_points;
     const auto summary = run_estimation_job(scenario, job);
     print_estimation_summary(std::cout, summary, job.out_dir);

@@ -1,7 +1,9 @@
-// `sigmafem estimate SCENARIO --data DIR --out DIR [--backend cpu] [--sigma simplex|star]`.
+// `sigmafem estimate SCENARIO --data DIR --out DIR [--backend cpu|opencl] [--device N]
+//  [--precision single|double] [--sigma simplex|star]`.
 #include <iostream>
 #include <memory>
 
+#include "host/cli/backend_options.h"
 #include "host/cli/commands.h"
 #include "host/cli/estimation_job.h"
 #include "host/scenario/scenario.h"
@@ -12,6 +14,7 @@ Action add_estimate_command(CLI::App& app) {
   struct Options {
     std::string scenario;
     EstimationJob job;
+    BackendChoice backend;
     bool quiet = false;
     double observation_std = 0.0;
   };
@@ -23,9 +26,7 @@ Action add_estimate_command(CLI::App& app) {
   sub->add_option("--data", options->job.data_dir, "Folder with observations.csv (and truth.csv)")
       ->required();
   sub->add_option("--out", options->job.out_dir, "Output folder (created if missing)")->required();
-  sub->add_option("--backend", options->job.backend, "Where the ensemble runs")
-      ->check(CLI::IsMember(std::vector<std::string>{"cpu"}))
-      ->capture_default_str();
+  add_backend_options(sub, options->backend);
   sub->add_option("--sigma", options->job.sigma_points,
                   "Sigma-point set (default: the scenario's filter.sigma_points)")
       ->check(CLI::IsMember(std::vector<std::string>{"simplex", "star"}));
@@ -39,6 +40,8 @@ Action add_estimate_command(CLI::App& app) {
     if (options->observation_std > 0.0 && scenario.filter)
       scenario.filter->observation_std = options->observation_std;
     options->job.progress = !options->quiet;
+    options->job.backend = options->backend.backend;
+    options->job.device = options->backend.device_options();
     const nlohmann::ordered_json summary = run_estimation_job(scenario, options->job);
     if (!options->quiet) print_estimation_summary(std::cout, summary, options->job.out_dir);
     return summary["complete"].get<bool>() ? 0 : 1;

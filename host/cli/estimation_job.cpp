@@ -13,24 +13,12 @@
 #include "host/common/progress.h"
 #include "host/data/observation_table.h"
 #include "host/data/truth_table.h"
-#include "host/ensemble/cpu_ensemble.h"
+#include "host/ensemble/make_ensemble.h"
 #include "host/model/model.h"
 
 namespace sigmafem::cli {
 namespace fs = std::filesystem;
 using json = nlohmann::ordered_json;
-
-namespace {
-
-std::unique_ptr<Ensemble> make_ensemble(const std::string& backend, const Scenario& scenario,
-                                        int sigma_count) {
-  if (backend == "cpu")
-    return std::make_unique<CpuEnsemble>(make_model(scenario), scenario.filter->estimate,
-                                         scenario.observations.nodes, sigma_count);
-  throw InputError("--backend " + backend + ": not available in this build (available: cpu)");
-}
-
-}  // namespace
 
 json run_estimation_job(const Scenario& scenario, const EstimationJob& job) {
   const auto start = std::chrono::steady_clock::now();
@@ -67,7 +55,9 @@ json run_estimation_job(const Scenario& scenario, const EstimationJob& job) {
   const int sigma_count = options.roukf.sigma_points == SigmaPointSet::simplex ? p + 1 : 2 * p + 1;
 
   fs::create_directories(job.out_dir);
-  std::unique_ptr<Ensemble> ensemble = make_ensemble(job.backend, scenario, sigma_count);
+  std::unique_ptr<Ensemble> ensemble =
+      make_ensemble(job.backend, make_model(scenario), scenario.filter->estimate,
+                    scenario.observations.nodes, sigma_count, job.device);
   Progress progress("estimate " + scenario.name + ": step", table.row_count() - 1, job.progress);
   const EstimationRun run = run_estimation(
       *ensemble, options, table.times, table.so, table.points, [&](const EstimationStep& step) {

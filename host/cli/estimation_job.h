@@ -5,6 +5,7 @@
 #include <nlohmann/json.hpp>
 #include <string>
 
+#include "host/common/device_error.h"
 #include "host/scenario/scenario.h"
 
 namespace sigmafem::cli {
@@ -13,6 +14,7 @@ struct EstimationJob {
   std::string data_dir;
   std::string out_dir;
   std::string backend = "cpu";
+  DeviceOptions device;            // for a device back end
   std::string sigma_points;        // "" = the scenario's filter.sigma_points
   bool progress = true;
 };

@@ -2,6 +2,7 @@
 #include <iostream>
 #include <memory>
 
+#include "host/cli/backend_options.h"
 #include "host/cli/commands.h"
 #include "host/cli/report.h"
 #include "host/generator/generate.h"
@@ -13,6 +14,7 @@ Action add_generate_command(CLI::App& app) {
   struct Options {
     std::string scenario;
     GenerateOptions generate;
+    BackendChoice backend;
     bool quiet = false;
     double noise_std = -1.0;
   };
@@ -31,9 +33,12 @@ Action add_generate_command(CLI::App& app) {
   sub->add_option("--noise-std", options->noise_std,
                   "Observation noise std in metres (default: the scenario's observations.noise_std)")
       ->check(CLI::NonNegativeNumber);
+  add_backend_options(sub, options->backend);
   sub->add_flag("--quiet", options->quiet, "No progress line and no summary");
   return [options]() {
     Scenario scenario = load_scenario(options->scenario);
+    options->generate.backend = options->backend.backend;
+    options->generate.device = options->backend.device_options();
     if (options->noise_std >= 0.0) scenario.observations.noise_std = options->noise_std;
     options->generate.progress = !options->quiet;
     const GenerateResult result = generate(scenario, options->generate, std::cerr);

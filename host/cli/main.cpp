@@ -1,10 +1,13 @@
 // sigmafem command line. Exit codes: 0 success, 1 a run that failed (the simulation), 2 bad
-// input (files, scenario, options), with a message on stderr that says where and what.
+// input (files, scenario, options), 3 a device that cannot run it (no OpenCL platform, a
+// kernel that fails to build, out of device memory), with a message on stderr that says
+// where and what.
 #include <CLI/CLI.hpp>
 #include <iostream>
 #include <map>
 
 #include "host/cli/commands.h"
+#include "host/common/device_error.h"
 #include "host/common/input_error.h"
 
 int main(int argc, char** argv) {
@@ -14,8 +17,8 @@ int main(int argc, char** argv) {
   app.require_subcommand(1);
   std::map<CLI::App*, sigmafem::cli::Action> actions;
   for (auto add : {sigmafem::cli::add_generate_command, sigmafem::cli::add_estimate_command,
-                   sigmafem::cli::add_demo_command,
-                   sigmafem::cli::add_info_command}) {
+                   sigmafem::cli::add_demo_command, sigmafem::cli::add_info_command,
+                   sigmafem::cli::add_devices_command}) {
     const std::size_t before = app.get_subcommands({}).size();
     sigmafem::cli::Action action = add(app);
     actions[app.get_subcommands({}).at(before)] = std::move(action);
@@ -30,6 +33,9 @@ int main(int argc, char** argv) {
   } catch (const sigmafem::InputError& e) {
     std::cerr << "sigmafem: error: " << e.what() << '\n';
     return 2;
+  } catch (const sigmafem::DeviceError& e) {
+    std::cerr << "sigmafem: device error: " << e.what() << '\n';
+    return 3;
   } catch (const std::exception& e) {
     std::cerr << "sigmafem: failed: " << e.what() << '\n';
     return 1;

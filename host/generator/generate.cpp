@@ -16,7 +16,7 @@
 #include "host/generator/gaussian_noise.h"
 #include "host/generator/vtk_series.h"
 #include "host/model/model.h"
-#include "host/reference/reference_simulation.h"
+#include "host/generator/truth_simulation.h"
 
 namespace sigmafem {
 namespace fs = std::filesystem;
@@ -28,7 +28,7 @@ GenerateResult generate(const Scenario& scenario, const GenerateOptions& options
   fs::create_directories(options.out_dir, error);
   if (error) throw InputError(options.out_dir + ": cannot create output folder: " + error.message());
 
-  ReferenceSimulation simulation(make_model(scenario));
+  TruthSimulation simulation(make_model(scenario), options);
   const Model& model = simulation.model();
   const int steps = scenario.time.steps;
   const double dt = scenario.time.dt;
@@ -50,7 +50,9 @@ GenerateResult generate(const Scenario& scenario, const GenerateOptions& options
   GaussianNoise noise(options.seed);
 
   GenerateResult result;
+  Eigen::VectorXd positions;
   auto record = [&](int k) {
+    positions = simulation.positions();
     const double t = k * dt;
     table.steps.push_back(k);
     table.times.push_back(t);
@@ -58,7 +60,7 @@ GenerateResult generate(const Scenario& scenario, const GenerateOptions& options
     for (std::size_t p = 0; p < observed.size(); ++p)
       for (int a = 0; a < 3; ++a)
         table.points(k, static_cast<Eigen::Index>(3 * p + a)) =
-            simulation.positions()[3 * observed[p] + a] +
+            positions[3 * observed[p] + a] +
             scenario.observations.noise_std * noise.next();
     truth.steps.push_back(k);
     truth.times.push_back(t);
@@ -67,7 +69,7 @@ GenerateResult generate(const Scenario& scenario, const GenerateOptions& options
     for (int i = 0; i < model.node_count(); ++i)
       result.max_displacement =
           std::max(result.max_displacement,
-                   (simulation.node_position(i) - model.rest_positions[i]).norm());
+                   (positions.segment<3>(3 * i) - model.rest_positions[i]).norm());
   };
 
   std::unique_ptr<VtkSeries> vtk;
@@ -75,7 +77,7 @@ GenerateResult generate(const Scenario& scenario, const GenerateOptions& options
 
   simulation.set_ligament_stiffness(scenario.ligament_stiffness_at(0.0));
   record(0);
-  if (vtk) vtk->write_frame(0.0, simulation.positions());
+  if (vtk) vtk->write_frame(0.0, positions);
   Progress progress("generate " + scenario.name + ": step", steps, options.progress);
   for (int k = 1; k <= steps; ++k) {
     const double t = k * dt;
@@ -92,7 +94,7 @@ GenerateResult generate(const Scenario& scenario, const GenerateOptions& options
              " SPD (negative stiffness, bad element).\n";
     }
     record(k);
-    if (vtk && k % vtk_every == 0) vtk->write_frame(t, simulation.positions());
+    if (vtk && k % vtk_every == 0) vtk->write_frame(t, positions);
     progress.update(k, "CG " + std::to_string(cg.iterations) + " it");
   }
   progress.finish();

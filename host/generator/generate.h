@@ -1,5 +1,6 @@
 // generate: the synthetic-data generator (`sigmafem generate`). It runs the scenario's
-// experiment on the CPU reference with the true ligament stiffnesses and the events (a cut),
+// experiment on the CPU reference (or on a device back end, one simulation) with the true
+// ligament stiffnesses and the events (a cut),
 // and writes what a tracking system would have measured:
 //   <out>/observations.csv  SO position and observed node positions per step, with Gaussian
 //                           noise of the scenario's noise_std (docs/FORMATS.md)
@@ -14,6 +15,7 @@
 #include <iosfwd>
 #include <string>
 
+#include "host/common/device_error.h"
 #include "host/scenario/scenario.h"
 
 namespace sigmafem {
@@ -23,6 +25,8 @@ struct GenerateOptions {
   std::uint64_t seed = 1;
   int vtk_every = -1;              // -1: the scenario's output.vtk_every; 0: no VTK
   bool progress = false;           // a progress line on stderr (when it is a terminal)
+  std::string backend = "cpu";     // make_ensemble's names; "cpu" is the double-precision reference
+  DeviceOptions device;            // for a device back end
 };
 
 struct GenerateResult {

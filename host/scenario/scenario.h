@@ -19,6 +19,7 @@ struct MeshSpec {
   std::string resolved_path;        // relative to the scenario's folder
   double scale = 1.0;
   Eigen::Vector3d translate = Eigen::Vector3d::Zero();
+  int refine = 0;                   // uniform refinement levels (0..3), each x8 tetrahedra
 };
 
 struct Material {
@@ -117,7 +118,7 @@ struct Scenario {
   std::string name;
   std::string description;          // free text, optional
   MeshSpec mesh_spec;
-  Mesh mesh;                        // loaded, transformed to metres, oriented and checked
+  Mesh mesh;                        // loaded, transformed to metres, oriented, checked, refined
   MeshQualityReport mesh_report;
   Material material;
   Damping damping;

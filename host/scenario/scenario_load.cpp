@@ -28,6 +28,10 @@ namespace fs = std::filesystem;
 
 constexpr const char* kFormat = "sigmafem-scenario/1";
 
+// mesh.refine: each level multiplies the tetrahedra by 8, so 3 levels (x512) already turn a
+// 10k-element mesh into millions; beyond that a finer mesh file is the better tool.
+constexpr int kMaxMeshRefine = 3;
+
 // ---------------------------------------------------------------------------------------
 // Text helpers for messages.
 
@@ -426,13 +430,18 @@ std::string resolve(const std::string& scenario_path, const std::string& file) {
 void read_mesh_section(const Checker& c, const json& root, const std::string& scenario_path,
                        Scenario& s) {
   const json& spec = root.at("mesh");
-  c.check_object(spec, "mesh", {"file", "scale", "translate"}, {"file"});
+  c.check_object(spec, "mesh", {"file", "scale", "translate", "refine"}, {"file"});
   s.mesh_spec.file = c.string(spec.at("file"), "mesh.file");
   c.require(!s.mesh_spec.file.empty(), "mesh.file", "empty file name");
   s.mesh_spec.scale = c.number_or(spec, "mesh", "scale", 1.0);
   c.positive(s.mesh_spec.scale, "mesh.scale");
   if (spec.contains("translate"))
     s.mesh_spec.translate = c.vector3(spec.at("translate"), "mesh.translate");
+  s.mesh_spec.refine = c.integer_or(spec, "mesh", "refine", 0);
+  c.require(s.mesh_spec.refine >= 0 && s.mesh_spec.refine <= kMaxMeshRefine, "mesh.refine",
+            "must be an integer from 0 to " + std::to_string(kMaxMeshRefine) +
+                " (uniform refinement levels, each splits every tetrahedron into 8), found " +
+                std::to_string(s.mesh_spec.refine));
   s.mesh_spec.resolved_path = resolve(scenario_path, s.mesh_spec.file);
   std::error_code error;
   c.require(fs::is_regular_file(s.mesh_spec.resolved_path, error), "mesh.file",
@@ -444,6 +453,19 @@ void read_mesh_section(const Checker& c, const json& root, const std::string& sc
     s.mesh_report = orient_and_check(s.mesh, s.mesh_spec.resolved_path);
   } catch (const InputError& e) {
     c.fail("mesh.file", e.what());
+  }
+  // Refined after orienting, so that selections (below, in read_ligaments and on) see the
+  // refined nodes while the file's nodes keep their indices for explicit node lists.
+  if (s.mesh_spec.refine == 0) return;
+  for (int level = 0; level < s.mesh_spec.refine; ++level) s.mesh = refine_uniform(s.mesh);
+  // The children of positive parents are positive, so this only measures the new elements;
+  // the count of inverted elements the file had stays the one reported for the file.
+  try {
+    const MeshQualityReport refined = orient_and_check(s.mesh, s.mesh_spec.resolved_path);
+    s.mesh_report.min_quality = refined.min_quality;
+    s.mesh_report.total_volume = refined.total_volume;
+  } catch (const InputError& e) {
+    c.fail("mesh.refine", e.what());  // element numbers there are those of the refined mesh
   }
 }
 

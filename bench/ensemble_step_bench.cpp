@@ -1,0 +1,142 @@
+// Speed of the ensembles (issue 4, "Speed"): one advance() of S sigma points, OpenCL beside
+// the CPU reference in the same run, against S on a ~5k-tetrahedron liver and against mesh
+// size at S = 16; and one whole ROUKF filter step on the liver (simplex, 3 ligaments).
+// Units (ARCHITECTURE.md): element-iterations per second (one element's product for one
+// sigma point in one CG iteration) and sigma-point steps per second. Results: bench/RESULTS.md.
+#include <benchmark/benchmark.h>
+
+#include <cmath>
+#include <memory>
+#include <string>
+
+#include "bench/bench_scenarios.h"
+#include "filter/roukf.h"
+#include "host/ensemble/make_ensemble.h"
+#include "host/model/model.h"
+#include "host/reference/reference_simulation.h"
+
+namespace sigmafem {
+namespace {
+
+struct Backend {
+  std::string name;        // make_ensemble's name
+  Precision precision;
+  std::string label;
+};
+
+const Backend kCpu{"cpu", Precision::double_precision, "cpu-reference double, all cores"};
+const Backend kOpenCl{"opencl", Precision::single, "opencl single, device 0"};
+
+// An ensemble of S sigma points with stiffnesses spread around the scenario's, advanced a
+// few steps so that the organ is deformed and CG warm-starts as in a run.
+std::unique_ptr<Ensemble> warmed_up(const Backend& backend, const Scenario& s, const Model& model,
+                                    int S, int& step) {
+  DeviceOptions options;
+  options.precision = backend.precision;
+  auto ensemble = make_ensemble(backend.name, model, s.filter->estimate, s.observations.nodes, S,
+                                options);
+  Eigen::MatrixXd theta(ensemble->parameter_count(), S);
+  for (int j = 0; j < theta.rows(); ++j)
+    for (int k = 0; k < S; ++k)
+      theta(j, k) = std::log(model.ligaments[s.filter->estimate[j]].stiffness) + 0.3 * std::sin(k + j);
+  ensemble->set_parameters(theta);
+  for (step = 1; step <= 5; ++step) ensemble->advance(bench::so_position(s, step));
+  return ensemble;
+}
+
+void BM_ensemble_step(benchmark::State& state, const Backend& backend, const std::string& name,
+                      int refinements) {
+  const int S = static_cast<int>(state.range(0));
+  const Scenario& s = bench::scenario(name, refinements);
+  const Model model = make_model(s);
+  int step = 0;
+  std::unique_ptr<Ensemble> ensemble;
+  try {
+    ensemble = warmed_up(backend, s, model, S, step);
+  } catch (const std::exception& e) {
+    state.SkipWithError(e.what());
+    return;
+  }
+  double element_iterations = 0.0;
+  double cg_iterations = 0.0;
+  for (auto _ : state) {
+    const StepReport report = ensemble->advance(bench::so_position(s, step++));
+    for (int k = 0; k < S; ++k) cg_iterations += report.cg_iterations[k];
+  }
+  element_iterations = cg_iterations * model.element_count();
+  state.counters["tetrahedra"] = model.element_count();
+  state.counters["S"] = S;
+  state.counters["cg_iterations_per_step"] =
+      cg_iterations / (static_cast<double>(state.iterations()) * S);
+  state.counters["element_iterations_per_s"] =
+      benchmark::Counter(element_iterations, benchmark::Counter::kIsRate);
+  state.counters["sigma_point_steps_per_s"] =
+      benchmark::Counter(static_cast<double>(state.iterations()) * S, benchmark::Counter::kIsRate);
+  state.SetLabel(backend.label);
+}
+
+// One whole filter step: re-centre, advance, gather, correct (the truth is simulated beside
+// it, outside the timing, to give the observations).
+void BM_filter_step(benchmark::State& state, const Backend& backend) {
+  const Scenario& s = bench::scenario("liver", 0);
+  const Model model = make_model(s);
+  RoukfOptions options;
+  options.sigma_points = SigmaPointSet::simplex;
+  options.initial_theta = Eigen::VectorXd(static_cast<Eigen::Index>(s.filter->estimate.size()));
+  for (std::size_t j = 0; j < s.filter->estimate.size(); ++j)
+    options.initial_theta[static_cast<Eigen::Index>(j)] = std::log(s.filter->initial_stiffness[j]);
+  options.initial_log_std = s.filter->initial_log_std;
+  options.parameter_drift_log_std = s.filter->parameter_drift_log_std;
+  options.observation_std = s.filter->observation_std;
+  DeviceOptions device;
+  device.precision = backend.precision;
+  std::unique_ptr<Ensemble> ensemble;
+  try {
+    ensemble = make_ensemble(backend.name, model, s.filter->estimate, s.observations.nodes,
+                             static_cast<int>(s.filter->estimate.size()) + 1, device);
+  } catch (const std::exception& e) {
+    state.SkipWithError(e.what());
+    return;
+  }
+  Roukf filter(options, *ensemble);
+  ReferenceSimulation truth(model);
+  Eigen::VectorXd y(3 * static_cast<Eigen::Index>(s.observations.nodes.size()));
+  int step = 0;
+  for (auto _ : state) {
+    state.PauseTiming();
+    ++step;
+    const Eigen::Vector3d so = bench::so_position(s, step);
+    truth.step(so);
+    for (std::size_t k = 0; k < s.observations.nodes.size(); ++k)
+      y.segment<3>(3 * static_cast<Eigen::Index>(k)) = truth.node_position(s.observations.nodes[k]);
+    state.ResumeTiming();
+    benchmark::DoNotOptimize(filter.step(so, y));
+  }
+  state.counters["sigma_points"] = ensemble->sigma_count();
+  state.SetLabel(backend.label + ", liver, simplex");
+}
+
+// Against S, on the liver refined once (4768 tetrahedra).
+BENCHMARK_CAPTURE(BM_ensemble_step, opencl_liver_4768, kOpenCl, std::string("liver"), 1)
+    ->RangeMultiplier(2)->Range(1, 256)->Unit(benchmark::kMillisecond)->UseRealTime();
+BENCHMARK_CAPTURE(BM_ensemble_step, cpu_liver_4768, kCpu, std::string("liver"), 1)
+    ->Arg(1)->Arg(16)->Unit(benchmark::kMillisecond)->UseRealTime();
+// Against mesh size, S = 16.
+BENCHMARK_CAPTURE(BM_ensemble_step, opencl_liver_596, kOpenCl, std::string("liver"), 0)
+    ->Arg(16)->Unit(benchmark::kMillisecond)->UseRealTime();
+BENCHMARK_CAPTURE(BM_ensemble_step, cpu_liver_596, kCpu, std::string("liver"), 0)
+    ->Arg(16)->Unit(benchmark::kMillisecond)->UseRealTime();
+BENCHMARK_CAPTURE(BM_ensemble_step, opencl_liver_fine_38144, kOpenCl, std::string("liver_fine"), 0)
+    ->Arg(16)->Unit(benchmark::kMillisecond)->UseRealTime();
+BENCHMARK_CAPTURE(BM_ensemble_step, cpu_liver_fine_38144, kCpu, std::string("liver_fine"), 0)
+    ->Arg(16)->Unit(benchmark::kMillisecond)->UseRealTime();
+BENCHMARK_CAPTURE(BM_ensemble_step, opencl_box_large_117240, kOpenCl, std::string("box_large"), 0)
+    ->Arg(16)->Unit(benchmark::kMillisecond)->UseRealTime();
+BENCHMARK_CAPTURE(BM_ensemble_step, cpu_box_large_117240, kCpu, std::string("box_large"), 0)
+    ->Arg(16)->Unit(benchmark::kMillisecond)->UseRealTime();
+// A whole filter step on the liver.
+BENCHMARK_CAPTURE(BM_filter_step, opencl, kOpenCl)->Unit(benchmark::kMillisecond)->UseRealTime();
+BENCHMARK_CAPTURE(BM_filter_step, cpu, kCpu)->Unit(benchmark::kMillisecond)->UseRealTime();
+
+}  // namespace
+}  // namespace sigmafem

@@ -1,0 +1,21 @@
+// The options that choose where simulations run, shared by `estimate`, `generate` and `demo`:
+// --backend cpu|opencl, --device N, --precision single|double.
+#pragma once
+
+#include <CLI/CLI.hpp>
+#include <string>
+
+#include "host/common/device_error.h"
+
+namespace sigmafem::cli {
+
+struct BackendChoice {
+  std::string backend = "cpu";
+  int device = 0;
+  std::string precision = "single";
+  DeviceOptions device_options() const;
+};
+
+void add_backend_options(CLI::App* command, BackendChoice& choice);
+
+}  // namespace sigmafem::cli

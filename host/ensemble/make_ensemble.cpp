@@ -1,0 +1,23 @@
+#include "host/ensemble/make_ensemble.h"
+
+#include "host/common/input_error.h"
+#include "host/ensemble/cpu_ensemble.h"
+#include "host/opencl/opencl_ensemble.h"
+
+namespace sigmafem {
+
+std::vector<std::string> available_backends() { return {"cpu", "opencl"}; }
+
+std::unique_ptr<Ensemble> make_ensemble(const std::string& backend, const Model& model,
+                                        const std::vector<int>& estimated,
+                                        const std::vector<int>& observed, int sigma_count,
+                                        const DeviceOptions& options) {
+  if (backend == "cpu") return std::make_unique<CpuEnsemble>(model, estimated, observed, sigma_count);
+  if (backend == "opencl")
+    return std::make_unique<OpenClEnsemble>(model, estimated, observed, sigma_count, options);
+  std::string names;
+  for (const std::string& name : available_backends()) names += (names.empty() ? "" : ", ") + name;
+  throw InputError("--backend " + backend + ": unknown back end (available: " + names + ")");
+}
+
+}  // namespace sigmafem

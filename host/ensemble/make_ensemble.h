@@ -1,0 +1,25 @@
+// make_ensemble: the one place that turns a back-end name ("cpu", "opencl") into an Ensemble,
+// for the command line, the tests and the benchmarks.
+#pragma once
+
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "filter/ensemble.h"
+#include "host/common/device_error.h"
+#include "host/model/model.h"
+
+namespace sigmafem {
+
+// The back ends this build has, in the order `--backend` lists them.
+std::vector<std::string> available_backends();
+
+// Throws InputError for an unknown name, DeviceError when the device cannot run it.
+// `options` is ignored by the CPU back end.
+std::unique_ptr<Ensemble> make_ensemble(const std::string& backend, const Model& model,
+                                        const std::vector<int>& estimated,
+                                        const std::vector<int>& observed, int sigma_count,
+                                        const DeviceOptions& options = {});
+
+}  // namespace sigmafem

@@ -1,0 +1,424 @@
+#include "host/opencl/opencl_ensemble.h"
+
+#include <algorithm>
+#include <cmath>
+#include <stdexcept>
+#include <string>
+
+namespace sigmafem {
+namespace {
+
+constexpr std::size_t kGroup = 64;        // work-group size; SF_GROUP_SIZE in the kernels
+constexpr int kStepConstants = 12;        // SF_STEP_CONSTANTS in ensemble_layout.h
+constexpr int kMaxParameters = 16;        // SF_MAX_PARAMETERS in recenter.cl
+
+std::size_t round_up(std::size_t n, std::size_t multiple) {
+  return (n + multiple - 1) / multiple * multiple;
+}
+
+// Sets the kernel's arguments in order.
+template <class... Args>
+void set_args(cl::Kernel& kernel, const Args&... args) {
+  cl_uint index = 0;
+  (kernel.setArg(index++, args), ...);
+}
+
+}  // namespace
+
+OpenClEnsemble::OpenClEnsemble(const Model& model, std::vector<int> estimated,
+                               std::vector<int> observed, int sigma_count,
+                               const DeviceOptions& options)
+    : device_(options.device, options.precision),
+      model_(model),
+      estimated_(std::move(estimated)),
+      observed_(std::move(observed)),
+      S_(sigma_count),
+      nodes_(model.node_count()),
+      elements_(model.element_count()) {
+  if (S_ < 1) throw std::invalid_argument("OpenClEnsemble: need at least one sigma point");
+  if (static_cast<int>(estimated_.size()) > kMaxParameters)
+    throw std::invalid_argument("OpenClEnsemble: at most " + std::to_string(kMaxParameters) +
+                                " estimated parameters");
+  for (int l : estimated_)
+    if (l < 0 || l >= static_cast<int>(model.ligaments.size()))
+      throw std::invalid_argument("OpenClEnsemble: no ligament " + std::to_string(l));
+  for (int node : observed_)
+    if (node < 0 || node >= nodes_)
+      throw std::invalid_argument("OpenClEnsemble: no node " + std::to_string(node));
+  tolerance_ = options.precision == Precision::single
+                   ? std::max(model.solver.cg_tolerance, kSingleTolerance)
+                   : model.solver.cg_tolerance;
+
+  // Check the memory before asking for it, to say how much is needed.
+  const std::size_t real = device_.real_size();
+  const std::size_t dof = 3 * static_cast<std::size_t>(nodes_) * S_;
+  const std::size_t per_element = static_cast<std::size_t>(elements_) * S_;
+  const std::size_t largest = 12 * per_element * real;
+  const std::size_t estimate = (9 * dof + 33 * per_element) * real;
+  const OpenClDeviceInfo& info = device_.info();
+  if (largest > info.max_allocation || estimate > info.global_memory)
+    throw DeviceError("out of device memory: " + std::to_string(S_) + " sigma points on " +
+                      std::to_string(elements_) + " tetrahedra need about " +
+                      std::to_string(estimate >> 20) + " MiB (largest buffer " +
+                      std::to_string(largest >> 20) + " MiB); " + info.name + " has " +
+                      std::to_string(info.global_memory >> 20) + " MiB (largest buffer " +
+                      std::to_string(info.max_allocation >> 20) +
+                      " MiB). Use fewer sigma points, a coarser mesh or another device");
+
+  // Shared data: elements, node incidence (a node's corners in element order: the gather
+  // order, hence the bits, is fixed), springs, mass, rest shape.
+  std::vector<int> element_nodes(4 * elements_);
+  std::vector<double> element_rest(16 * static_cast<std::size_t>(elements_), 0.0);
+  std::vector<int> incidence_offsets(nodes_ + 1, 0);
+  for (int e = 0; e < elements_; ++e) {
+    const ElementRest& element = model.elements[e];
+    for (int c = 0; c < 4; ++c) {
+      element_nodes[4 * e + c] = element.nodes[c];
+      ++incidence_offsets[element.nodes[c] + 1];
+    }
+    std::copy(element.grad.begin(), element.grad.end(), element_rest.begin() + 16 * e);
+    element_rest[16 * e + 12] = element.vlambda;
+    element_rest[16 * e + 13] = element.vmu;
+  }
+  for (int n = 0; n < nodes_; ++n) incidence_offsets[n + 1] += incidence_offsets[n];
+  std::vector<int> incidence(incidence_offsets[nodes_]);
+  std::vector<int> fill(incidence_offsets.begin(), incidence_offsets.end() - 1);
+  for (int e = 0; e < elements_; ++e)
+    for (int c = 0; c < 4; ++c) incidence[fill[element_nodes[4 * e + c]]++] = 4 * e + c;
+
+  const int L = static_cast<int>(model.ligaments.size());
+  std::vector<int> ligament_offsets(nodes_ + 1, 0);
+  for (const SpringSet& ligament : model.ligaments)
+    for (int node : ligament.nodes) ++ligament_offsets[node + 1];
+  for (int n = 0; n < nodes_; ++n) ligament_offsets[n + 1] += ligament_offsets[n];
+  std::vector<int> ligament_of_node(std::max(1, ligament_offsets[nodes_]));
+  fill.assign(ligament_offsets.begin(), ligament_offsets.end() - 1);
+  for (int l = 0; l < L; ++l)
+    for (int node : model.ligaments[l].nodes) ligament_of_node[fill[node]++] = l;
+  ligament_k_.assign(static_cast<std::size_t>(std::max(1, L)) * S_, 0.0);
+  for (int l = 0; l < L; ++l) {
+    const double per_node = model.ligaments[l].stiffness /
+                            static_cast<double>(model.ligaments[l].nodes.size());
+    for (int s = 0; s < S_; ++s) ligament_k_[static_cast<std::size_t>(l) * S_ + s] = per_node;
+  }
+  std::vector<double> control_k(nodes_, 0.0);
+  for (int node : model.control.nodes)
+    control_k[node] += model.control.stiffness / static_cast<double>(model.control.nodes.size());
+  std::vector<double> mass(model.mass.data(), model.mass.data() + nodes_);
+  std::vector<double> rest(3 * static_cast<std::size_t>(nodes_));
+  for (int n = 0; n < nodes_; ++n)
+    for (int k = 0; k < 3; ++k) rest[3 * n + k] = model.rest_positions[n][k];
+  std::vector<double> x0(dof);
+  for (std::size_t row = 0; row < 3 * static_cast<std::size_t>(nodes_); ++row)
+    for (int s = 0; s < S_; ++s) x0[row * S_ + s] = rest[row];
+
+  try {
+    element_nodes_ = make_buffer(element_nodes, "element nodes");
+    element_rest_ = make_buffer(element_rest, "element rest state");
+    incidence_offsets_ = make_buffer(incidence_offsets, "node incidence");
+    incidence_ = make_buffer(incidence, "node incidence");
+    ligament_offsets_ = make_buffer(ligament_offsets, "ligament nodes");
+    ligament_of_node_ = make_buffer(ligament_of_node, "ligament nodes");
+    control_k_ = make_buffer(control_k, "control springs");
+    mass_ = make_buffer(mass, "mass");
+    rest_positions_ = make_buffer(rest, "rest positions");
+    observed_nodes_ = make_buffer(observed_.empty() ? std::vector<int>{0} : observed_,
+                                  "observed nodes");
+    constants_ = make_buffer(kStepConstants, "step constants");
+    ligament_k_buffer_ = make_buffer(ligament_k_, "ligament stiffness");
+    x_ = make_buffer(x0, "positions");
+    const std::vector<double> zeros(dof, 0.0);
+    v_ = make_buffer(zeros, "velocities");
+    dv_ = make_buffer(zeros, "velocity change");
+    for (cl::Buffer* b : {&rhs_, &inverse_diagonal_, &r_, &z_, &d_, &q_})
+      *b = make_buffer(dof, "CG vectors");
+    frames_ = make_buffer(9 * per_element, "element frames");
+    element_out_ = make_buffer(12 * per_element, "element outputs");
+    element_diagonal_ = make_buffer(12 * per_element, "element diagonals");
+    observations_ = make_buffer(std::max<std::size_t>(1, observed_.size()) * 3 * S_, "observations");
+    for (cl::Buffer* b : {&bb_, &rr_, &rz_})
+      *b = make_buffer(static_cast<std::size_t>(S_), "CG scalars");
+    for (cl::Buffer* b : {&active_, &converged_, &iterations_})
+      *b = make_buffer(std::vector<int>(S_, 0), "CG flags");
+    all_active_ = make_buffer(std::vector<int>(S_, 1), "CG flags");
+    recenter_scalars_ = make_buffer(1 + kMaxParameters, "re-centring");
+    directions_ = make_buffer(static_cast<std::size_t>(kMaxParameters) * S_, "re-centring");
+    weights_ = make_buffer(static_cast<std::size_t>(kMaxParameters) * S_, "re-centring");
+
+    k_element_rhs_ = device_.kernel("element_rhs");
+    k_node_rhs_ = device_.kernel("node_rhs");
+    k_element_product_ = device_.kernel("element_product");
+    k_node_product_ = device_.kernel("node_product");
+    k_cg_start_ = device_.kernel("cg_start");
+    k_cg_iteration_ = device_.kernel("cg_iteration");
+    k_state_update_ = device_.kernel("state_update");
+    k_observation_gather_ = device_.kernel("observation_gather");
+    k_recenter_ = device_.kernel("recenter");
+
+    const cl_uint S = S_, E = elements_, N = nodes_, rows = 3 * nodes_;
+    set_args(k_element_rhs_, S, E, element_nodes_, element_rest_, frames_, x_, v_, constants_,
+             element_out_, element_diagonal_);
+    set_args(k_node_rhs_, S, N, constants_, incidence_offsets_, incidence_, ligament_offsets_,
+             ligament_of_node_, ligament_k_buffer_, control_k_, mass_, rest_positions_, x_, v_,
+             element_out_, element_diagonal_, rhs_, inverse_diagonal_);
+    set_args(k_element_product_, S, E, element_nodes_, element_rest_, frames_);
+    set_args(k_node_product_, S, N, constants_, incidence_offsets_, incidence_, ligament_offsets_,
+             ligament_of_node_, ligament_k_buffer_, control_k_, mass_);
+    set_args(k_cg_start_, S, N, constants_, incidence_offsets_, incidence_, ligament_offsets_,
+             ligament_of_node_, ligament_k_buffer_, control_k_, mass_, element_out_, rhs_,
+             inverse_diagonal_, dv_, r_, z_, d_, bb_, rr_, rz_, active_, converged_,
+             iterations_);
+    set_args(k_cg_iteration_, S, N, static_cast<cl_int>(model.solver.cg_max_iterations),
+             constants_, incidence_offsets_, incidence_, ligament_offsets_, ligament_of_node_,
+             ligament_k_buffer_, control_k_, mass_, element_out_, inverse_diagonal_, dv_, r_, z_,
+             d_, q_, bb_, rr_, rz_, active_, converged_, iterations_);
+    set_args(k_state_update_, S, rows, constants_, bb_, dv_, x_, v_);
+    set_args(k_observation_gather_, S, static_cast<cl_uint>(observed_.size()), observed_nodes_,
+             x_, observations_);
+    set_args(k_recenter_, S, rows, static_cast<cl_uint>(estimated_.size()), recenter_scalars_,
+             directions_, weights_, x_, v_);
+    device_.queue().finish();
+  } catch (const cl::Error& error) {
+    throw opencl_failure("setting up the OpenCL ensemble", error);
+  }
+}
+
+cl::Buffer OpenClEnsemble::make_buffer(std::size_t count, const char* what) {
+  try {
+    const std::size_t bytes = std::max<std::size_t>(1, count) * device_.real_size();
+    device_bytes_ += bytes;
+    return cl::Buffer(device_.context(), CL_MEM_READ_WRITE, bytes);
+  } catch (const cl::Error& error) {
+    throw opencl_failure(std::string("allocating ") + what, error);
+  }
+}
+
+cl::Buffer OpenClEnsemble::make_buffer(const std::vector<double>& values, const char* what) {
+  cl::Buffer buffer = make_buffer(values.size(), what);
+  write(buffer, values);
+  return buffer;
+}
+
+cl::Buffer OpenClEnsemble::make_buffer(const std::vector<int>& values, const char* what) {
+  try {
+    const std::size_t bytes = values.size() * sizeof(cl_int);
+    device_bytes_ += bytes;
+    cl::Buffer buffer(device_.context(), CL_MEM_READ_WRITE, bytes);
+    device_.queue().enqueueWriteBuffer(buffer, CL_TRUE, 0, bytes, values.data());
+    return buffer;
+  } catch (const cl::Error& error) {
+    throw opencl_failure(std::string("allocating ") + what, error);
+  }
+}
+
+void OpenClEnsemble::write(const cl::Buffer& buffer, const std::vector<double>& values) const {
+  if (values.empty()) return;
+  if (device_.precision() == Precision::single) {
+    const std::vector<float> converted(values.begin(), values.end());
+    device_.queue().enqueueWriteBuffer(buffer, CL_TRUE, 0, converted.size() * sizeof(float),
+                                       converted.data());
+  } else {
+    device_.queue().enqueueWriteBuffer(buffer, CL_TRUE, 0, values.size() * sizeof(double),
+                                       values.data());
+  }
+}
+
+std::vector<double> OpenClEnsemble::read(const cl::Buffer& buffer, std::size_t count) const {
+  if (device_.precision() == Precision::single) {
+    std::vector<float> values(count);
+    device_.queue().enqueueReadBuffer(buffer, CL_TRUE, 0, count * sizeof(float), values.data());
+    return std::vector<double>(values.begin(), values.end());
+  }
+  std::vector<double> values(count);
+  device_.queue().enqueueReadBuffer(buffer, CL_TRUE, 0, count * sizeof(double), values.data());
+  return values;
+}
+
+std::vector<double> OpenClEnsemble::sigma_column(const cl::Buffer& buffer, std::size_t rows,
+                                                 int s) const {
+  if (s < 0 || s >= S_) throw std::out_of_range("OpenClEnsemble: no sigma point " + std::to_string(s));
+  const std::vector<double> all = read(buffer, rows * S_);
+  std::vector<double> column(rows);
+  for (std::size_t row = 0; row < rows; ++row) column[row] = all[row * S_ + s];
+  return column;
+}
+
+void OpenClEnsemble::set_parameters(const Eigen::MatrixXd& theta) {
+  if (theta.rows() != parameter_count() || theta.cols() != sigma_count())
+    throw std::invalid_argument("OpenClEnsemble::set_parameters: expected a " +
+                                std::to_string(parameter_count()) + " x " +
+                                std::to_string(sigma_count()) + " matrix");
+  for (int j = 0; j < parameter_count(); ++j) {
+    const int l = estimated_[j];
+    const double nodes = static_cast<double>(model_.ligaments[l].nodes.size());
+    for (int s = 0; s < S_; ++s)
+      ligament_k_[static_cast<std::size_t>(l) * S_ + s] = std::exp(theta(j, s)) / nodes;
+  }
+  write(ligament_k_buffer_, ligament_k_);
+}
+
+void OpenClEnsemble::write_step_constants(const Eigen::Vector3d& so_position) {
+  const Model& m = model_;
+  const double h = m.dt, a = m.damping.rayleigh_stiffness, b = m.damping.rayleigh_mass;
+  const Eigen::Vector3d shift = so_position - m.control_start;
+  write(constants_, {h, 1.0 + h * b, h * (h + a), b, h + a, m.gravity.x(), m.gravity.y(),
+                     m.gravity.z(), shift.x(), shift.y(), shift.z(), tolerance_ * tolerance_});
+}
+
+void OpenClEnsemble::run(cl::Kernel& kernel, std::size_t items, std::size_t local) const {
+  const std::size_t group = local > 0 ? local : kGroup;
+  device_.queue().enqueueNDRangeKernel(kernel, cl::NullRange,
+                                       cl::NDRange(round_up(items, group)), cl::NDRange(group));
+}
+
+void OpenClEnsemble::element_rhs() { run(k_element_rhs_, static_cast<std::size_t>(elements_) * S_); }
+
+void OpenClEnsemble::node_rhs() { run(k_node_rhs_, static_cast<std::size_t>(nodes_) * S_); }
+
+void OpenClEnsemble::element_product(const cl::Buffer& d, const cl::Buffer& active) {
+  k_element_product_.setArg(5, d);
+  k_element_product_.setArg(6, active);
+  k_element_product_.setArg(7, element_out_);
+  run(k_element_product_, static_cast<std::size_t>(elements_) * S_);
+}
+
+void OpenClEnsemble::node_product(const cl::Buffer& d, const cl::Buffer& q) {
+  k_node_product_.setArg(10, d);
+  k_node_product_.setArg(11, element_out_);
+  k_node_product_.setArg(12, q);
+  run(k_node_product_, static_cast<std::size_t>(nodes_) * S_);
+}
+
+void OpenClEnsemble::conjugate_gradient() {
+  // The warm start's residual (dv holds the last step's velocity change).
+  element_product(dv_, all_active_);
+  run(k_cg_start_, kGroup * S_, kGroup);
+  // Iterate, checking on the host only now and then: first after as many iterations as the
+  // last step needed (warm-started steps need about the same), then in small batches. A
+  // sigma point that is done is left alone by the kernels, so overshooting changes nothing.
+  const int cap = model_.solver.cg_max_iterations;
+  int batch = std::max(1, expected_iterations_);
+  std::vector<cl_uint> active(S_);
+  for (int done = 0; done < cap;) {
+    const int count = std::min(batch, cap - done);
+    for (int i = 0; i < count; ++i) {
+      element_product(d_, active_);
+      run(k_cg_iteration_, kGroup * S_, kGroup);
+    }
+    done += count;
+    device_.queue().enqueueReadBuffer(active_, CL_TRUE, 0, S_ * sizeof(cl_uint), active.data());
+    if (std::none_of(active.begin(), active.end(), [](cl_uint a) { return a != 0; })) break;
+    batch = std::max(2, expected_iterations_ / 8);
+  }
+}
+
+StepReport OpenClEnsemble::advance(const Eigen::Vector3d& so_position) {
+  const std::size_t dof = 3 * static_cast<std::size_t>(nodes_) * S_;
+  StepReport report;
+  try {
+    write_step_constants(so_position);
+    element_rhs();
+    node_rhs();
+    conjugate_gradient();
+    run(k_state_update_, dof);
+    std::vector<cl_int> iterations(S_);
+    std::vector<cl_uint> converged(S_);
+    device_.queue().enqueueReadBuffer(iterations_, CL_FALSE, 0, S_ * sizeof(cl_int),
+                                      iterations.data());
+    device_.queue().enqueueReadBuffer(converged_, CL_FALSE, 0, S_ * sizeof(cl_uint),
+                                      converged.data());
+    const std::vector<double> rr = read(rr_, S_);
+    const std::vector<double> bb = read(bb_, S_);
+    report.cg_iterations.assign(iterations.begin(), iterations.end());
+    report.converged.assign(converged.begin(), converged.end());
+    report.relative_residual.resize(S_);
+    for (int s = 0; s < S_; ++s)
+      report.relative_residual[s] = bb[s] > 0.0 ? std::sqrt(rr[s] / bb[s]) : 0.0;
+    expected_iterations_ = *std::max_element(iterations.begin(), iterations.end());
+  } catch (const cl::Error& error) {
+    throw opencl_failure("advancing the OpenCL ensemble", error);
+  }
+  return report;
+}
+
+void OpenClEnsemble::predicted_observations(Eigen::MatrixXd& y) const {
+  const std::size_t rows = observed_.size() * 3;
+  y.resize(static_cast<Eigen::Index>(rows), S_);
+  if (rows == 0) return;
+  try {
+    run(k_observation_gather_, rows * S_);
+    const std::vector<double> values = read(observations_, rows * S_);
+    for (std::size_t row = 0; row < rows; ++row)
+      for (int s = 0; s < S_; ++s) y(static_cast<Eigen::Index>(row), s) = values[row * S_ + s];
+  } catch (const cl::Error& error) {
+    throw opencl_failure("reading the observations", error);
+  }
+}
+
+void OpenClEnsemble::recenter(const Recentering& r) {
+  const int p = parameter_count();
+  if (r.directions.rows() != p || r.directions.cols() != S_ || r.correction.size() != p ||
+      r.factor.rows() != p || r.factor.cols() != p)
+    throw std::invalid_argument("OpenClEnsemble::recenter: sizes do not match the ensemble");
+  const Eigen::MatrixXd weights = r.factor * r.directions;   // W = C I
+  std::vector<double> scalars(1 + kMaxParameters, 0.0), directions(p * S_), w(p * S_);
+  scalars[0] = r.alpha;
+  for (int j = 0; j < p; ++j) {
+    scalars[1 + j] = r.correction[j];
+    for (int s = 0; s < S_; ++s) {
+      directions[j * S_ + s] = r.directions(j, s);
+      w[j * S_ + s] = weights(j, s);
+    }
+  }
+  try {
+    write(recenter_scalars_, scalars);
+    write(directions_, directions);
+    write(weights_, w);
+    run(k_recenter_, 3 * static_cast<std::size_t>(nodes_));
+  } catch (const cl::Error& error) {
+    throw opencl_failure("re-centring the OpenCL ensemble", error);
+  }
+}
+
+Eigen::VectorXd OpenClEnsemble::positions(int s) const {
+  const std::vector<double> column = sigma_column(x_, 3 * static_cast<std::size_t>(nodes_), s);
+  return Eigen::Map<const Eigen::VectorXd>(column.data(), static_cast<Eigen::Index>(column.size()));
+}
+
+Eigen::VectorXd OpenClEnsemble::velocities(int s) const {
+  const std::vector<double> column = sigma_column(v_, 3 * static_cast<std::size_t>(nodes_), s);
+  return Eigen::Map<const Eigen::VectorXd>(column.data(), static_cast<Eigen::Index>(column.size()));
+}
+
+std::vector<double> OpenClEnsemble::frames(int s) const {
+  return sigma_column(frames_, 9 * static_cast<std::size_t>(elements_), s);
+}
+
+Eigen::MatrixXd OpenClEnsemble::system_product(const Eigen::MatrixXd& d) {
+  const std::size_t rows = 3 * static_cast<std::size_t>(nodes_);
+  if (static_cast<std::size_t>(d.rows()) != rows || d.cols() != S_)
+    throw std::invalid_argument("OpenClEnsemble::system_product: expected 3N x S");
+  std::vector<double> values(rows * S_);
+  for (std::size_t row = 0; row < rows; ++row)
+    for (int s = 0; s < S_; ++s) values[row * S_ + s] = d(static_cast<Eigen::Index>(row), s);
+  Eigen::MatrixXd y(d.rows(), d.cols());
+  try {
+    write(d_, values);
+    element_product(d_, all_active_);
+    node_product(d_, q_);
+    const std::vector<double> q = read(q_, rows * S_);
+    for (std::size_t row = 0; row < rows; ++row)
+      for (int s = 0; s < S_; ++s) y(static_cast<Eigen::Index>(row), s) = q[row * S_ + s];
+  } catch (const cl::Error& error) {
+    throw opencl_failure("the system product", error);
+  }
+  return y;
+}
+
+std::string OpenClEnsemble::description() const {
+  return std::string("opencl ") +
+         (device_.precision() == Precision::single ? "single" : "double") + " on " +
+         device_.info().name;
+}
+
+}  // namespace sigmafem

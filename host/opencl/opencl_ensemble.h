@@ -1,0 +1,96 @@
+// OpenClEnsemble: the Ensemble (filter/ensemble.h) with all S sigma-point simulations
+// advancing together in OpenCL kernels (kernels/opencl/, one file per step, named as the
+// methods below that enqueue them). The state of every sigma point stays on the device; per
+// filter step only the S parameter vectors go down and the observed positions (3m x S) and
+// the solver report come back. Layout and assembly: kernels/opencl/ensemble_layout.h.
+//
+// Arithmetic is float32 by default. float32 cannot reach the scenario's CG tolerance (1e-10
+// is far below its rounding), so in single precision the tolerance is raised to
+// kSingleTolerance; double precision keeps the scenario's and agrees with the CPU reference
+// to about 1e-10 (tests/opencl/).
+#pragma once
+
+#include <Eigen/Core>
+#include <vector>
+
+#include "host/ensemble/device_ensemble.h"
+#include "host/model/model.h"
+#include "host/opencl/opencl_device.h"
+
+namespace sigmafem {
+
+class OpenClEnsemble : public DeviceEnsemble {
+ public:
+  // The CG tolerance floor in single precision: about ten float32 epsilons.
+  static constexpr double kSingleTolerance = 1e-6;
+
+  // `estimated`: indices into model.ligaments whose log-stiffness the parameters are;
+  // `observed`: node indices. Throws DeviceError (no device, build failure, too little memory).
+  OpenClEnsemble(const Model& model, std::vector<int> estimated, std::vector<int> observed,
+                 int sigma_count, const DeviceOptions& options);
+
+  int sigma_count() const override { return S_; }
+  int parameter_count() const override { return static_cast<int>(estimated_.size()); }
+  int observation_count() const override { return 3 * static_cast<int>(observed_.size()); }
+  void set_parameters(const Eigen::MatrixXd& theta) override;
+  StepReport advance(const Eigen::Vector3d& so_position) override;
+  void predicted_observations(Eigen::MatrixXd& y) const override;
+  void recenter(const Recentering& recentering) override;
+
+  // DeviceEnsemble's read-outs (tests, VTK output).
+  Eigen::VectorXd positions(int s) const override;
+  Eigen::VectorXd velocities(int s) const override;
+  std::vector<double> frames(int s) const override;
+  Eigen::MatrixXd system_product(const Eigen::MatrixXd& d) override;
+  double cg_tolerance() const override { return tolerance_; }
+  std::string description() const override;
+  const OpenClDeviceInfo& device_info() const { return device_.info(); }
+  // Bytes of device memory the ensemble holds.
+  std::size_t device_bytes() const { return device_bytes_; }
+
+ private:
+  cl::Buffer make_buffer(std::size_t count, const char* what);
+  cl::Buffer make_buffer(const std::vector<double>& values, const char* what);
+  cl::Buffer make_buffer(const std::vector<int>& values, const char* what);
+  void write(const cl::Buffer& buffer, const std::vector<double>& values) const;
+  std::vector<double> read(const cl::Buffer& buffer, std::size_t count) const;
+  std::vector<double> sigma_column(const cl::Buffer& buffer, std::size_t rows, int s) const;
+  void write_step_constants(const Eigen::Vector3d& so_position);
+
+  // Enqueue the kernels of one step (kernels/opencl/<file>.cl holds the kernel of the same
+  // name; conjugate_gradient() enqueues cg_start and cg_iteration).
+  void element_rhs();
+  void node_rhs();
+  void element_product(const cl::Buffer& d, const cl::Buffer& active);
+  void node_product(const cl::Buffer& d, const cl::Buffer& q);
+  void conjugate_gradient();
+  void run(cl::Kernel& kernel, std::size_t items, std::size_t local = 0) const;
+
+  mutable OpenClDevice device_;
+  Model model_;                             // a copy: the ensemble outlives its caller's model
+  std::vector<int> estimated_, observed_;
+  int S_ = 0, nodes_ = 0, elements_ = 0;
+  double tolerance_ = 0.0;
+  std::size_t device_bytes_ = 0;
+  std::vector<double> ligament_k_;          // per ligament and sigma, N/m per node: [l * S + s]
+  int expected_iterations_ = 1;             // CG iterations the last step needed (at most)
+
+  // Shared data.
+  cl::Buffer element_nodes_, element_rest_, incidence_offsets_, incidence_;
+  cl::Buffer ligament_offsets_, ligament_of_node_, control_k_, mass_, rest_positions_;
+  cl::Buffer observed_nodes_, constants_;
+  // Per-sigma data.
+  cl::Buffer ligament_k_buffer_, x_, v_, dv_, rhs_, inverse_diagonal_, r_, z_, d_, q_;
+  cl::Buffer frames_, element_out_, element_diagonal_, observations_;
+  // Per-sigma CG scalars; all_active_ holds S ones (products outside CG).
+  cl::Buffer bb_, rr_, rz_, active_, converged_, iterations_, all_active_;
+  // Re-centring inputs.
+  cl::Buffer recenter_scalars_, directions_, weights_;
+
+  // Mutable: enqueueing a kernel (also from the const read-outs) changes no visible state.
+  mutable cl::Kernel k_element_rhs_, k_node_rhs_, k_element_product_, k_node_product_;
+  mutable cl::Kernel k_cg_start_, k_cg_iteration_, k_state_update_, k_observation_gather_;
+  mutable cl::Kernel k_recenter_;
+};
+
+}  // namespace sigmafem

@@ -1,0 +1,38 @@
+/* element_rhs: the rotation step and each element's part of the implicit Euler right-hand
+ * side and of the Jacobi diagonal, per sigma point, in one pass over the elements (host:
+ * element_frames, ImplicitEulerSystem::right_hand_side and ::diagonal):
+ *   frame  = the element's QR frame at x   (stored: every CG product of the step uses it)
+ *   rhs_e  = f_e(x) - (h + a) K_e v_e      (elastic force and the stiffness-damping product)
+ *   diag_e = diag(R K_e R^T)
+ * The node kernel (node_assembly.cl) sums them over the incident elements and adds the
+ * nodal terms (mass, springs, gravity). */
+#include "ensemble_layout.h"
+
+__kernel void element_rhs(uint S, uint element_count, __global const int* nodes,
+                          __global const real* rest, __global real* frames,
+                          __global const real* x, __global const real* v,
+                          __global const real* c, __global real* rhs_out,
+                          __global real* diagonal_out) {
+  size_t gid = get_global_id(0);
+  if (gid >= (size_t)element_count * S) return;
+  uint s = (uint)(gid % S);
+  uint e = (uint)(gid / S);
+  real grad[12];
+  real vlambda;
+  real vmu;
+  real frame[9];
+  real corner[12];
+  real force[12];
+  real product[12];
+  sf_load_rest(rest, e, grad, &vlambda, &vmu);
+  sf_gather_corners(x, nodes, e, s, S, corner);
+  sf_element_frame(corner, frame);
+  for (int i = 0; i < 9; ++i) frames[((size_t)9 * e + i) * S + s] = frame[i];
+  sf_element_force(frame, grad, vlambda, vmu, corner, force);
+  sf_gather_corners(v, nodes, e, s, S, corner);
+  sf_element_product(frame, grad, vlambda, vmu, corner, product);
+  for (int i = 0; i < 12; ++i) force[i] -= c[SF_VELOCITY_FACTOR] * product[i];
+  sf_store_corners(rhs_out, e, s, S, force);
+  sf_element_diagonal(frame, grad, vlambda, vmu, product);
+  sf_store_corners(diagonal_out, e, s, S, product);
+}

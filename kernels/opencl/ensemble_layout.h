@@ -1,0 +1,65 @@
+/* ensemble_layout.h: how the OpenCL ensemble lays out its arrays (ARCHITECTURE.md, "The
+ * ensemble on a device"). Every per-sigma array has the sigma index innermost, so that
+ * neighbouring work-items (neighbouring sigma points) read neighbouring addresses:
+ *   per-dof     x[(3 * node + axis) * S + s]
+ *   per-element frames[(9 * e + i) * S + s],  corner outputs [(12 * e + i) * S + s]
+ * Shared data (rest shape, element rest state, mass) is stored once for all sigma points.
+ * Work-items of the element and node kernels are flattened: gid = item * S + s. */
+#ifndef SIGMAFEM_ENSEMBLE_LAYOUT_H
+#define SIGMAFEM_ENSEMBLE_LAYOUT_H
+
+#ifdef SF_USE_DOUBLE
+#  pragma OPENCL EXTENSION cl_khr_fp64 : enable
+#  define SF_REAL double
+#endif
+
+#include "element.h"
+
+typedef SF_REAL real;
+
+/* The implicit Euler constants of a step, in a small buffer the host writes each step
+ * (a buffer, not a struct argument, so that host and device never disagree on padding). */
+#define SF_H 0                 /* time step h */
+#define SF_MASS_FACTOR 1       /* 1 + h b */
+#define SF_STIFFNESS_FACTOR 2  /* h (h + a) */
+#define SF_RAYLEIGH_MASS 3     /* b */
+#define SF_VELOCITY_FACTOR 4   /* h + a */
+#define SF_GRAVITY 5           /* 3 numbers */
+#define SF_SO_SHIFT 8          /* 3 numbers: so(t_{n+1}) - so(0), the control target shift */
+#define SF_CG_TOLERANCE2 11   /* squared relative CG tolerance */
+#define SF_STEP_CONSTANTS 12
+
+/* The element rest state, 16 numbers per element: grad[12], vlambda, vmu, two unused. */
+#define SF_REST_STRIDE 16
+
+/* Loads the 15 rest numbers of element e (element.h's grad, vlambda, vmu). */
+static inline void sf_load_rest(__global const real* rest, uint e, real grad[12],
+                                real* vlambda, real* vmu) {
+  __global const real* r = rest + (size_t)e * SF_REST_STRIDE;
+  for (int i = 0; i < 12; ++i) grad[i] = r[i];
+  *vlambda = r[12];
+  *vmu = r[13];
+}
+
+/* Gathers a per-dof array's values at element e's four corners for sigma point s. */
+static inline void sf_gather_corners(__global const real* v, __global const int* nodes,
+                                     uint e, uint s, uint S, real out[12]) {
+  for (int c = 0; c < 4; ++c) {
+    size_t base = (size_t)(3 * nodes[4 * e + c]) * S + s;
+    for (int k = 0; k < 3; ++k) out[3 * c + k] = v[base + (size_t)k * S];
+  }
+}
+
+/* Loads element e's frame for sigma point s. */
+static inline void sf_load_frame(__global const real* frames, uint e, uint s, uint S,
+                                 real frame[9]) {
+  for (int i = 0; i < 9; ++i) frame[i] = frames[((size_t)9 * e + i) * S + s];
+}
+
+/* Stores 12 corner values of element e for sigma point s. */
+static inline void sf_store_corners(__global real* out, uint e, uint s, uint S,
+                                    const real values[12]) {
+  for (int i = 0; i < 12; ++i) out[((size_t)12 * e + i) * S + s] = values[i];
+}
+
+#endif /* SIGMAFEM_ENSEMBLE_LAYOUT_H */
