@@ -11,8 +11,11 @@ cd "$(dirname "$0")"
 mode=${1:-run}
 case "$mode" in run|test) ;; *) echo "usage: ./setup.sh run|test" >&2; exit 2 ;; esac
 
+# OpenCL: the ICD loader and C++ headers to build; PoCL runs the kernels on any CPU (a GPU
+# vendor's driver, where there is one, is picked up by the same loader).
 packages="g++ cmake ninja-build pkg-config libeigen3-dev nlohmann-json3-dev libcli11-dev
-          libgtest-dev libbenchmark-dev gnuplot-nox"
+          libgtest-dev libbenchmark-dev gnuplot-nox
+          ocl-icd-opencl-dev opencl-clhpp-headers pocl-opencl-icd"
 missing=""
 for p in $packages; do
   dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q 'ok installed' || missing="$missing $p"

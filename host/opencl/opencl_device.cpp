@@ -1,5 +1,7 @@
 #include "host/opencl/opencl_device.h"
 
+#include <cstdlib>
+#include <iostream>
 #include <sstream>
 
 namespace sigmafem {
@@ -79,17 +81,22 @@ OpenClDevice::OpenClDevice(int index, Precision precision) : precision_(precisio
                       ") has no double precision (cl_khr_fp64); use --precision single");
   try {
     context_ = cl::Context(device_);
-    queue_ = cl::CommandQueue(context_, device_);
-    program_ = cl::Program(context_, std::string(kOpenClKernelSource));
+    profiling_ = std::getenv("SIGMAFEM_OPENCL_PROFILE") != nullptr;
+    queue_ = cl::CommandQueue(context_, device_, profiling_ ? CL_QUEUE_PROFILING_ENABLE : 0);
   } catch (const cl::Error& error) {
     throw opencl_failure("setting up OpenCL device " + std::to_string(index), error);
   }
-  const std::string options = precision == Precision::double_precision
-                                  ? "-cl-std=CL1.2 -DSF_USE_DOUBLE"
-                                  : "-cl-std=CL1.2";
+}
+
+void OpenClDevice::build_program(const std::string& defines) {
+  const std::string options = std::string("-cl-std=CL1.2") +
+                              (precision_ == Precision::double_precision ? " -DSF_USE_DOUBLE" : "") +
+                              (defines.empty() ? "" : " " + defines);
   try {
+    program_ = cl::Program(context_, std::string(kOpenClKernelSource));
     program_.build({device_}, options.c_str());
-  } catch (const cl::Error&) {
+  } catch (const cl::Error& error) {
+    if (error.err() != CL_BUILD_PROGRAM_FAILURE) throw opencl_failure("building the kernels", error);
     std::string log;
     try {
       log = program_.getBuildInfo<CL_PROGRAM_BUILD_LOG>(device_);
@@ -135,6 +142,25 @@ DeviceError opencl_failure(const std::string& what, const cl::Error& error) {
       error.err() == CL_OUT_OF_HOST_MEMORY || error.err() == CL_INVALID_BUFFER_SIZE)
     message << " (out of device memory: use fewer sigma points, a coarser mesh or another device)";
   return DeviceError(message.str());
+}
+
+void OpenClDevice::record(const cl::Kernel& kernel, const cl::Event& event) {
+  if (!profiling_) return;
+  event.wait();
+  const double ns = static_cast<double>(event.getProfilingInfo<CL_PROFILING_COMMAND_END>() -
+                                        event.getProfilingInfo<CL_PROFILING_COMMAND_START>());
+  KernelTime& time = profile_[kernel.getInfo<CL_KERNEL_FUNCTION_NAME>()];
+  time.seconds += 1e-9 * ns;
+  ++time.launches;
+}
+
+OpenClDevice::~OpenClDevice() {
+  if (!profiling_ || profile_.empty()) return;
+  std::cerr << "OpenCL kernel times on " << info_.name << " (SIGMAFEM_OPENCL_PROFILE):\n";
+  for (const auto& [name, time] : profile_)
+    std::cerr << "  " << name << ": " << time.launches << " launches, " << time.seconds
+              << " s, " << 1e6 * time.seconds / static_cast<double>(time.launches)
+              << " us each\n";
 }
 
 }  // namespace sigmafem

@@ -10,6 +10,7 @@
 #define CL_HPP_ENABLE_EXCEPTIONS
 #include <CL/opencl.hpp>
 
+#include <map>
 #include <string>
 #include <vector>
 
@@ -36,16 +37,24 @@ std::vector<OpenClDeviceInfo> list_opencl_devices();
 // A device with its context, queue and the ensemble's program.
 class OpenClDevice {
  public:
-  // Throws DeviceError: no platform, no device `index`, no fp64 for double precision, or a
-  // program that fails to build (the message holds the build log).
+  // Throws DeviceError: no platform, no device `index`, or no fp64 for double precision.
   OpenClDevice(int index, Precision precision);
+  ~OpenClDevice();
+  OpenClDevice(const OpenClDevice&) = delete;
+  OpenClDevice& operator=(const OpenClDevice&) = delete;
 
   const OpenClDeviceInfo& info() const { return info_; }
   Precision precision() const { return precision_; }
   std::size_t real_size() const { return precision_ == Precision::single ? 4 : 8; }
   cl::Context& context() { return context_; }
   cl::CommandQueue& queue() { return queue_; }
+  // Builds the embedded kernels with these extra -D options (once, before kernel()).
+  // Throws DeviceError with the build log when they fail to build.
+  void build_program(const std::string& defines);
   cl::Kernel kernel(const char* name) const;
+  // With SIGMAFEM_OPENCL_PROFILE set, adds the kernel's device time (waiting for it) to a
+  // table printed on stderr when the device is released: where the time goes.
+  void record(const cl::Kernel& kernel, const cl::Event& event);
 
  private:
   OpenClDeviceInfo info_;
@@ -54,6 +63,12 @@ class OpenClDevice {
   cl::Context context_;
   cl::CommandQueue queue_;
   cl::Program program_;
+  struct KernelTime {
+    double seconds = 0.0;
+    long long launches = 0;
+  };
+  bool profiling_ = false;
+  std::map<std::string, KernelTime> profile_;
 };
 
 // The name of an OpenCL error code ("CL_OUT_OF_RESOURCES"), for messages.

@@ -112,6 +112,11 @@ OpenClEnsemble::OpenClEnsemble(const Model& model, std::vector<int> estimated,
   for (std::size_t row = 0; row < 3 * static_cast<std::size_t>(nodes_); ++row)
     for (int s = 0; s < S_; ++s) x0[row * S_ + s] = rest[row];
 
+  // Element kernels: on a CPU device one work-item takes an element for all S sigma points,
+  // so the compiler vectorises over them; elsewhere one work-item per (element, sigma).
+  sigma_block_ = info.type == "cpu" ? S_ : 1;
+  device_.build_program("-DSF_SIGMA_BLOCK=" + std::to_string(sigma_block_));
+
   try {
     element_nodes_ = make_buffer(element_nodes, "element nodes");
     element_rest_ = make_buffer(element_rest, "element rest state");
@@ -169,9 +174,8 @@ OpenClEnsemble::OpenClEnsemble(const Model& model, std::vector<int> estimated,
              inverse_diagonal_, dv_, r_, z_, d_, bb_, rr_, rz_, active_, converged_,
              iterations_);
     set_args(k_cg_iteration_, S, N, static_cast<cl_int>(model.solver.cg_max_iterations),
-             constants_, incidence_offsets_, incidence_, ligament_offsets_, ligament_of_node_,
-             ligament_k_buffer_, control_k_, mass_, element_out_, inverse_diagonal_, dv_, r_, z_,
-             d_, q_, bb_, rr_, rz_, active_, converged_, iterations_);
+             constants_, inverse_diagonal_, dv_, r_, z_, d_, q_, bb_, rr_, rz_, active_,
+             converged_, iterations_);
     set_args(k_state_update_, S, rows, constants_, bb_, dv_, x_, v_);
     set_args(k_observation_gather_, S, static_cast<cl_uint>(observed_.size()), observed_nodes_,
              x_, observations_);
@@ -267,11 +271,17 @@ void OpenClEnsemble::write_step_constants(const Eigen::Vector3d& so_position) {
 
 void OpenClEnsemble::run(cl::Kernel& kernel, std::size_t items, std::size_t local) const {
   const std::size_t group = local > 0 ? local : kGroup;
-  device_.queue().enqueueNDRangeKernel(kernel, cl::NullRange,
-                                       cl::NDRange(round_up(items, group)), cl::NDRange(group));
+  cl::Event event;
+  device_.queue().enqueueNDRangeKernel(kernel, cl::NullRange, cl::NDRange(round_up(items, group)),
+                                       cl::NDRange(group), nullptr, &event);
+  device_.record(kernel, event);
 }
 
-void OpenClEnsemble::element_rhs() { run(k_element_rhs_, static_cast<std::size_t>(elements_) * S_); }
+std::size_t OpenClEnsemble::element_items() const {
+  return static_cast<std::size_t>(elements_) * (S_ / sigma_block_);
+}
+
+void OpenClEnsemble::element_rhs() { run(k_element_rhs_, element_items()); }
 
 void OpenClEnsemble::node_rhs() { run(k_node_rhs_, static_cast<std::size_t>(nodes_) * S_); }
 
@@ -279,14 +289,14 @@ void OpenClEnsemble::element_product(const cl::Buffer& d, const cl::Buffer& acti
   k_element_product_.setArg(5, d);
   k_element_product_.setArg(6, active);
   k_element_product_.setArg(7, element_out_);
-  run(k_element_product_, static_cast<std::size_t>(elements_) * S_);
+  run(k_element_product_, element_items());
 }
 
 void OpenClEnsemble::node_product(const cl::Buffer& d, const cl::Buffer& q) {
   k_node_product_.setArg(10, d);
   k_node_product_.setArg(11, element_out_);
   k_node_product_.setArg(12, q);
-  run(k_node_product_, static_cast<std::size_t>(nodes_) * S_);
+  run(k_node_product_, static_cast<std::size_t>(nodes_) * (S_ / sigma_block_));
 }
 
 void OpenClEnsemble::conjugate_gradient() {
@@ -303,6 +313,7 @@ void OpenClEnsemble::conjugate_gradient() {
     const int count = std::min(batch, cap - done);
     for (int i = 0; i < count; ++i) {
       element_product(d_, active_);
+      node_product(d_, q_);
       run(k_cg_iteration_, kGroup * S_, kGroup);
     }
     done += count;

@@ -59,6 +59,7 @@ class OpenClEnsemble : public DeviceEnsemble {
 
   // Enqueue the kernels of one step (kernels/opencl/<file>.cl holds the kernel of the same
   // name; conjugate_gradient() enqueues cg_start and cg_iteration).
+  std::size_t element_items() const;   // work-items of the element kernels
   void element_rhs();
   void node_rhs();
   void element_product(const cl::Buffer& d, const cl::Buffer& active);
@@ -73,6 +74,7 @@ class OpenClEnsemble : public DeviceEnsemble {
   double tolerance_ = 0.0;
   std::size_t device_bytes_ = 0;
   std::vector<double> ligament_k_;          // per ligament and sigma, N/m per node: [l * S + s]
+  int sigma_block_ = 1;                     // SF_SIGMA_BLOCK: sigma points per element work-item
   int expected_iterations_ = 1;             // CG iterations the last step needed (at most)
 
   // Shared data.

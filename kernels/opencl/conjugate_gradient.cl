@@ -2,11 +2,11 @@
  * scalars and a per-sigma convergence flag (host: host/reference/conjugate_gradient.h, the
  * same stopping rule |r| <= tolerance |b|).
  *
- * One work-group per sigma point owns every row of that sigma point, so a whole CG iteration
- * after the element products is one kernel: the product's node gather with d.q, the update
- * with r.r and r.z, the convergence test and the new direction, with the dot products
- * reduced inside the group (a fixed tree: the same bits every run) and no host round trip.
- * Per iteration the host enqueues two kernels (element_product, cg_iteration).
+ * One work-group per sigma point owns every row of that sigma point, so the rest of a CG
+ * iteration after the product q = A d is one kernel: d.q, the update with r.r and r.z, the
+ * convergence test and the new direction, with the dot products reduced inside the group
+ * (a fixed tree: the same bits every run) and no host round trip. Per iteration the host
+ * enqueues three kernels (element_product, node_product, cg_iteration).
  *
  * A sigma point that has converged (or hit the iteration cap, or broke down) is inactive and
  * its group returns at once, so the host may enqueue several iterations between checks
@@ -56,6 +56,7 @@ void cg_start(uint S, uint node_count, __global const real* c,
   for (uint n = get_local_id(0); n < node_count; n += SF_GROUP_SIZE) {
     real spring = sf_node_spring(ligament_offsets, ligament_of_node, ligament_k, control_k, n, s, S);
     real m = sf_solver_mass(mass[n], spring);
+    SF_UNROLL
     for (int k = 0; k < 3; ++k) {
       size_t row = ((size_t)3 * n + k) * S + s;
       real q = sf_system_row(c, element_out, incidence_offsets, incidence, spring, m, x, n, k, s, S);
@@ -84,18 +85,14 @@ void cg_start(uint S, uint node_count, __global const real* c,
   }
 }
 
-/* One CG iteration of one sigma point, the element products of d being in element_out:
- * q = A d, alpha = rz / d.q, x += alpha d, r -= alpha q, z = M^-1 r, then the convergence
+/* One CG iteration of one sigma point, given q = A d (node_product): alpha = rz / d.q, x += alpha d, r -= alpha q, z = M^-1 r, then the convergence
  * test (|r|^2 <= tol^2 |b|^2), the cap, breakdown (a residual that is not finite: the matrix
  * is not SPD or the input held a NaN), and d = z + beta d. */
 __kernel __attribute__((reqd_work_group_size(SF_GROUP_SIZE, 1, 1)))
 void cg_iteration(uint S, uint node_count, int max_iterations, __global const real* c,
-                  __global const int* incidence_offsets, __global const int* incidence,
-                  __global const int* ligament_offsets, __global const int* ligament_of_node,
-                  __global const real* ligament_k, __global const real* control_k,
-                  __global const real* mass, __global const real* element_out,
                   __global const real* inverse_diagonal, __global real* x, __global real* r,
-                  __global real* z, __global real* d, __global real* q, __global const real* bb,
+                  __global real* z, __global real* d, __global const real* q,
+                  __global const real* bb,
                   __global real* rr, __global real* rz, __global uint* active,
                   __global uint* converged, __global int* iterations) {
   __local real scratch[SF_GROUP_SIZE];
@@ -107,13 +104,10 @@ void cg_iteration(uint S, uint node_count, int max_iterations, __global const re
 
   real sum_dq = (real)0;
   for (uint n = first; n < node_count; n += SF_GROUP_SIZE) {
-    real spring = sf_node_spring(ligament_offsets, ligament_of_node, ligament_k, control_k, n, s, S);
-    real m = sf_solver_mass(mass[n], spring);
+    SF_UNROLL
     for (int k = 0; k < 3; ++k) {
       size_t row = ((size_t)3 * n + k) * S + s;
-      real qi = sf_system_row(c, element_out, incidence_offsets, incidence, spring, m, d, n, k, s, S);
-      q[row] = qi;
-      sum_dq += d[row] * qi;
+      sum_dq += d[row] * q[row];
     }
   }
   real alpha = rz_old / sf_group_sum(scratch, sum_dq);
@@ -121,6 +115,7 @@ void cg_iteration(uint S, uint node_count, int max_iterations, __global const re
   real sum_rr = (real)0;
   real sum_rz = (real)0;
   for (uint n = first; n < node_count; n += SF_GROUP_SIZE) {
+    SF_UNROLL
     for (int k = 0; k < 3; ++k) {
       size_t row = ((size_t)3 * n + k) * S + s;
       x[row] += alpha * d[row];
@@ -148,6 +143,7 @@ void cg_iteration(uint S, uint node_count, int max_iterations, __global const re
   if (stop) return;
   real beta = sum_rz / rz_old;
   for (uint n = first; n < node_count; n += SF_GROUP_SIZE) {
+    SF_UNROLL
     for (int k = 0; k < 3; ++k) {
       size_t row = ((size_t)3 * n + k) * S + s;
       d[row] = z[row] + beta * d[row];

@@ -5,34 +5,42 @@
  *   rhs_e  = f_e(x) - (h + a) K_e v_e      (elastic force and the stiffness-damping product)
  *   diag_e = diag(R K_e R^T)
  * The node kernel (node_assembly.cl) sums them over the incident elements and adds the
- * nodal terms (mass, springs, gravity). */
+ * nodal terms (mass, springs, gravity). Work-items as in element_product.cl. */
 #include "ensemble_layout.h"
 
-__kernel void element_rhs(uint S, uint element_count, __global const int* nodes,
-                          __global const real* rest, __global real* frames,
-                          __global const real* x, __global const real* v,
-                          __global const real* c, __global real* rhs_out,
-                          __global real* diagonal_out) {
+__kernel void element_rhs(uint S, uint element_count, __global const int* restrict nodes,
+                          __global const real* restrict rest, __global real* restrict frames,
+                          __global const real* restrict x, __global const real* restrict v,
+                          __global const real* restrict c, __global real* restrict rhs_out,
+                          __global real* restrict diagonal_out) {
   size_t gid = get_global_id(0);
-  if (gid >= (size_t)element_count * S) return;
-  uint s = (uint)(gid % S);
-  uint e = (uint)(gid / S);
+  uint blocks = S / SF_SIGMA_BLOCK;
+  if (gid >= (size_t)element_count * blocks) return;
+  uint e = (uint)(gid / blocks);
+  uint first = (uint)(gid % blocks) * SF_SIGMA_BLOCK;
   real grad[12];
   real vlambda;
   real vmu;
-  real frame[9];
-  real corner[12];
-  real force[12];
-  real product[12];
   sf_load_rest(rest, e, grad, &vlambda, &vmu);
-  sf_gather_corners(x, nodes, e, s, S, corner);
-  sf_element_frame(corner, frame);
-  for (int i = 0; i < 9; ++i) frames[((size_t)9 * e + i) * S + s] = frame[i];
-  sf_element_force(frame, grad, vlambda, vmu, corner, force);
-  sf_gather_corners(v, nodes, e, s, S, corner);
-  sf_element_product(frame, grad, vlambda, vmu, corner, product);
-  for (int i = 0; i < 12; ++i) force[i] -= c[SF_VELOCITY_FACTOR] * product[i];
-  sf_store_corners(rhs_out, e, s, S, force);
-  sf_element_diagonal(frame, grad, vlambda, vmu, product);
-  sf_store_corners(diagonal_out, e, s, S, product);
+  int corner_nodes[4];
+  sf_load_nodes(nodes, e, corner_nodes);
+  for (uint b = 0; b < SF_SIGMA_BLOCK; ++b) {
+    uint s = first + b;
+    real frame[9];
+    real corner[12];
+    real force[12];
+    real product[12];
+    sf_gather_corners(x, corner_nodes, s, S, corner);
+    sf_element_frame(corner, frame);
+    SF_UNROLL
+    for (int i = 0; i < 9; ++i) frames[((size_t)9 * e + i) * S + s] = frame[i];
+    sf_element_force(frame, grad, vlambda, vmu, corner, force);
+    sf_gather_corners(v, corner_nodes, s, S, corner);
+    sf_element_product(frame, grad, vlambda, vmu, corner, product);
+    SF_UNROLL
+    for (int i = 0; i < 12; ++i) force[i] -= c[SF_VELOCITY_FACTOR] * product[i];
+    sf_store_corners(rhs_out, e, s, S, force);
+    sf_element_diagonal(frame, grad, vlambda, vmu, product);
+    sf_store_corners(diagonal_out, e, s, S, product);
+  }
 }

@@ -29,36 +29,53 @@ typedef SF_REAL real;
 #define SF_CG_TOLERANCE2 11   /* squared relative CG tolerance */
 #define SF_STEP_CONSTANTS 12
 
+/* Sigma points per work-item in the element kernels: 1 on a GPU (a work-item per element and
+ * sigma point), S on a CPU (the host sets it; see element_product.cl). */
+#ifndef SF_SIGMA_BLOCK
+#  define SF_SIGMA_BLOCK 1
+#endif
+
 /* The element rest state, 16 numbers per element: grad[12], vlambda, vmu, two unused. */
 #define SF_REST_STRIDE 16
 
 /* Loads the 15 rest numbers of element e (element.h's grad, vlambda, vmu). */
-static inline void sf_load_rest(__global const real* rest, uint e, real grad[12],
+static inline void sf_load_rest(__global const real* restrict rest, uint e, real grad[12],
                                 real* vlambda, real* vmu) {
   __global const real* r = rest + (size_t)e * SF_REST_STRIDE;
+  SF_UNROLL
   for (int i = 0; i < 12; ++i) grad[i] = r[i];
   *vlambda = r[12];
   *vmu = r[13];
 }
 
-/* Gathers a per-dof array's values at element e's four corners for sigma point s. */
-static inline void sf_gather_corners(__global const real* v, __global const int* nodes,
-                                     uint e, uint s, uint S, real out[12]) {
+/* Loads element e's four node indices (once per element, for all its sigma points). */
+static inline void sf_load_nodes(__global const int* restrict nodes, uint e, int corner_nodes[4]) {
+  SF_UNROLL
+  for (int c = 0; c < 4; ++c) corner_nodes[c] = nodes[4 * e + c];
+}
+
+/* Gathers a per-dof array's values at an element's four corners for sigma point s. */
+static inline void sf_gather_corners(__global const real* restrict v, const int corner_nodes[4],
+                                     uint s, uint S, real out[12]) {
+  SF_UNROLL
   for (int c = 0; c < 4; ++c) {
-    size_t base = (size_t)(3 * nodes[4 * e + c]) * S + s;
+    size_t base = (size_t)(3 * corner_nodes[c]) * S + s;
+    SF_UNROLL
     for (int k = 0; k < 3; ++k) out[3 * c + k] = v[base + (size_t)k * S];
   }
 }
 
 /* Loads element e's frame for sigma point s. */
-static inline void sf_load_frame(__global const real* frames, uint e, uint s, uint S,
+static inline void sf_load_frame(__global const real* restrict frames, uint e, uint s, uint S,
                                  real frame[9]) {
+  SF_UNROLL
   for (int i = 0; i < 9; ++i) frame[i] = frames[((size_t)9 * e + i) * S + s];
 }
 
 /* Stores 12 corner values of element e for sigma point s. */
-static inline void sf_store_corners(__global real* out, uint e, uint s, uint S,
+static inline void sf_store_corners(__global real* restrict out, uint e, uint s, uint S,
                                     const real values[12]) {
+  SF_UNROLL
   for (int i = 0; i < 12; ++i) out[((size_t)12 * e + i) * S + s] = values[i];
 }
 

@@ -1,8 +1,8 @@
 /* node_assembly: per node and sigma point, the element outputs gathered at the node plus the
  * nodal terms of the implicit Euler system (host: host/reference/implicit_euler.h):
  *   node_rhs:     rhs = h (f - (h + a) K v - b M v) and the inverse Jacobi diagonal of A,
- *   node_product: q = A d (the CG product outside CG: the conformance tests' system product).
- * Inside CG the same rows are formed by the per-sigma kernels of conjugate_gradient.cl. */
+ *   node_product: q = A d, in every CG iteration (work-items as in element_product.cl: on a
+ *                 CPU a node for all sigma points, vectorised over them). */
 #include "node_assembly.h"
 
 __kernel void node_rhs(uint S, uint node_count, __global const real* c,
@@ -19,6 +19,7 @@ __kernel void node_rhs(uint S, uint node_count, __global const real* c,
   uint n = (uint)(gid / S);
   real spring = sf_node_spring(ligament_offsets, ligament_of_node, ligament_k, control_k, n, s, S);
   real m = sf_solver_mass(mass[n], spring);
+  SF_UNROLL
   for (int k = 0; k < 3; ++k) {
     size_t row = ((size_t)3 * n + k) * S + s;
     real xr = x[row];
@@ -36,20 +37,41 @@ __kernel void node_rhs(uint S, uint node_count, __global const real* c,
   }
 }
 
-__kernel void node_product(uint S, uint node_count, __global const real* c,
-                           __global const int* incidence_offsets, __global const int* incidence,
-                           __global const int* ligament_offsets,
-                           __global const int* ligament_of_node, __global const real* ligament_k,
-                           __global const real* control_k, __global const real* mass,
-                           __global const real* d, __global const real* element_out,
-                           __global real* q) {
+__kernel void node_product(uint S, uint node_count, __global const real* restrict c,
+                           __global const int* restrict incidence_offsets,
+                           __global const int* restrict incidence,
+                           __global const int* restrict ligament_offsets,
+                           __global const int* restrict ligament_of_node,
+                           __global const real* restrict ligament_k,
+                           __global const real* restrict control_k,
+                           __global const real* restrict mass, __global const real* restrict d,
+                           __global const real* restrict element_out, __global real* restrict q) {
   size_t gid = get_global_id(0);
-  if (gid >= (size_t)node_count * S) return;
-  uint s = (uint)(gid % S);
-  uint n = (uint)(gid / S);
-  real spring = sf_node_spring(ligament_offsets, ligament_of_node, ligament_k, control_k, n, s, S);
-  real m = sf_solver_mass(mass[n], spring);
-  for (int k = 0; k < 3; ++k)
-    q[((size_t)3 * n + k) * S + s] = sf_system_row(c, element_out, incidence_offsets, incidence,
-                                                   spring, m, d, n, k, s, S);
+  uint blocks = S / SF_SIGMA_BLOCK;
+  if (gid >= (size_t)node_count * blocks) return;
+  uint n = (uint)(gid / blocks);
+  uint first = (uint)(gid % blocks) * SF_SIGMA_BLOCK;
+  /* Loops over the sigma block innermost, over contiguous data: the compiler vectorises them. */
+  real spring[SF_SIGMA_BLOCK];
+  real m[SF_SIGMA_BLOCK];
+  for (uint b = 0; b < SF_SIGMA_BLOCK; ++b) spring[b] = control_k[n];
+  for (int i = ligament_offsets[n]; i < ligament_offsets[n + 1]; ++i) {
+    __global const real* k = ligament_k + (size_t)ligament_of_node[i] * S + first;
+    for (uint b = 0; b < SF_SIGMA_BLOCK; ++b) spring[b] += k[b];
+  }
+  for (uint b = 0; b < SF_SIGMA_BLOCK; ++b) m[b] = sf_solver_mass(mass[n], spring[b]);
+  SF_UNROLL
+  for (int k = 0; k < 3; ++k) {
+    real sum[SF_SIGMA_BLOCK];
+    for (uint b = 0; b < SF_SIGMA_BLOCK; ++b) sum[b] = (real)0;
+    for (int i = incidence_offsets[n]; i < incidence_offsets[n + 1]; ++i) {
+      __global const real* out = element_out + ((size_t)3 * incidence[i] + k) * S + first;
+      for (uint b = 0; b < SF_SIGMA_BLOCK; ++b) sum[b] += out[b];
+    }
+    size_t row = ((size_t)3 * n + k) * S + first;
+    for (uint b = 0; b < SF_SIGMA_BLOCK; ++b) {
+      real db = d[row + b];
+      q[row + b] = c[SF_STIFFNESS_FACTOR] * (sum[b] + spring[b] * db) + c[SF_MASS_FACTOR] * m[b] * db;
+    }
+  }
 }

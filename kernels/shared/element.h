@@ -29,21 +29,25 @@ SF_FN void sf_element_frame(SF_IN(p, 12), SF_OUT(frame, 9)) {
   SF_REAL ex[3];
   SF_REAL ey[3];
   SF_REAL ez[3];
+  SF_UNROLL
   for (int k = 0; k < 3; ++k) {
     ex[k] = p[3 + k] - p[k];
     ey[k] = p[6 + k] - p[k];
   }
   SF_REAL nx = SF_SQRT(ex[0] * ex[0] + ex[1] * ex[1] + ex[2] * ex[2]);
+  SF_UNROLL
   for (int k = 0; k < 3; ++k) ex[k] /= nx;
   ez[0] = ex[1] * ey[2] - ex[2] * ey[1];
   ez[1] = ex[2] * ey[0] - ex[0] * ey[2];
   ez[2] = ex[0] * ey[1] - ex[1] * ey[0];
   SF_REAL nz = SF_SQRT(ez[0] * ez[0] + ez[1] * ez[1] + ez[2] * ez[2]);
+  SF_UNROLL
   for (int k = 0; k < 3; ++k) ez[k] /= nz;
   /* y = z x x is already unit length: z and x are orthonormal. */
   ey[0] = ez[1] * ex[2] - ez[2] * ex[1];
   ey[1] = ez[2] * ex[0] - ez[0] * ex[2];
   ey[2] = ez[0] * ex[1] - ez[1] * ex[0];
+  SF_UNROLL
   for (int k = 0; k < 3; ++k) {
     frame[k] = ex[k];
     frame[3 + k] = ey[k];
@@ -59,7 +63,9 @@ SF_FN void sf_element_stress_divergence(SF_IN(frame, 9), SF_IN(grad, 12), SF_REA
                                         SF_REAL vmu, SF_IN(G, 9), SF_REAL identity_shift,
                                         SF_REAL sign, SF_OUT(y, 12)) {
   SF_REAL H[9];
+  SF_UNROLL
   for (int r = 0; r < 3; ++r) {
+    SF_UNROLL
     for (int j = 0; j < 3; ++j) {
       H[3 * r + j] = frame[3 * r] * G[j] + frame[3 * r + 1] * G[3 + j] +
                      frame[3 * r + 2] * G[6 + j];
@@ -70,17 +76,23 @@ SF_FN void sf_element_stress_divergence(SF_IN(frame, 9), SF_IN(grad, 12), SF_REA
   H[8] -= identity_shift;
   SF_REAL pressure = vlambda * (H[0] + H[4] + H[8]);
   SF_REAL S[9]; /* V sigma, symmetric */
+  SF_UNROLL
   for (int r = 0; r < 3; ++r) {
+    SF_UNROLL
     for (int j = 0; j < 3; ++j) S[3 * r + j] = vmu * (H[3 * r + j] + H[3 * j + r]);
     S[4 * r] += pressure;
   }
   SF_REAL T[9]; /* sign * F^T S: the stress rotated back to the world, row index world */
+  SF_UNROLL
   for (int k = 0; k < 3; ++k) {
+    SF_UNROLL
     for (int j = 0; j < 3; ++j) {
       T[3 * k + j] = sign * (frame[k] * S[j] + frame[3 + k] * S[3 + j] + frame[6 + k] * S[6 + j]);
     }
   }
+  SF_UNROLL
   for (int c = 0; c < 4; ++c) {
+    SF_UNROLL
     for (int k = 0; k < 3; ++k) {
       y[3 * c + k] = T[3 * k] * grad[3 * c] + T[3 * k + 1] * grad[3 * c + 1] +
                      T[3 * k + 2] * grad[3 * c + 2];
@@ -92,10 +104,14 @@ SF_FN void sf_element_stress_divergence(SF_IN(frame, 9), SF_IN(grad, 12), SF_REA
  * Relative values keep float32 rounding at the element's size, not the organ's position
  * (the shape-function gradients sum to zero, so the result is the same in exact arithmetic). */
 SF_FN void sf_element_gradient(SF_IN(grad, 12), SF_IN(v, 12), SF_REAL relative, SF_OUT(G, 9)) {
+  SF_UNROLL
   for (int i = 0; i < 9; ++i) G[i] = SF_LIT(0.0);
+  SF_UNROLL
   for (int c = 0; c < 4; ++c) {
+    SF_UNROLL
     for (int i = 0; i < 3; ++i) {
       SF_REAL value = v[3 * c + i] - relative * v[i];
+      SF_UNROLL
       for (int j = 0; j < 3; ++j) G[3 * i + j] += value * grad[3 * c + j];
     }
   }
@@ -124,11 +140,13 @@ SF_FN void sf_element_force(SF_IN(frame, 9), SF_IN(grad, 12), SF_REAL vlambda, S
  * is K_cc = V ((lambda + mu) g g^T + mu |g|^2 I) in the rest frame; rotated, w = F^T g. */
 SF_FN void sf_element_diagonal(SF_IN(frame, 9), SF_IN(grad, 12), SF_REAL vlambda, SF_REAL vmu,
                                SF_OUT(diag, 12)) {
+  SF_UNROLL
   for (int c = 0; c < 4; ++c) {
     SF_REAL g0 = grad[3 * c];
     SF_REAL g1 = grad[3 * c + 1];
     SF_REAL g2 = grad[3 * c + 2];
     SF_REAL g_squared = g0 * g0 + g1 * g1 + g2 * g2;
+    SF_UNROLL
     for (int k = 0; k < 3; ++k) {
       SF_REAL w = frame[k] * g0 + frame[3 + k] * g1 + frame[6 + k] * g2;
       diag[3 * c + k] = (vlambda + vmu) * w * w + vmu * g_squared;
