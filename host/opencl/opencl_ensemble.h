@@ -74,6 +74,7 @@ class OpenClEnsemble : public DeviceEnsemble {
   double tolerance_ = 0.0;
   std::size_t device_bytes_ = 0;
   std::vector<double> ligament_k_;          // per ligament and sigma, N/m per node: [l * S + s]
+  std::size_t cg_group_ = 64;               // SF_GROUP_SIZE: work-items per sigma point in CG
   int sigma_block_ = 1;                     // SF_SIGMA_BLOCK: sigma points per element work-item
   int expected_iterations_ = 1;             // CG iterations the last step needed (at most)
 
