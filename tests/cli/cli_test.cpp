@@ -23,8 +23,8 @@ struct CommandRun {
   std::string output;   // stdout and stderr together
 };
 
-CommandRun run_sigmafem(const std::string& arguments) {
-  const std::string command = std::string(SIGMAFEM_BINARY) + " " + arguments + " 2>&1";
+CommandRun run_sigmafem_command(const std::string& command_line) {
+  const std::string command = command_line + " 2>&1";
   CommandRun run;
   FILE* pipe = popen(command.c_str(), "r");
   if (!pipe) return run;
@@ -33,6 +33,15 @@ CommandRun run_sigmafem(const std::string& arguments) {
   const int status = pclose(pipe);
   run.exit_code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
   return run;
+}
+
+CommandRun run_sigmafem(const std::string& arguments) {
+  return run_sigmafem_command(std::string(SIGMAFEM_BINARY) + " " + arguments);
+}
+
+// The same with environment assignments ("NAME=value ...") before the program.
+CommandRun run_sigmafem_with_env(const std::string& environment, const std::string& arguments) {
+  return run_sigmafem_command(environment + " " + std::string(SIGMAFEM_BINARY) + " " + arguments);
 }
 
 class CliTest : public ::testing::Test {
@@ -192,6 +201,42 @@ TEST_F(CliTest, InfoDescribesTheShippedScenarios) {
     EXPECT_EQ(run.exit_code, 0) << run.output;
     EXPECT_NE(run.output.find("tetrahedra"), std::string::npos) << run.output;
   }
+}
+
+}  // namespace
+}  // namespace sigmafem
+
+namespace sigmafem {
+namespace {
+
+// The OpenCL back end's failures are clear messages with exit code 3, never a crash, and
+// leave no data files. OCL_ICD_VENDORS pointing at an empty place hides every OpenCL driver
+// from the ICD loader: a machine without OpenCL.
+TEST_F(CliTest, OpenClWithoutAPlatformIsAClearDeviceError) {
+  std::ofstream(dir_ / "box.json") << box_.dump(2);
+  const CommandRun run = run_sigmafem_with_env(
+      "OCL_ICD_VENDORS=" + (dir_ / "no-drivers").string(),
+      "generate " + (dir_ / "box.json").string() + " --out " + (dir_ / "out").string() +
+          " --backend opencl --vtk-every 0 --quiet");
+  EXPECT_EQ(run.exit_code, 3) << run.output;
+  EXPECT_NE(run.output.find("no OpenCL platform found"), std::string::npos) << run.output;
+  EXPECT_FALSE(fs::exists(dir_ / "out" / "observations.csv"));
+  const CommandRun devices =
+      run_sigmafem_with_env("OCL_ICD_VENDORS=" + (dir_ / "no-drivers").string(), "devices");
+  EXPECT_EQ(devices.exit_code, 0) << devices.output;
+  EXPECT_NE(devices.output.find("no OpenCL platform found"), std::string::npos) << devices.output;
+}
+
+TEST_F(CliTest, OpenClDeviceOutOfRangeIsAClearDeviceError) {
+  std::ofstream(dir_ / "box.json") << box_.dump(2);
+  const CommandRun run = run_sigmafem("generate " + (dir_ / "box.json").string() + " --out " +
+                                      (dir_ / "out").string() +
+                                      " --backend opencl --device 99 --vtk-every 0 --quiet");
+  EXPECT_EQ(run.exit_code, 3) << run.output;
+  const bool named = run.output.find("no OpenCL device 99") != std::string::npos ||
+                     run.output.find("no OpenCL platform found") != std::string::npos;
+  EXPECT_TRUE(named) << run.output;
+  EXPECT_FALSE(fs::exists(dir_ / "out" / "observations.csv"));
 }
 
 }  // namespace
