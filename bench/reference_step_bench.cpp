@@ -21,7 +21,7 @@ using bench::scenario;
 ReferenceSimulation warmed_up(const Scenario& s, int& step) {
   ReferenceSimulation simulation(make_model(s));
   for (step = 1; step <= 20; ++step)
-    simulation.step(s.control.trajectory.position(step * s.time.dt, s.control.start));
+    simulation.step(bench::so_position(s, step));
   return simulation;
 }
 
@@ -32,7 +32,7 @@ void BM_reference_step(benchmark::State& state, const std::string& name, int ref
   long long iterations = 0;
   for (auto _ : state) {
     const CgResult cg =
-        simulation.step(s.control.trajectory.position(step * s.time.dt, s.control.start));
+        simulation.step(bench::so_position(s, step));
     iterations += cg.iterations;
     ++step;
   }

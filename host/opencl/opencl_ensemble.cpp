@@ -171,9 +171,12 @@ OpenClEnsemble::OpenClEnsemble(const Model& model, std::vector<int> estimated,
     set_args(k_node_rhs_, S, N, constants_, incidence_offsets_, incidence_, ligament_offsets_,
              ligament_of_node_, ligament_k_buffer_, control_k_, mass_, rest_positions_, x_, v_,
              element_out_, element_diagonal_, rhs_, inverse_diagonal_);
+    // Arguments 5-6 (d, active) and 10 (d), 12 (q) are set per call.
     set_args(k_element_product_, S, E, element_nodes_, element_rest_, frames_);
+    k_element_product_.setArg(7, element_out_);
     set_args(k_node_product_, S, N, constants_, incidence_offsets_, incidence_, ligament_offsets_,
              ligament_of_node_, ligament_k_buffer_, control_k_, mass_);
+    k_node_product_.setArg(11, element_out_);
     set_args(k_cg_start_, S, N, constants_, incidence_offsets_, incidence_, ligament_offsets_,
              ligament_of_node_, ligament_k_buffer_, control_k_, mass_, element_out_, rhs_,
              inverse_diagonal_, dv_, r_, z_, d_, bb_, rr_, rz_, active_, converged_,
@@ -293,13 +296,11 @@ void OpenClEnsemble::node_rhs() { run(k_node_rhs_, static_cast<std::size_t>(node
 void OpenClEnsemble::element_product(const cl::Buffer& d, const cl::Buffer& active) {
   k_element_product_.setArg(5, d);
   k_element_product_.setArg(6, active);
-  k_element_product_.setArg(7, element_out_);
   run(k_element_product_, element_items());
 }
 
 void OpenClEnsemble::node_product(const cl::Buffer& d, const cl::Buffer& q) {
   k_node_product_.setArg(10, d);
-  k_node_product_.setArg(11, element_out_);
   k_node_product_.setArg(12, q);
   run(k_node_product_, static_cast<std::size_t>(nodes_) * (S_ / sigma_block_));
 }

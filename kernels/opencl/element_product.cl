@@ -13,11 +13,9 @@ __kernel void element_product(uint S, uint element_count, __global const int* re
                               __global const real* restrict rest, __global const real* restrict frames,
                               __global const real* restrict d, __global const uint* restrict active,
                               __global real* restrict out) {
-  size_t gid = get_global_id(0);
-  uint blocks = S / SF_SIGMA_BLOCK;
-  if (gid >= (size_t)element_count * blocks) return;
-  uint e = (uint)(gid / blocks);
-  uint first = (uint)(gid % blocks) * SF_SIGMA_BLOCK;
+  uint e;
+  uint first;
+  if (!sf_block_item(get_global_id(0), S, element_count, &e, &first)) return;
   real grad[12];
   real vlambda;
   real vmu;

@@ -13,11 +13,9 @@ __kernel void element_rhs(uint S, uint element_count, __global const int* restri
                           __global const real* restrict x, __global const real* restrict v,
                           __global const real* restrict c, __global real* restrict rhs_out,
                           __global real* restrict diagonal_out) {
-  size_t gid = get_global_id(0);
-  uint blocks = S / SF_SIGMA_BLOCK;
-  if (gid >= (size_t)element_count * blocks) return;
-  uint e = (uint)(gid / blocks);
-  uint first = (uint)(gid % blocks) * SF_SIGMA_BLOCK;
+  uint e;
+  uint first;
+  if (!sf_block_item(get_global_id(0), S, element_count, &e, &first)) return;
   real grad[12];
   real vlambda;
   real vmu;

@@ -35,6 +35,17 @@ typedef SF_REAL real;
 #  define SF_SIGMA_BLOCK 1
 #endif
 
+/* The item (element or node) and the first sigma point of the block that work-item `gid`
+ * takes in the blocked kernels; 0 for a work-item past the end (the global size is rounded
+ * up to whole work-groups). */
+static inline int sf_block_item(size_t gid, uint S, uint count, uint* item, uint* first) {
+  uint blocks = S / SF_SIGMA_BLOCK;
+  if (gid >= (size_t)count * blocks) return 0;
+  *item = (uint)(gid / blocks);
+  *first = (uint)(gid % blocks) * SF_SIGMA_BLOCK;
+  return 1;
+}
+
 /* The element rest state, 16 numbers per element: grad[12], vlambda, vmu, two unused. */
 #define SF_REST_STRIDE 16
 

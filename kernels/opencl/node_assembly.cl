@@ -46,11 +46,9 @@ __kernel void node_product(uint S, uint node_count, __global const real* restric
                            __global const real* restrict control_k,
                            __global const real* restrict mass, __global const real* restrict d,
                            __global const real* restrict element_out, __global real* restrict q) {
-  size_t gid = get_global_id(0);
-  uint blocks = S / SF_SIGMA_BLOCK;
-  if (gid >= (size_t)node_count * blocks) return;
-  uint n = (uint)(gid / blocks);
-  uint first = (uint)(gid % blocks) * SF_SIGMA_BLOCK;
+  uint n;
+  uint first;
+  if (!sf_block_item(get_global_id(0), S, node_count, &n, &first)) return;
   /* Loops over the sigma block innermost, over contiguous data: the compiler vectorises them. */
   real spring[SF_SIGMA_BLOCK];
   real m[SF_SIGMA_BLOCK];

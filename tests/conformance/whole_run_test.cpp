@@ -10,6 +10,7 @@
 #include <sstream>
 
 #include "temp_path.h"
+#include "tests/filter/scenario_filter_options.h"
 #include "filter/estimation.h"
 #include "host/data/observation_table.h"
 #include "host/ensemble/make_ensemble.h"
@@ -24,14 +25,8 @@ namespace fs = std::filesystem;
 
 EstimationRun estimate_box(const Scenario& s, const ObservationTable& data,
                            const std::string& backend) {
-  EstimationOptions options;
-  options.roukf.sigma_points = SigmaPointSet::simplex;
-  options.roukf.initial_theta.resize(static_cast<Eigen::Index>(s.filter->estimate.size()));
-  for (std::size_t j = 0; j < s.filter->estimate.size(); ++j)
-    options.roukf.initial_theta[static_cast<Eigen::Index>(j)] = std::log(s.filter->initial_stiffness[j]);
-  options.roukf.initial_log_std = s.filter->initial_log_std;
-  options.roukf.parameter_drift_log_std = s.filter->parameter_drift_log_std;
-  options.roukf.observation_std = s.filter->observation_std;
+  const EstimationOptions options =
+      test::filter_options(s, SigmaPointSet::simplex, s.filter->observation_std);
   auto ensemble = make_ensemble(backend, make_model(s), s.filter->estimate, s.observations.nodes,
                                 static_cast<int>(s.filter->estimate.size()) + 1);
   return run_estimation(*ensemble, options, data.times, data.so, data.points, {});

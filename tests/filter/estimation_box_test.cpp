@@ -10,6 +10,7 @@
 #include <sstream>
 
 #include "temp_path.h"
+#include "tests/filter/scenario_filter_options.h"
 #include "filter/error_figures.h"
 #include "filter/estimation.h"
 #include "host/data/observation_table.h"
@@ -37,6 +38,8 @@ struct BoxData {
   TruthTable truth;
 };
 
+using test::filter_options;
+
 // Generates the box data once per configuration (noise, with or without the cut).
 const BoxData& box_data(bool noise_free, bool with_cut) {
   static std::map<std::pair<bool, bool>, std::unique_ptr<BoxData>> cache;
@@ -59,19 +62,6 @@ const BoxData& box_data(bool noise_free, bool with_cut) {
     fs::remove_all(dir);
   }
   return *slot;
-}
-
-EstimationOptions filter_options(const Scenario& scenario, SigmaPointSet set, double observation_std) {
-  const FilterSpec& spec = *scenario.filter;
-  EstimationOptions options;
-  options.roukf.sigma_points = set;
-  options.roukf.initial_theta.resize(static_cast<Eigen::Index>(spec.estimate.size()));
-  for (std::size_t j = 0; j < spec.estimate.size(); ++j)
-    options.roukf.initial_theta[static_cast<Eigen::Index>(j)] = std::log(spec.initial_stiffness[j]);
-  options.roukf.initial_log_std = spec.initial_log_std;
-  options.roukf.parameter_drift_log_std = spec.parameter_drift_log_std;
-  options.roukf.observation_std = observation_std;
-  return options;
 }
 
 struct BoxRun {
