@@ -58,7 +58,7 @@ class OpenClEnsemble : public DeviceEnsemble {
   void write_step_constants(const Eigen::Vector3d& so_position);
 
   // Enqueue the kernels of one step (kernels/opencl/<file>.cl holds the kernel of the same
-  // name; conjugate_gradient() enqueues cg_start and cg_iteration).
+  // name; conjugate_gradient() enqueues cg_start and cg_iteration, or cg_solve).
   std::size_t element_items() const;   // work-items of the element kernels
   void element_rhs();
   void node_rhs();
@@ -77,6 +77,8 @@ class OpenClEnsemble : public DeviceEnsemble {
   std::size_t cg_group_ = 64;               // SF_GROUP_SIZE: work-items per sigma point in CG
   int sigma_block_ = 1;                     // SF_SIGMA_BLOCK: sigma points per element work-item
   int expected_iterations_ = 1;             // CG iterations the last step needed (at most)
+  bool whole_solve_ = false;                // cg_solve (one launch) instead of per iteration
+  int solve_block_ = 1;                     // SF_SOLVE_BLOCK: sigma points per work-item of cg_solve
 
   // Shared data.
   cl::Buffer element_nodes_, element_rest_, incidence_offsets_, incidence_;
@@ -92,7 +94,8 @@ class OpenClEnsemble : public DeviceEnsemble {
 
   // Mutable: enqueueing a kernel (also from the const read-outs) changes no visible state.
   mutable cl::Kernel k_element_rhs_, k_node_rhs_, k_element_product_, k_node_product_;
-  mutable cl::Kernel k_cg_start_, k_cg_iteration_, k_state_update_, k_observation_gather_;
+  mutable cl::Kernel k_cg_start_, k_cg_iteration_, k_cg_solve_, k_state_update_;
+  mutable cl::Kernel k_observation_gather_;
   mutable cl::Kernel k_recenter_;
 };
 

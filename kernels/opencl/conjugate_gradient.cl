@@ -1,19 +1,25 @@
 /* conjugate_gradient: Jacobi-preconditioned CG for all sigma points at once, with per-sigma
  * scalars and a per-sigma convergence flag (host: host/reference/conjugate_gradient.h, the
- * same stopping rule |r| <= tolerance |b|).
+ * same stopping rule |r| <= tolerance |b|). Two ways to run it, chosen by the host
+ * (OpenClEnsemble::conjugate_gradient):
  *
- * One work-group per sigma point owns every row of that sigma point, so the rest of a CG
- * iteration after the product q = A d is one kernel: d.q, the update with r.r and r.z, the
- * convergence test and the new direction, with the dot products reduced inside the group
- * (a fixed tree: the same bits every run) and no host round trip. Per iteration the host
- * enqueues three kernels (element_product, node_product, cg_iteration).
+ * Per iteration (cg_start, then cg_iteration after every product q = A d). One work-group per
+ * sigma point owns every row of that sigma point, so the rest of a CG iteration after the
+ * product is one kernel: d.q, the update with r.r and r.z, the convergence test and the new
+ * direction, with the dot products reduced inside the group (a fixed tree: the same bits
+ * every run) and no host round trip. Per iteration the host enqueues three kernels
+ * (element_product, node_product, cg_iteration). A sigma point that has converged (or hit the
+ * iteration cap, or broke down) is inactive and its group returns at once, so the host may
+ * enqueue several iterations between checks without changing anyone's result.
  *
- * A sigma point that has converged (or hit the iteration cap, or broke down) is inactive and
- * its group returns at once, so the host may enqueue several iterations between checks
- * without changing anyone's result.
+ * The whole solve in one launch (cg_solve, below). One work-item takes a block of sigma
+ * points and does their products itself, so a step costs one launch instead of three per
+ * iteration: on a CPU, where a launch costs tens of microseconds, that is most of the time
+ * on small meshes (the filter step).
  *
  * Per-sigma scalars (arrays of S): bb = b.b, rr = r.r, rz = r.z, active (1 while iterating),
  * converged (1 converged, 0 hit the cap or broke down), iterations (products done). */
+#include "element_product.h"
 #include "node_assembly.h"
 
 /* Work-items per sigma point: a power of two (the host passes the same number). */
@@ -148,5 +154,166 @@ void cg_iteration(uint S, uint node_count, int max_iterations, __global const re
       size_t row = ((size_t)3 * n + k) * S + s;
       d[row] = z[row] + beta * d[row];
     }
+  }
+}
+
+/* Sigma points per work-item of cg_solve, a divisor of S (the host sets it: S divided over
+ * the compute units). */
+#ifndef SF_SOLVE_BLOCK
+#  define SF_SOLVE_BLOCK 1
+#endif
+
+/* Sigma points first .. first + count - 1's element products of d. The products of every
+ * sigma point of the block are computed, finished ones too (their outputs are not used):
+ * the loop over the block then has no branch and vectorises. */
+static inline __attribute__((always_inline)) void sf_block_element_products(uint first, uint count, uint S, uint element_count,
+                                             __global const int* restrict nodes,
+                                             __global const real* restrict rest,
+                                             __global const real* restrict frames,
+                                             __global const real* restrict d,
+                                             __global real* restrict out) {
+  for (uint e = 0; e < element_count; ++e) {
+    real grad[12];
+    real vlambda;
+    real vmu;
+    sf_load_rest(rest, e, grad, &vlambda, &vmu);
+    int corner_nodes[4];
+    sf_load_nodes(nodes, e, corner_nodes);
+    for (uint b = 0; b < count; ++b)
+      sf_element_product_of(grad, vlambda, vmu, corner_nodes, frames, d, e, first + b, S, out);
+  }
+}
+
+/* The whole CG solve of a block of sigma points (x = dv, warm-started), the same arithmetic
+ * as cg_start and cg_iteration but with the dot products summed in row order. Work-item i
+ * takes sigma points i * SF_SOLVE_BLOCK onwards; the solve of the block goes on until every
+ * sigma point of it has stopped, the finished ones left as they are. */
+__kernel void cg_solve(uint S, uint element_count, uint node_count, int max_iterations,
+                       __global const real* restrict c, __global const int* restrict nodes,
+                       __global const real* restrict rest, __global const real* restrict frames,
+                       __global const int* restrict incidence_offsets,
+                       __global const int* restrict incidence,
+                       __global const int* restrict ligament_offsets,
+                       __global const int* restrict ligament_of_node,
+                       __global const real* restrict ligament_k,
+                       __global const real* restrict control_k, __global const real* restrict mass,
+                       __global const real* restrict b, __global const real* restrict inverse_diagonal,
+                       __global real* restrict x, __global real* restrict r,
+                       __global real* restrict z, __global real* restrict d,
+                       __global real* restrict q, __global real* restrict element_out,
+                       __global real* restrict bb, __global real* restrict rr,
+                       __global real* restrict rz, __global uint* restrict active,
+                       __global uint* restrict converged, __global int* restrict iterations) {
+  /* The host makes SF_SOLVE_BLOCK divide S: the block's loops have a fixed length. */
+  const uint count = SF_SOLVE_BLOCK;
+  uint first = (uint)get_global_id(0) * count;
+  if (first >= S) return;
+  const real tolerance2 = c[SF_CG_TOLERANCE2];
+
+  /* The warm start: r = b - A x, z = M^-1 r, d = z. */
+  sf_block_element_products(first, count, S, element_count, nodes, rest, frames, x, element_out);
+  real sum_bb[SF_SOLVE_BLOCK];
+  real sum_rr[SF_SOLVE_BLOCK];
+  real sum_rz[SF_SOLVE_BLOCK];
+  for (uint i = 0; i < count; ++i) sum_bb[i] = sum_rr[i] = sum_rz[i] = (real)0;
+  for (uint n = 0; n < node_count; ++n) {
+    for (uint i = 0; i < count; ++i) {
+      uint s = first + i;
+      real spring = sf_node_spring(ligament_offsets, ligament_of_node, ligament_k, control_k, n, s, S);
+      real m = sf_solver_mass(mass[n], spring);
+      SF_UNROLL
+      for (int k = 0; k < 3; ++k) {
+        size_t row = ((size_t)3 * n + k) * S + s;
+        real ri = b[row] - sf_system_row(c, element_out, incidence_offsets, incidence, spring, m, x, n, k, s, S);
+        real zi = inverse_diagonal[row] * ri;
+        r[row] = ri;
+        z[row] = zi;
+        d[row] = zi;
+        sum_bb[i] += b[row] * b[row];
+        sum_rr[i] += ri * ri;
+        sum_rz[i] += ri * zi;
+      }
+    }
+  }
+  int going[SF_SOLVE_BLOCK];
+  int count_done[SF_SOLVE_BLOCK];
+  int any = 0;
+  for (uint i = 0; i < count; ++i) {
+    int done = sum_bb[i] == (real)0 || sum_rr[i] <= tolerance2 * sum_bb[i];
+    converged[first + i] = done ? 1u : 0u;
+    going[i] = !done;
+    count_done[i] = 0;
+    any |= going[i];
+  }
+
+  while (any) {
+    /* q = A d and d.q */
+    sf_block_element_products(first, count, S, element_count, nodes, rest, frames, d, element_out);
+    real sum_dq[SF_SOLVE_BLOCK];
+    for (uint i = 0; i < count; ++i) sum_dq[i] = (real)0;
+    for (uint n = 0; n < node_count; ++n) {
+      for (uint i = 0; i < count; ++i) {
+        uint s = first + i;
+        real spring = sf_node_spring(ligament_offsets, ligament_of_node, ligament_k, control_k, n, s, S);
+        real m = sf_solver_mass(mass[n], spring);
+        SF_UNROLL
+        for (int k = 0; k < 3; ++k) {
+          size_t row = ((size_t)3 * n + k) * S + s;
+          real qi = sf_system_row(c, element_out, incidence_offsets, incidence, spring, m, d, n, k, s, S);
+          q[row] = qi;
+          sum_dq[i] += d[row] * qi;
+        }
+      }
+    }
+    /* x += alpha d, r -= alpha q, z = M^-1 r; a finished sigma point gets alpha = 0. */
+    real alpha[SF_SOLVE_BLOCK];
+    real rr_new[SF_SOLVE_BLOCK];
+    real rz_new[SF_SOLVE_BLOCK];
+    for (uint i = 0; i < count; ++i) {
+      alpha[i] = going[i] ? sum_rz[i] / sum_dq[i] : (real)0;
+      rr_new[i] = rz_new[i] = (real)0;
+    }
+    for (uint row = 0; row < 3 * node_count; ++row) {
+      for (uint i = 0; i < count; ++i) {
+        size_t at = (size_t)row * S + first + i;
+        x[at] += alpha[i] * d[at];
+        real ri = r[at] - alpha[i] * q[at];
+        real zi = inverse_diagonal[at] * ri;
+        r[at] = ri;
+        z[at] = zi;
+        rr_new[i] += ri * ri;
+        rz_new[i] += ri * zi;
+      }
+    }
+    /* The convergence test, the cap and breakdown, then d = z + beta d. */
+    real beta[SF_SOLVE_BLOCK];
+    any = 0;
+    for (uint i = 0; i < count; ++i) {
+      beta[i] = (real)1;
+      if (!going[i]) continue;
+      ++count_done[i];
+      sum_rr[i] = rr_new[i];
+      int done = rr_new[i] <= tolerance2 * sum_bb[i];
+      if (done) converged[first + i] = 1u;
+      going[i] = !(done || !isfinite(rr_new[i]) || count_done[i] >= max_iterations);
+      beta[i] = rz_new[i] / sum_rz[i];
+      sum_rz[i] = rz_new[i];
+      any |= going[i];
+    }
+    if (!any) break;
+    for (uint row = 0; row < 3 * node_count; ++row) {
+      for (uint i = 0; i < count; ++i) {
+        size_t at = (size_t)row * S + first + i;
+        d[at] = going[i] ? z[at] + beta[i] * d[at] : d[at];
+      }
+    }
+  }
+  for (uint i = 0; i < count; ++i) {
+    uint s = first + i;
+    bb[s] = sum_bb[i];
+    rr[s] = sum_rr[i];
+    rz[s] = sum_rz[i];
+    active[s] = 0u;
+    iterations[s] = count_done[i];
   }
 }

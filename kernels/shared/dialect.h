@@ -19,7 +19,7 @@ typedef unsigned int uint;
 #  ifndef SF_REAL
 #    define SF_REAL float
 #  endif
-#  define SF_FN static inline
+#  define SF_FN static inline __attribute__((always_inline))
 #  define SF_SQRT(x) sqrt(x)
 #  define SF_IN(n, N) const SF_REAL n[N]
 #  define SF_OUT(n, N) SF_REAL n[N]
