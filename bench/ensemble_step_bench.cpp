@@ -155,6 +155,13 @@ BENCHMARK_CAPTURE(BM_ensemble_step, cpu_liver_596, kCpu, std::string("liver"), 0
     ->Arg(16)->Unit(benchmark::kMillisecond)->UseRealTime();
 BENCHMARK_CAPTURE(BM_ensemble_step, opencl_liver_fine_38144, kOpenCl, std::string("liver_fine"), 0)
     ->Arg(16)->Unit(benchmark::kMillisecond)->UseRealTime();
+// The two CG launch modes at few sigma points on a large mesh, where launches cost little.
+BENCHMARK_CAPTURE(BM_ensemble_step, opencl_per_iteration_liver_fine_38144, kOpenClPerIteration,
+                  std::string("liver_fine"), 0)
+    ->Arg(4)->Unit(benchmark::kMillisecond)->UseRealTime();
+BENCHMARK_CAPTURE(BM_ensemble_step, opencl_whole_solve_liver_fine_38144, kOpenClWholeSolve,
+                  std::string("liver_fine"), 0)
+    ->Arg(4)->Unit(benchmark::kMillisecond)->UseRealTime();
 BENCHMARK_CAPTURE(BM_ensemble_step, cpu_liver_fine_38144, kCpu, std::string("liver_fine"), 0)
     ->Arg(16)->Unit(benchmark::kMillisecond)->UseRealTime();
 BENCHMARK_CAPTURE(BM_ensemble_step, opencl_box_large_117240, kOpenCl, std::string("box_large"), 0)
