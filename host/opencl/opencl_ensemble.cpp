@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstring>
 #include <stdexcept>
 #include <string>
 
@@ -258,15 +259,21 @@ void OpenClEnsemble::write(const cl::Buffer& buffer, const std::vector<double>& 
   }
 }
 
-std::vector<double> OpenClEnsemble::read(const cl::Buffer& buffer, std::size_t count) const {
+std::vector<double> OpenClEnsemble::to_doubles(const std::vector<unsigned char>& bytes) const {
   if (device_.precision() == Precision::single) {
-    std::vector<float> values(count);
-    device_.queue().enqueueReadBuffer(buffer, CL_TRUE, 0, count * sizeof(float), values.data());
+    std::vector<float> values(bytes.size() / sizeof(float));
+    std::memcpy(values.data(), bytes.data(), values.size() * sizeof(float));
     return std::vector<double>(values.begin(), values.end());
   }
-  std::vector<double> values(count);
-  device_.queue().enqueueReadBuffer(buffer, CL_TRUE, 0, count * sizeof(double), values.data());
+  std::vector<double> values(bytes.size() / sizeof(double));
+  std::memcpy(values.data(), bytes.data(), values.size() * sizeof(double));
   return values;
+}
+
+std::vector<double> OpenClEnsemble::read(const cl::Buffer& buffer, std::size_t count) const {
+  std::vector<unsigned char> bytes(count * device_.real_size());
+  device_.queue().enqueueReadBuffer(buffer, CL_TRUE, 0, bytes.size(), bytes.data());
+  return to_doubles(bytes);
 }
 
 std::vector<double> OpenClEnsemble::sigma_column(const cl::Buffer& buffer, std::size_t rows,
@@ -365,14 +372,17 @@ StepReport OpenClEnsemble::advance(const Eigen::Vector3d& so_position) {
     node_rhs();
     conjugate_gradient();
     run(k_state_update_, dof);
+    // The solver report: four small reads, one wait.
     std::vector<cl_int> iterations(S_);
     std::vector<cl_uint> converged(S_);
-    device_.queue().enqueueReadBuffer(iterations_, CL_FALSE, 0, S_ * sizeof(cl_int),
-                                      iterations.data());
-    device_.queue().enqueueReadBuffer(converged_, CL_FALSE, 0, S_ * sizeof(cl_uint),
-                                      converged.data());
-    const std::vector<double> rr = read(rr_, S_);
-    const std::vector<double> bb = read(bb_, S_);
+    std::vector<unsigned char> rr_bytes(S_ * device_.real_size()), bb_bytes(rr_bytes.size());
+    cl::CommandQueue& queue = device_.queue();
+    queue.enqueueReadBuffer(iterations_, CL_FALSE, 0, S_ * sizeof(cl_int), iterations.data());
+    queue.enqueueReadBuffer(converged_, CL_FALSE, 0, S_ * sizeof(cl_uint), converged.data());
+    queue.enqueueReadBuffer(rr_, CL_FALSE, 0, rr_bytes.size(), rr_bytes.data());
+    queue.enqueueReadBuffer(bb_, CL_FALSE, 0, bb_bytes.size(), bb_bytes.data());
+    queue.finish();
+    const std::vector<double> rr = to_doubles(rr_bytes), bb = to_doubles(bb_bytes);
     report.cg_iterations.assign(iterations.begin(), iterations.end());
     report.converged.assign(converged.begin(), converged.end());
     report.relative_residual.resize(S_);
