@@ -307,11 +307,13 @@ void spatial_pattern(const Eigen::MatrixXd& Z, const Eigen::MatrixX3d& positions
   // (the fit is linear) when no row is missing, and their scatter gives its standard error.
   const Eigen::Index N = Z.rows();
   const Eigen::MatrixXd A = rigid_motion_basis(positions, s.centroid);
-  const Eigen::MatrixXd full_solve = Eigen::CompleteOrthogonalDecomposition<Eigen::MatrixXd>(A).pseudoInverse();
+  const bool all_placed = A.allFinite();   // false when a point has no position (never observed)
+  const Eigen::MatrixXd full_solve =
+      all_placed ? Eigen::CompleteOrthogonalDecomposition<Eigen::MatrixXd>(A).pseudoInverse() : Eigen::MatrixXd();
   Eigen::MatrixXd motion(N, 6);
   for (Eigen::Index t = 0; t < N; ++t) {
     const Eigen::VectorXd z = Z.row(t).transpose();
-    if (z.allFinite())
+    if (all_placed && z.allFinite())
       motion.row(t) = (full_solve * z).transpose();
     else {
       const RigidFit step = fit_rigid_motion(positions, s.centroid, z);
@@ -361,6 +363,15 @@ std::vector<std::string> ResidualVerdict::failed() const {
   for (const DiagnosticTest& test : tests)
     if (!test.passed) names.push_back(test.name);
   return names;
+}
+
+Eigen::MatrixX3d mean_observed_positions(const Eigen::MatrixXd& points) {
+  Eigen::VectorXd mean = Eigen::VectorXd::Constant(points.cols(), kNan);
+  for (Eigen::Index c = 0; c < points.cols(); ++c) {
+    const Eigen::Array<bool, Eigen::Dynamic, 1> finite = points.col(c).array().isFinite();
+    if (finite.count() > 0) mean[c] = finite.select(points.col(c).array(), 0.0).sum() / static_cast<double>(finite.count());
+  }
+  return as_points(mean);
 }
 
 InnovationSeries innovation_series(const EstimationRun& run) {

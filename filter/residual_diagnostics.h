@@ -143,6 +143,10 @@ struct ResidualDiagnostics {
   ResidualVerdict verdict;
 };
 
+// Where the observed points are on average: the mean over the rows of `points` (rows x 3m,
+// NaN = missing) per coordinate, as m x 3 (NaN for a point never observed).
+Eigen::MatrixX3d mean_observed_positions(const Eigen::MatrixXd& points);
+
 // `positions` (m x 3): where the observed points are (e.g. their mean observed position),
 // for the rigid part of the pattern. Throws std::invalid_argument when the sizes disagree.
 ResidualDiagnostics diagnose_residuals(const InnovationSeries& series, const Eigen::MatrixX3d& positions,
