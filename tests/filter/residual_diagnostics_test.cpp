@@ -8,6 +8,8 @@
 
 #include <cmath>
 #include <filesystem>
+#include <iostream>
+#include <map>
 #include <memory>
 #include <sstream>
 
@@ -94,6 +96,23 @@ TEST(ResidualDiagnostics, WhiteInnovationsWithTheRightCovarianceAreConsistent) {
     }
   }
   EXPECT_LE(inconsistent, 1);
+}
+
+// The measurement behind the false-alarm figure in residual_diagnostics.h (4000 runs, about
+// 5 s): ./sigmafem_tests --gtest_also_run_disabled_tests --gtest_filter='*FalseAlarmRate*'
+TEST(ResidualDiagnostics, DISABLED_FalseAlarmRateOverManySeeds) {
+  const int runs = 4000;
+  int inconsistent = 0;
+  std::map<std::string, int> failures;
+  for (std::uint64_t seed = 1001; seed <= 1000 + runs; ++seed) {
+    const ResidualDiagnostics d = diagnose_residuals(synthetic_series(seed), synthetic_points());
+    inconsistent += d.verdict.consistency != Consistency::consistent;
+    for (const std::string& name : d.verdict.failed()) ++failures[name];
+  }
+  std::cout << inconsistent << " inconsistent verdicts in " << runs << " consistent runs:";
+  for (const auto& [name, count] : failures) std::cout << ' ' << name << ' ' << count;
+  std::cout << '\n';
+  EXPECT_LE(inconsistent, runs / 100) << "above the 1% the options ask for";
 }
 
 TEST(ResidualDiagnostics, ABiasOnOneRowIsFlagged) {
@@ -216,8 +235,11 @@ TEST(ResidualDiagnosticsBox, DataTheModelExplainsAreConsistent) {
 }
 
 TEST(ResidualDiagnosticsBox, ACameraRegistrationErrorIsInconsistentAndRigid) {
-  // Every observed point shifted by (0.2, 0.4, 0.4) mm, about the noise of one coordinate:
-  // the filter bends the stiffnesses to explain it, but what it cannot explain stays rigid.
+  // Every observed point shifted by (0.2, 0.4, 0.4) mm, about the noise of one coordinate.
+  // The filter bends the stiffnesses to explain it; over this short run what it cannot yet
+  // explain stays rigid. (Over the whole 1500 steps it bends them far enough that its own
+  // wrong deformation dominates the mean residual, rigid share 0.21, README; the rigid
+  // components' t-test still fails, at 12 against 3.6.)
   Eigen::MatrixXd points = box_run_data().observations.points;
   const Eigen::Vector3d offset(0.2e-3, 0.4e-3, 0.4e-3);
   for (Eigen::Index c = 0; c < points.cols(); c += 3)
@@ -225,6 +247,7 @@ TEST(ResidualDiagnosticsBox, ACameraRegistrationErrorIsInconsistentAndRigid) {
   const ResidualDiagnostics d = diagnose_box(points);
   EXPECT_EQ(d.verdict.consistency, Consistency::inconsistent) << describe(d);
   EXPECT_TRUE(failed(d, "rigid_bias")) << describe(d);
+  RecordProperty("rigid_share", std::to_string(d.spatial.rigid_share));
   EXPECT_GT(d.spatial.rigid_share, 0.75) << "the rigid part dominates: " << describe(d);
   EXPECT_GT(d.spatial.translation.dot(offset), 0.0) << "in the direction of the offset";
 }
