@@ -49,8 +49,9 @@ echo "== tests (sanitizers)"
 # code here in 80 steps. Likewise the device conformance tests whose time goes into long
 # CPU-reference runs (200-step trajectories, repeated runs, 16 sigma points, the whole-run
 # comparison) ran above; the one-step, re-centring and iteration-cap tests with 1 and 4
-# sigma points run here and cover the same host code.
+# sigma points run here and cover the same host code. The residual diagnostics' two 100-step
+# box runs (ResidualDiagnosticsBox) ran above too; their synthetic tests run here.
 ASAN_OPTIONS=detect_leaks=1:abort_on_error=1 UBSAN_OPTIONS=print_stacktrace=1:halt_on_error=1 \
   ctest --test-dir build-sanitize --output-on-failure -j "$jobs" \
-  -E 'BoxEstimation|WholeRun|Conformance.*(Trajectory|TwoRuns|_S16)'
+  -E 'BoxEstimation|ResidualDiagnosticsBox|WholeRun|Conformance.*(Trajectory|TwoRuns|_S16)'
 

@@ -33,6 +33,13 @@ EstimationRun run_estimation(Ensemble& ensemble, const EstimationOptions& option
     step.innovation_rms = result.innovation_rms;
     step.normalised_innovation = result.normalised_innovation;
     step.observed_rows = result.observed_rows;
+    step.innovation = Eigen::VectorXd::Constant(points.cols(), NAN);
+    step.innovation_std = Eigen::VectorXd::Constant(points.cols(), NAN);
+    for (std::size_t j = 0; j < result.observed_indices.size(); ++j) {
+      const auto row = static_cast<Eigen::Index>(j);
+      step.innovation[result.observed_indices[j]] = result.innovation[row];
+      step.innovation_std[result.observed_indices[j]] = std::sqrt(result.innovation_variance[row]);
+    }
     for (std::size_t s = 0; s < result.ensemble.cg_iterations.size(); ++s)
       step.max_cg_iterations = std::max(step.max_cg_iterations, result.ensemble.cg_iterations[s]);
     step.unconverged_sigma_points = result.ensemble.unconverged_count();

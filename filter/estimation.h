@@ -30,6 +30,12 @@ struct EstimationStep {
   Eigen::VectorXd stiffness_std;   // exp(theta_hat) * std(theta): first-order std, N/m
   Eigen::VectorXd log_std;         // std(theta)
   double innovation_rms = 0.0;     // m
+  // For the residual diagnostics (filter/residual_diagnostics.h), on all 3m rows of the data
+  // (NaN where the row was missing): the innovation z_bar (observed - predicted mean, m) and
+  // sqrt(diag(S)), its standard deviation as the filter sees it (m), so z_i / sqrt(S_ii) is
+  // N(0, 1) when the filter is consistent.
+  Eigen::VectorXd innovation;
+  Eigen::VectorXd innovation_std;
   double normalised_innovation = 0.0;
   int observed_rows = 0;
   bool change_detected = false;

@@ -85,6 +85,7 @@ RoukfStep Roukf::step(const Eigen::Vector3d& so_position, const Eigen::VectorXd&
   Eigen::MatrixXd Z(m, r);
   for (int j = 0; j < m; ++j) Z.row(j) = y[rows[j]] - predicted.row(rows[j]).array();
   result.observed_rows = m;
+  result.observed_indices = rows;
 
   // Prediction of the parameter block: theta does not evolve, so the mean stays theta_hat and
   // L_theta = alpha sum theta_i I_i^T (= L_theta for both sets, computed as the definition).
@@ -101,6 +102,11 @@ RoukfStep Roukf::step(const Eigen::Vector3d& so_position, const Eigen::VectorXd&
     result.innovation = z_bar;
     result.innovation_rms = std::sqrt(z_bar.squaredNorm() / m);
     result.normalised_innovation = correct(Z);
+    // diag(S) = row norms of HL (H P^- H^T = HL HL^T) plus R's diagonal: what standardises
+    // each row's innovation for the residual diagnostics, at the cost of one m x p product.
+    const Eigen::MatrixXd HL = alpha * Z * I.transpose();
+    result.innovation_variance = HL.rowwise().squaredNorm().array() +
+                                 options_.observation_std * options_.observation_std;
     theta_ += L_theta_ * correction_;
   }
   result.theta = theta_;

@@ -35,6 +35,8 @@ struct RoukfStep {
   Eigen::VectorXd theta;                // corrected theta_hat
   Eigen::MatrixXd theta_covariance;     // L_theta U^-1 L_theta^T
   Eigen::VectorXd innovation;           // z_bar on the observed rows (observed - predicted mean)
+  Eigen::VectorXd innovation_variance;  // diag(S) on the observed rows, S = H P^- H^T + R
+  std::vector<int> observed_indices;    // the rows of y that `innovation` holds, increasing
   int observed_rows = 0;                // rows of y that were not missing
   double innovation_rms = 0.0;          // sqrt(mean z_bar^2) over the observed rows (NaN if none)
   double normalised_innovation = 0.0;   // z_bar^T S^-1 z_bar, S = H P^- H^T + R (chi^2, m dof)

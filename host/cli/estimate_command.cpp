@@ -21,7 +21,7 @@ Action add_estimate_command(CLI::App& app) {
   auto options = std::make_shared<Options>();
   CLI::App* sub = app.add_subcommand(
       "estimate", "Estimate the ligament stiffnesses from observations with the ROUKF and write "
-                  "estimates.csv, summary.json, stiffness.png and innovation.png");
+                  "estimates.csv, summary.json, residual.json, stiffness.png, innovation.png and residual.png");
   sub->add_option("scenario", options->scenario, "Scenario JSON file (with a filter block)")->required();
   sub->add_option("--data", options->job.data_dir, "Folder with observations.csv (and truth.csv)")
       ->required();

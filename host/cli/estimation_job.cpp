@@ -8,6 +8,7 @@
 #include <optional>
 
 #include "filter/estimation.h"
+#include "filter/residual_diagnostics.h"
 #include "host/cli/estimation_report.h"
 #include "host/common/input_error.h"
 #include "host/common/progress.h"
@@ -76,6 +77,7 @@ json run_estimation_job(const Scenario& scenario, const EstimationJob& job) {
   report.sigma_count = sigma_count;
   for (int l : spec.estimate) report.names.push_back(scenario.ligaments[l].name);
   report.truth = truth;
+  report.observed_positions = mean_observed_positions(table.points);
   report.total_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   return write_estimation_report(report, run);
 }
@@ -108,13 +110,26 @@ void print_estimation_summary(std::ostream& out, const json& summary, const std:
       out << '\n';
     }
   }
+  if (summary["residual"].is_object()) {
+    const auto& residual = summary["residual"];
+    out << "  residuals: " << residual["verdict"].get<std::string>();
+    if (!residual["failed_tests"].empty()) {
+      out << " (failed:";
+      for (const auto& name : residual["failed_tests"]) out << ' ' << name.get<std::string>();
+      out << ')';
+    }
+    out << '\n';
+  }
   const fs::path dir(out_dir);
   out << "  " << (dir / "estimates.csv").string() << "\n  " << (dir / "summary.json").string() << '\n';
+  if (summary["residual"].is_object()) out << "  " << summary["residual"]["file"].get<std::string>() << '\n';
   if (summary["plots"].contains("skipped"))
     out << "  plots skipped: " << summary["plots"]["skipped"].get<std::string>() << '\n';
   else
     out << "  " << summary["plots"]["stiffness"].get<std::string>() << "\n  "
         << summary["plots"]["innovation"].get<std::string>() << '\n';
+  if (summary["plots"].contains("residual"))
+    out << "  " << summary["plots"]["residual"].get<std::string>() << '\n';
 }
 
 }  // namespace sigmafem::cli

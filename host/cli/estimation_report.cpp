@@ -5,6 +5,7 @@
 #include <sstream>
 
 #include "host/cli/plot.h"
+#include "host/cli/residual_report.h"
 #include "host/common/atomic_file.h"
 #include "host/data/csv_format.h"
 
@@ -192,6 +193,20 @@ nlohmann::ordered_json write_estimation_report(const EstimationReport& report, c
     summary["errors"] = nullptr;
   }
 
+  // Residual diagnostics (issue 6): does the model explain the data?
+  const InnovationSeries series = innovation_series(run);
+  std::optional<ResidualDiagnostics> residual;
+  if (!run.steps.empty() && 3 * report.observed_positions.rows() == series.innovation.cols()) {
+    residual = diagnose_residuals(series, report.observed_positions, report.residual);
+    const fs::path file = out / "residual.json";
+    write_file_atomically(file.string(), residual_json(*residual, report.residual).dump(2) + "\n");
+    summary["residual"] = {{"verdict", to_string(residual->verdict.consistency)},
+                           {"failed_tests", residual->verdict.failed()},
+                           {"file", file.string()}};
+  } else {
+    summary["residual"] = nullptr;
+  }
+
   json plots = json::object();
   if (run.steps.empty()) {
     plots["skipped"] = "no filter step";
@@ -202,6 +217,10 @@ nlohmann::ordered_json write_estimation_report(const EstimationReport& report, c
     plot_innovation(report, run, (out / "innovation.png").string());
     plots["stiffness"] = (out / "stiffness.png").string();
     plots["innovation"] = (out / "innovation.png").string();
+    if (residual) {
+      plot_residuals(*residual, series, report.scenario_name, (out / "residual.png").string());
+      plots["residual"] = (out / "residual.png").string();
+    }
   }
   summary["plots"] = plots;
   write_file_atomically((out / "summary.json").string(), summary.dump(2) + "\n");

@@ -1,6 +1,8 @@
-// The outputs of `sigmafem estimate` (docs/FORMATS.md): estimates.csv, summary.json and two
-// PNG plots (estimated stiffness with a +-2 std band against the truth, one line per
-// ligament, as the seed paper's Figures 3 and 4; innovation RMS over the steps).
+// The outputs of `sigmafem estimate` (docs/FORMATS.md): estimates.csv, summary.json,
+// residual.json (the residual diagnostics and their verdict, host/cli/residual_report.h) and
+// three PNG plots (estimated stiffness with a +-2 std band against the truth, one line per
+// ligament, as the seed paper's Figures 3 and 4; innovation RMS over the steps; NIS and
+// standardised innovations over the steps).
 #pragma once
 
 #include <nlohmann/json.hpp>
@@ -10,6 +12,7 @@
 
 #include "filter/estimation.h"
 #include "filter/error_figures.h"
+#include "filter/residual_diagnostics.h"
 #include "host/data/truth_table.h"
 
 namespace sigmafem::cli {
@@ -23,6 +26,9 @@ struct EstimationReport {
   int sigma_count = 0;
   std::vector<std::string> names;             // estimated ligaments
   std::optional<TruthTable> truth;            // when the data folder has truth.csv
+  Eigen::MatrixX3d observed_positions;        // m x 3: mean observed position of each point (m),
+                                              // the lever arms of the residual's rigid part
+  ResidualDiagnosticsOptions residual;        // burn-in, lags, false-alarm rate
   double total_seconds = 0.0;
 };
 

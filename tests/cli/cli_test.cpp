@@ -146,7 +146,7 @@ TEST_F(CliTest, RejectsBadOptions) {
   EXPECT_NE(run_sigmafem("no-such-command").exit_code, 0);
 }
 
-TEST_F(CliTest, EstimateWritesEstimatesSummaryAndPlots) {
+TEST_F(CliTest, EstimateWritesEstimatesSummaryResidualsAndPlots) {
   json scenario = box_;
   scenario["time"]["steps"] = 30;
   std::ofstream(dir_ / "short.json") << scenario.dump(2);
@@ -165,10 +165,18 @@ TEST_F(CliTest, EstimateWritesEstimatesSummaryAndPlots) {
   EXPECT_EQ(summary["filter_steps"].get<int>(), 30);
   EXPECT_TRUE(summary["errors"].is_object()) << "truth.csv was in the data folder";
   EXPECT_TRUE(summary["final"].contains("middle"));
+  // The residual diagnostics: 30 steps less the 10% burn-in, six tests and a verdict.
+  ASSERT_TRUE(summary["residual"].is_object());
+  std::ifstream residual_file(out / "residual.json");
+  const json residual = json::parse(residual_file);
+  EXPECT_EQ(residual["verdict"], summary["residual"]["verdict"]);
+  EXPECT_EQ(residual["steps_used"].get<int>(), 27);
+  EXPECT_EQ(residual["tests"].size(), 6u);
+  EXPECT_EQ(residual["bias"]["rows"].size(), 36u) << "12 observed points, 3 axes";
   if (summary["plots"].contains("skipped")) {
     GTEST_SKIP() << "plots not checked: " << summary["plots"]["skipped"];
   }
-  for (const char* png : {"stiffness.png", "innovation.png"}) {
+  for (const char* png : {"stiffness.png", "innovation.png", "residual.png"}) {
     std::ifstream in(out / png, std::ios::binary);
     char magic[8] = {};
     in.read(magic, 8);

@@ -103,6 +103,12 @@ TEST_P(RoukfExactTest, MatchesTheExactKalmanFilterStepAfterStep) {
         << to_string(GetParam()) << " step " << k << ": state";
     EXPECT_NEAR(result.normalised_innovation, exact_nis, kExact * (1.0 + exact_nis))
         << to_string(GetParam()) << " step " << k << ": normalised innovation squared";
+    // What the residual diagnostics keep: the innovation and diag(S), row by row.
+    ASSERT_EQ(result.innovation_variance.size(), m);
+    EXPECT_LT((result.innovation - innovation).norm(), kExact * (1.0 + innovation.norm()))
+        << to_string(GetParam()) << " step " << k << ": innovation";
+    EXPECT_LT((result.innovation_variance - S.diagonal()).norm(), kExact * S.diagonal().norm())
+        << to_string(GetParam()) << " step " << k << ": diagonal of the innovation covariance";
   }
   // And the filter learnt something: theta moved towards the truth.
   EXPECT_LT((filter.theta() - model.theta_true).norm(), 0.5 * model.theta_true.norm());
