@@ -14,6 +14,7 @@
 #include "host/ensemble/make_ensemble.h"
 #include "host/model/model.h"
 #include "host/reference/reference_simulation.h"
+#include "host/scenario/estimation_options.h"
 
 namespace sigmafem {
 namespace {
@@ -93,18 +94,13 @@ void BM_ensemble_step(benchmark::State& state, const Backend& backend, const std
 void BM_filter_step(benchmark::State& state, const Backend& backend) {
   const Scenario& s = bench::scenario("liver", 0);
   const Model model = make_model(s);
-  RoukfOptions options;
+  RoukfOptions options = estimation_options(s).roukf;
   options.sigma_points = SigmaPointSet::simplex;
-  options.initial_theta = Eigen::VectorXd(static_cast<Eigen::Index>(s.filter->estimate.size()));
-  for (std::size_t j = 0; j < s.filter->estimate.size(); ++j)
-    options.initial_theta[static_cast<Eigen::Index>(j)] = std::log(s.filter->initial_stiffness[j]);
-  options.initial_log_std = s.filter->initial_log_std;
-  options.parameter_drift_log_std = s.filter->parameter_drift_log_std;
-  options.observation_std = s.filter->observation_std;
   std::unique_ptr<Ensemble> ensemble;
   try {
     ensemble = make_ensemble(backend.name, model, s.filter->estimate, s.observations.nodes,
-                             static_cast<int>(s.filter->estimate.size()) + 1,
+                             sigma_point_count(SigmaPointSet::simplex,
+                                               static_cast<int>(s.filter->estimate.size())),
                              device_options(backend));
   } catch (const std::exception& e) {
     state.SkipWithError(e.what());

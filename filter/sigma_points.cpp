@@ -49,4 +49,8 @@ SigmaPoints make_sigma_points(SigmaPointSet set, int p) {
   return points;
 }
 
+int sigma_point_count(SigmaPointSet set, int parameter_count) {
+  return set == SigmaPointSet::simplex ? parameter_count + 1 : 2 * parameter_count + 1;
+}
+
 }  // namespace sigmafem

@@ -30,4 +30,7 @@ struct SigmaPoints {
 
 SigmaPoints make_sigma_points(SigmaPointSet set, int parameter_count);
 
+// r: p + 1 for the simplex set, 2p + 1 for the star set.
+int sigma_point_count(SigmaPointSet set, int parameter_count);
+
 }  // namespace sigmafem

@@ -16,6 +16,7 @@
 #include "host/data/truth_table.h"
 #include "host/ensemble/make_ensemble.h"
 #include "host/model/model.h"
+#include "host/scenario/estimation_options.h"
 
 namespace sigmafem::cli {
 namespace fs = std::filesystem;
@@ -37,23 +38,10 @@ json run_estimation_job(const Scenario& scenario, const EstimationJob& job) {
   std::optional<TruthTable> truth;
   if (fs::exists(data / "truth.csv")) truth = read_truth_csv((data / "truth.csv").string());
 
-  EstimationOptions options;
-  const std::string set_name = job.sigma_points.empty() ? spec.sigma_points : job.sigma_points;
-  options.roukf.sigma_points = parse_sigma_point_set(set_name);
-  options.roukf.initial_theta.resize(static_cast<Eigen::Index>(spec.estimate.size()));
-  for (std::size_t j = 0; j < spec.estimate.size(); ++j)
-    options.roukf.initial_theta[static_cast<Eigen::Index>(j)] = std::log(spec.initial_stiffness[j]);
-  options.roukf.initial_log_std = spec.initial_log_std;
-  options.roukf.parameter_drift_log_std = spec.parameter_drift_log_std;
-  options.roukf.observation_std = spec.observation_std;
-  const ChangeDetectionSpec& detection = spec.change_detection;
-  if (detection.enabled) options.detector.enabled = *detection.enabled;
-  if (detection.window) options.detector.window = *detection.window;
-  if (detection.false_alarm) options.detector.false_alarm = *detection.false_alarm;
-  if (detection.hold_off) options.detector.hold_off = *detection.hold_off;
-  if (detection.inflation_log_std) options.detector.inflation_log_std = *detection.inflation_log_std;
-  const int p = static_cast<int>(spec.estimate.size());
-  const int sigma_count = options.roukf.sigma_points == SigmaPointSet::simplex ? p + 1 : 2 * p + 1;
+  EstimationOptions options = estimation_options(scenario);
+  if (!job.sigma_points.empty()) options.roukf.sigma_points = parse_sigma_point_set(job.sigma_points);
+  const int sigma_count =
+      sigma_point_count(options.roukf.sigma_points, static_cast<int>(spec.estimate.size()));
 
   fs::create_directories(job.out_dir);
   std::unique_ptr<Ensemble> ensemble =

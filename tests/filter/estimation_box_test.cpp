@@ -76,7 +76,7 @@ BoxRun run_box(const BoxData& data, SigmaPointSet set, double observation_std,
   const EstimationOptions options = filter_options(s, set, observation_std);
   const int p = static_cast<int>(s.filter->estimate.size());
   CpuEnsemble ensemble(make_model(s), s.filter->estimate, s.observations.nodes,
-                       set == SigmaPointSet::simplex ? p + 1 : 2 * p + 1);
+                       sigma_point_count(set, p));
   BoxRun box;
   box.run = run_estimation(ensemble, options, data.observations.times, data.observations.so,
                            points, {});

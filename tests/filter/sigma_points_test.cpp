@@ -18,6 +18,7 @@ TEST_P(SigmaPointsTest, DirectionsSumToZeroWithIdentityCovariance) {
     const SigmaPoints points = make_sigma_points(GetParam(), p);
     const int expected = GetParam() == SigmaPointSet::simplex ? p + 1 : 2 * p + 1;
     ASSERT_EQ(points.count(), expected) << to_string(GetParam()) << " p=" << p;
+    EXPECT_EQ(sigma_point_count(GetParam(), p), expected) << to_string(GetParam()) << " p=" << p;
     EXPECT_NEAR(points.alpha * points.count(), 1.0, kRounding) << "weights sum to one";
     const Eigen::VectorXd sum = points.directions.rowwise().sum();
     EXPECT_LT(sum.norm(), kRounding) << to_string(GetParam()) << " p=" << p << ": sum V_i";

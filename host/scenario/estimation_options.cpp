@@ -1,0 +1,26 @@
+#include "host/scenario/estimation_options.h"
+
+#include <cmath>
+
+namespace sigmafem {
+
+EstimationOptions estimation_options(const Scenario& scenario) {
+  const FilterSpec& spec = *scenario.filter;
+  EstimationOptions options;
+  options.roukf.sigma_points = parse_sigma_point_set(spec.sigma_points);
+  options.roukf.initial_theta.resize(static_cast<Eigen::Index>(spec.estimate.size()));
+  for (std::size_t j = 0; j < spec.estimate.size(); ++j)
+    options.roukf.initial_theta[static_cast<Eigen::Index>(j)] = std::log(spec.initial_stiffness[j]);
+  options.roukf.initial_log_std = spec.initial_log_std;
+  options.roukf.parameter_drift_log_std = spec.parameter_drift_log_std;
+  options.roukf.observation_std = spec.observation_std;
+  const ChangeDetectionSpec& detection = spec.change_detection;
+  if (detection.enabled) options.detector.enabled = *detection.enabled;
+  if (detection.window) options.detector.window = *detection.window;
+  if (detection.false_alarm) options.detector.false_alarm = *detection.false_alarm;
+  if (detection.hold_off) options.detector.hold_off = *detection.hold_off;
+  if (detection.inflation_log_std) options.detector.inflation_log_std = *detection.inflation_log_std;
+  return options;
+}
+
+}  // namespace sigmafem
