@@ -204,10 +204,9 @@ OpenClEnsemble::OpenClEnsemble(const Model& model, std::vector<int> estimated,
              constants_, inverse_diagonal_, dv_, r_, z_, d_, q_, bb_, rr_, rz_, active_,
              converged_, iterations_);
     set_args(k_cg_solve_, S, E, N, static_cast<cl_int>(model.solver.cg_max_iterations),
-             constants_, element_nodes_, element_rest_, frames_, incidence_offsets_, incidence_,
-             ligament_offsets_, ligament_of_node_, ligament_k_buffer_, control_k_, mass_, rhs_,
-             inverse_diagonal_, dv_, r_, z_, d_, q_, element_out_, bb_, rr_, rz_, active_,
-             converged_, iterations_);
+             constants_, element_nodes_, element_rest_, frames_, ligament_offsets_,
+             ligament_of_node_, ligament_k_buffer_, control_k_, mass_, rhs_, inverse_diagonal_,
+             dv_, r_, z_, d_, q_, bb_, rr_, rz_, active_, converged_, iterations_);
     set_args(k_state_update_, S, rows, constants_, bb_, dv_, x_, v_);
     set_args(k_observation_gather_, S, static_cast<cl_uint>(observed_.size()), observed_nodes_,
              x_, observations_);

@@ -13,13 +13,13 @@
  * enqueue several iterations between checks without changing anyone's result.
  *
  * The whole solve in one launch (cg_solve, below). One work-item takes a block of sigma
- * points and does their products itself, so a step costs one launch instead of three per
- * iteration: on a CPU, where a launch costs tens of microseconds, that is most of the time
- * on small meshes (the filter step).
+ * points and does their products itself, adding each element's product straight into q, so
+ * a step costs one launch instead of three per iteration and no element outputs go through
+ * memory: on a CPU, where a launch costs tens of microseconds, that is most of the time on
+ * small meshes (the filter step).
  *
  * Per-sigma scalars (arrays of S): bb = b.b, rr = r.r, rz = r.z, active (1 while iterating),
  * converged (1 converged, 0 hit the cap or broke down), iterations (products done). */
-#include "element_product.h"
 #include "node_assembly.h"
 
 /* Work-items per sigma point: a power of two (the host passes the same number). */
@@ -163,15 +163,31 @@ void cg_iteration(uint S, uint node_count, int max_iterations, __global const re
 #  define SF_SOLVE_BLOCK 1
 #endif
 
-/* Sigma points first .. first + count - 1's element products of d. The products of every
- * sigma point of the block are computed, finished ones too (their outputs are not used):
- * the loop over the block then has no branch and vectorises. */
-static inline __attribute__((always_inline)) void sf_block_element_products(uint first, uint count, uint S, uint element_count,
-                                             __global const int* restrict nodes,
-                                             __global const real* restrict rest,
-                                             __global const real* restrict frames,
-                                             __global const real* restrict d,
-                                             __global real* restrict out) {
+/* q = A d for sigma points first .. first + SF_SOLVE_BLOCK - 1: the nodal terms (mass and
+ * springs), then each element's product added at its four corners, element by element. One
+ * work-item owns these sigma points' rows, so the sums need no atomics and come in the same
+ * order every run; and no element outputs go through memory, as they must between the
+ * per-iteration kernels. */
+static inline __attribute__((always_inline)) void sf_block_system_product(
+    uint first, uint S, uint element_count, uint node_count, __global const real* restrict c,
+    __global const int* restrict nodes, __global const real* restrict rest,
+    __global const real* restrict frames, __global const int* restrict ligament_offsets,
+    __global const int* restrict ligament_of_node, __global const real* restrict ligament_k,
+    __global const real* restrict control_k, __global const real* restrict mass,
+    __global const real* restrict d, __global real* restrict q) {
+  for (uint n = 0; n < node_count; ++n) {
+    for (uint i = 0; i < SF_SOLVE_BLOCK; ++i) {
+      uint s = first + i;
+      real spring = sf_node_spring(ligament_offsets, ligament_of_node, ligament_k, control_k, n, s, S);
+      real nodal = c[SF_MASS_FACTOR] * sf_solver_mass(mass[n], spring) + c[SF_STIFFNESS_FACTOR] * spring;
+      SF_UNROLL
+      for (int k = 0; k < 3; ++k) {
+        size_t row = ((size_t)3 * n + k) * S + s;
+        q[row] = nodal * d[row];
+      }
+    }
+  }
+  const real stiffness_factor = c[SF_STIFFNESS_FACTOR];
   for (uint e = 0; e < element_count; ++e) {
     real grad[12];
     real vlambda;
@@ -179,20 +195,32 @@ static inline __attribute__((always_inline)) void sf_block_element_products(uint
     sf_load_rest(rest, e, grad, &vlambda, &vmu);
     int corner_nodes[4];
     sf_load_nodes(nodes, e, corner_nodes);
-    for (uint b = 0; b < count; ++b)
-      sf_element_product_of(grad, vlambda, vmu, corner_nodes, frames, d, e, first + b, S, out);
+    for (uint i = 0; i < SF_SOLVE_BLOCK; ++i) {
+      uint s = first + i;
+      real frame[9];
+      real corner[12];
+      real product[12];
+      sf_load_frame(frames, e, s, S, frame);
+      sf_gather_corners(d, corner_nodes, s, S, corner);
+      sf_element_product(frame, grad, vlambda, vmu, corner, product);
+      SF_UNROLL
+      for (int a = 0; a < 4; ++a) {
+        size_t base = (size_t)(3 * corner_nodes[a]) * S + s;
+        SF_UNROLL
+        for (int k = 0; k < 3; ++k) q[base + (size_t)k * S] += stiffness_factor * product[3 * a + k];
+      }
+    }
   }
 }
 
-/* The whole CG solve of a block of sigma points (x = dv, warm-started), the same arithmetic
- * as cg_start and cg_iteration but with the dot products summed in row order. Work-item i
- * takes sigma points i * SF_SOLVE_BLOCK onwards; the solve of the block goes on until every
- * sigma point of it has stopped, the finished ones left as they are. */
+/* The whole CG solve of a block of sigma points (x = dv, warm-started), the same algorithm
+ * as cg_start and cg_iteration with the dot products summed in row order. Work-item i takes
+ * sigma points i * SF_SOLVE_BLOCK onwards; the solve of the block goes on until every sigma
+ * point of it has stopped, the finished ones left as they are (their products are still
+ * computed: the loops over the block then have no branch). */
 __kernel void cg_solve(uint S, uint element_count, uint node_count, int max_iterations,
                        __global const real* restrict c, __global const int* restrict nodes,
                        __global const real* restrict rest, __global const real* restrict frames,
-                       __global const int* restrict incidence_offsets,
-                       __global const int* restrict incidence,
                        __global const int* restrict ligament_offsets,
                        __global const int* restrict ligament_of_node,
                        __global const real* restrict ligament_k,
@@ -200,39 +228,35 @@ __kernel void cg_solve(uint S, uint element_count, uint node_count, int max_iter
                        __global const real* restrict b, __global const real* restrict inverse_diagonal,
                        __global real* restrict x, __global real* restrict r,
                        __global real* restrict z, __global real* restrict d,
-                       __global real* restrict q, __global real* restrict element_out,
-                       __global real* restrict bb, __global real* restrict rr,
-                       __global real* restrict rz, __global uint* restrict active,
-                       __global uint* restrict converged, __global int* restrict iterations) {
-  /* The host makes SF_SOLVE_BLOCK divide S: the block's loops have a fixed length. */
+                       __global real* restrict q, __global real* restrict bb,
+                       __global real* restrict rr, __global real* restrict rz,
+                       __global uint* restrict active, __global uint* restrict converged,
+                       __global int* restrict iterations) {
   const uint count = SF_SOLVE_BLOCK;
   uint first = (uint)get_global_id(0) * count;
   if (first >= S) return;
   const real tolerance2 = c[SF_CG_TOLERANCE2];
+  const uint rows = 3 * node_count;
 
   /* The warm start: r = b - A x, z = M^-1 r, d = z. */
-  sf_block_element_products(first, count, S, element_count, nodes, rest, frames, x, element_out);
+  sf_block_system_product(first, S, element_count, node_count, c, nodes, rest, frames,
+                          ligament_offsets, ligament_of_node, ligament_k, control_k, mass, x, q);
   real sum_bb[SF_SOLVE_BLOCK];
   real sum_rr[SF_SOLVE_BLOCK];
   real sum_rz[SF_SOLVE_BLOCK];
   for (uint i = 0; i < count; ++i) sum_bb[i] = sum_rr[i] = sum_rz[i] = (real)0;
-  for (uint n = 0; n < node_count; ++n) {
+  for (uint row = 0; row < rows; ++row) {
     for (uint i = 0; i < count; ++i) {
-      uint s = first + i;
-      real spring = sf_node_spring(ligament_offsets, ligament_of_node, ligament_k, control_k, n, s, S);
-      real m = sf_solver_mass(mass[n], spring);
-      SF_UNROLL
-      for (int k = 0; k < 3; ++k) {
-        size_t row = ((size_t)3 * n + k) * S + s;
-        real ri = b[row] - sf_system_row(c, element_out, incidence_offsets, incidence, spring, m, x, n, k, s, S);
-        real zi = inverse_diagonal[row] * ri;
-        r[row] = ri;
-        z[row] = zi;
-        d[row] = zi;
-        sum_bb[i] += b[row] * b[row];
-        sum_rr[i] += ri * ri;
-        sum_rz[i] += ri * zi;
-      }
+      size_t at = (size_t)row * S + first + i;
+      real bi = b[at];
+      real ri = bi - q[at];
+      real zi = inverse_diagonal[at] * ri;
+      r[at] = ri;
+      z[at] = zi;
+      d[at] = zi;
+      sum_bb[i] += bi * bi;
+      sum_rr[i] += ri * ri;
+      sum_rz[i] += ri * zi;
     }
   }
   int going[SF_SOLVE_BLOCK];
@@ -248,23 +272,15 @@ __kernel void cg_solve(uint S, uint element_count, uint node_count, int max_iter
 
   while (any) {
     /* q = A d and d.q */
-    sf_block_element_products(first, count, S, element_count, nodes, rest, frames, d, element_out);
+    sf_block_system_product(first, S, element_count, node_count, c, nodes, rest, frames,
+                            ligament_offsets, ligament_of_node, ligament_k, control_k, mass, d, q);
     real sum_dq[SF_SOLVE_BLOCK];
     for (uint i = 0; i < count; ++i) sum_dq[i] = (real)0;
-    for (uint n = 0; n < node_count; ++n) {
+    for (uint row = 0; row < rows; ++row)
       for (uint i = 0; i < count; ++i) {
-        uint s = first + i;
-        real spring = sf_node_spring(ligament_offsets, ligament_of_node, ligament_k, control_k, n, s, S);
-        real m = sf_solver_mass(mass[n], spring);
-        SF_UNROLL
-        for (int k = 0; k < 3; ++k) {
-          size_t row = ((size_t)3 * n + k) * S + s;
-          real qi = sf_system_row(c, element_out, incidence_offsets, incidence, spring, m, d, n, k, s, S);
-          q[row] = qi;
-          sum_dq[i] += d[row] * qi;
-        }
+        size_t at = (size_t)row * S + first + i;
+        sum_dq[i] += d[at] * q[at];
       }
-    }
     /* x += alpha d, r -= alpha q, z = M^-1 r; a finished sigma point gets alpha = 0. */
     real alpha[SF_SOLVE_BLOCK];
     real rr_new[SF_SOLVE_BLOCK];
@@ -273,7 +289,7 @@ __kernel void cg_solve(uint S, uint element_count, uint node_count, int max_iter
       alpha[i] = going[i] ? sum_rz[i] / sum_dq[i] : (real)0;
       rr_new[i] = rz_new[i] = (real)0;
     }
-    for (uint row = 0; row < 3 * node_count; ++row) {
+    for (uint row = 0; row < rows; ++row) {
       for (uint i = 0; i < count; ++i) {
         size_t at = (size_t)row * S + first + i;
         x[at] += alpha[i] * d[at];
@@ -301,7 +317,7 @@ __kernel void cg_solve(uint S, uint element_count, uint node_count, int max_iter
       any |= going[i];
     }
     if (!any) break;
-    for (uint row = 0; row < 3 * node_count; ++row) {
+    for (uint row = 0; row < rows; ++row) {
       for (uint i = 0; i < count; ++i) {
         size_t at = (size_t)row * S + first + i;
         d[at] = going[i] ? z[at] + beta[i] * d[at] : d[at];

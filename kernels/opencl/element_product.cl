@@ -7,7 +7,7 @@
  * on a GPU one (element, sigma) each; on a CPU all of them, so that the element's rest
  * state is loaded once and the loop over sigma points, whose data are contiguous, is
  * vectorised by the compiler. */
-#include "element_product.h"
+#include "ensemble_layout.h"
 
 __kernel void element_product(uint S, uint element_count, __global const int* restrict nodes,
                               __global const real* restrict rest, __global const real* restrict frames,
@@ -23,9 +23,16 @@ __kernel void element_product(uint S, uint element_count, __global const int* re
   int corner_nodes[4];
   sf_load_nodes(nodes, e, corner_nodes);
   for (uint b = 0; b < SF_SIGMA_BLOCK; ++b) {
+    uint s = first + b;
 #if SF_SIGMA_BLOCK == 1
-    if (!active[first]) return; /* this sigma point's CG is done */
+    if (!active[s]) return; /* this sigma point's CG is done */
 #endif
-    sf_element_product_of(grad, vlambda, vmu, corner_nodes, frames, d, e, first + b, S, out);
+    real frame[9];
+    real corner[12];
+    real product[12];
+    sf_load_frame(frames, e, s, S, frame);
+    sf_gather_corners(d, corner_nodes, s, S, corner);
+    sf_element_product(frame, grad, vlambda, vmu, corner, product);
+    sf_store_corners(out, e, s, S, product);
   }
 }
