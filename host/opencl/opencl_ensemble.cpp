@@ -125,20 +125,24 @@ OpenClEnsemble::OpenClEnsemble(const Model& model, std::vector<int> estimated,
   // Element kernels: on a CPU device one work-item takes an element for all S sigma points,
   // so the compiler vectorises over them; elsewhere one work-item per (element, sigma).
   sigma_block_ = info.type == "cpu" ? S_ : 1;
-  // The per-sigma CG kernels: on a CPU one work-item per sigma point does all its rows (no
-  // barriers to pay for; measured on PoCL, 2 cores: 209 ms per liver-4768 step at S = 16
-  // against 237 ms with 8 and 259 ms with 64 work-items per sigma point).
-  cg_group_ = info.type == "cpu" ? 1 : 64;
+  // On a CPU the element product goes in contiguous chunks of elements, one per compute unit,
+  // each adding into its own copy of K d (element_product.cl), instead of element outputs.
+  element_chunks_ = info.type == "cpu" ? static_cast<int>(std::max(1u, info.compute_units)) : 0;
+  // The CG kernels (conjugate_gradient.cl): on a GPU a work-group of 64 per sigma point; on
+  // a CPU a work-item per block of sigma points, the blocks shared out over the compute
+  // units (and dividing S, so that the kernels' loops over a block have a fixed length).
+  cg_per_group_ = info.type != "cpu";
+  cg_group_ = cg_per_group_ ? 64 : 1;
+  const int units = static_cast<int>(std::max(1u, info.compute_units));
+  cg_block_ = (S_ + units - 1) / units;
+  while (S_ % cg_block_ != 0) --cg_block_;
   whole_solve_ = options.solve_launch == SolveLaunch::whole_solve ||
                  (options.solve_launch == SolveLaunch::automatic && prefers_whole_solve(info, S_));
-  // cg_solve: the sigma points shared out over the compute units, a block per work-item;
-  // the block divides S, so that the kernel's loops over it have a fixed length.
-  const int units = static_cast<int>(std::max(1u, info.compute_units));
-  solve_block_ = (S_ + units - 1) / units;
-  while (S_ % solve_block_ != 0) --solve_block_;
   device_.build_program("-DSF_SIGMA_BLOCK=" + std::to_string(sigma_block_) +
+                        " -DSF_ELEMENT_CHUNKS=" + std::to_string(element_chunks_) +
+                        " -DSF_CG_PER_GROUP=" + std::to_string(cg_per_group_ ? 1 : 0) +
                         " -DSF_GROUP_SIZE=" + std::to_string(cg_group_) +
-                        " -DSF_SOLVE_BLOCK=" + std::to_string(solve_block_));
+                        " -DSF_CG_BLOCK=" + std::to_string(cg_block_));
 
   try {
     element_nodes_ = make_buffer(element_nodes, "element nodes");
@@ -161,7 +165,9 @@ OpenClEnsemble::OpenClEnsemble(const Model& model, std::vector<int> estimated,
     for (cl::Buffer* b : {&rhs_, &inverse_diagonal_, &r_, &z_, &d_, &q_})
       *b = make_buffer(dof, "CG vectors");
     frames_ = make_buffer(9 * per_element, "element frames");
-    element_out_ = make_buffer(12 * per_element, "element outputs");
+    // Per-corner outputs of element_rhs (and of element_product on a GPU), or the chunks'
+    // copies of K d on a CPU.
+    element_out_ = make_buffer(std::max(12 * per_element, element_chunks_ * dof), "element outputs");
     element_diagonal_ = make_buffer(12 * per_element, "element diagonals");
     observations_ = make_buffer(std::max<std::size_t>(1, observed_.size()) * 3 * S_, "observations");
     for (cl::Buffer* b : {&bb_, &rr_, &rz_})
@@ -193,16 +199,23 @@ OpenClEnsemble::OpenClEnsemble(const Model& model, std::vector<int> estimated,
     // Arguments 5-6 (d, active) and 10 (d), 12 (q) are set per call.
     set_args(k_element_product_, S, E, element_nodes_, element_rest_, frames_);
     k_element_product_.setArg(7, element_out_);
+    k_element_product_.setArg(8, N);
     set_args(k_node_product_, S, N, constants_, incidence_offsets_, incidence_, ligament_offsets_,
              ligament_of_node_, ligament_k_buffer_, control_k_, mass_);
     k_node_product_.setArg(11, element_out_);
-    set_args(k_cg_start_, S, N, constants_, incidence_offsets_, incidence_, ligament_offsets_,
-             ligament_of_node_, ligament_k_buffer_, control_k_, mass_, element_out_, rhs_,
-             inverse_diagonal_, dv_, r_, z_, d_, bb_, rr_, rz_, active_, converged_,
-             iterations_);
+    set_args(k_cg_start_, S, N, constants_, q_, rhs_, inverse_diagonal_, r_, z_, d_, bb_, rr_,
+             rz_, active_, converged_, iterations_);
     set_args(k_cg_iteration_, S, N, static_cast<cl_int>(model.solver.cg_max_iterations),
              constants_, inverse_diagonal_, dv_, r_, z_, d_, q_, bb_, rr_, rz_, active_,
              converged_, iterations_);
+    if (!cg_per_group_) {  // the CPU form also does node_product's part (conjugate_gradient.cl)
+      k_cg_iteration_.setArg(16, ligament_offsets_);
+      k_cg_iteration_.setArg(17, ligament_of_node_);
+      k_cg_iteration_.setArg(18, ligament_k_buffer_);
+      k_cg_iteration_.setArg(19, control_k_);
+      k_cg_iteration_.setArg(20, mass_);
+      k_cg_iteration_.setArg(21, element_out_);
+    }
     set_args(k_cg_solve_, S, E, N, static_cast<cl_int>(model.solver.cg_max_iterations),
              constants_, element_nodes_, element_rest_, frames_, ligament_offsets_,
              ligament_of_node_, ligament_k_buffer_, control_k_, mass_, rhs_, inverse_diagonal_,
@@ -314,6 +327,13 @@ void OpenClEnsemble::run(cl::Kernel& kernel, std::size_t items, std::size_t loca
   device_.record(kernel, event);
 }
 
+void OpenClEnsemble::run_cg(cl::Kernel& kernel) const {
+  if (cg_per_group_)
+    run(kernel, cg_group_ * S_, cg_group_);
+  else
+    run(kernel, static_cast<std::size_t>(S_ / cg_block_), 1);
+}
+
 std::size_t OpenClEnsemble::element_items() const {
   return static_cast<std::size_t>(elements_) * (S_ / sigma_block_);
 }
@@ -325,7 +345,9 @@ void OpenClEnsemble::node_rhs() { run(k_node_rhs_, static_cast<std::size_t>(node
 void OpenClEnsemble::element_product(const cl::Buffer& d, const cl::Buffer& active) {
   k_element_product_.setArg(5, d);
   k_element_product_.setArg(6, active);
-  run(k_element_product_, element_items());
+  run(k_element_product_, element_chunks_ > 0 ? static_cast<std::size_t>(element_chunks_)
+                                              : element_items(),
+      element_chunks_ > 0 ? 1 : 0);
 }
 
 void OpenClEnsemble::node_product(const cl::Buffer& d, const cl::Buffer& q) {
@@ -336,12 +358,13 @@ void OpenClEnsemble::node_product(const cl::Buffer& d, const cl::Buffer& q) {
 
 void OpenClEnsemble::conjugate_gradient() {
   if (whole_solve_) {
-    run(k_cg_solve_, S_ / solve_block_, 1);
+    run(k_cg_solve_, S_ / cg_block_, 1);
     return;
   }
   // The warm start's residual (dv holds the last step's velocity change).
   element_product(dv_, all_active_);
-  run(k_cg_start_, cg_group_ * S_, cg_group_);
+  node_product(dv_, q_);
+  run_cg(k_cg_start_);
   // Iterate, checking on the host only now and then: first after as many iterations as the
   // last step needed (warm-started steps need about the same), then in small batches. A
   // sigma point that is done is left alone by the kernels, so overshooting changes nothing.
@@ -352,8 +375,8 @@ void OpenClEnsemble::conjugate_gradient() {
     const int count = std::min(batch, cap - done);
     for (int i = 0; i < count; ++i) {
       element_product(d_, active_);
-      node_product(d_, q_);
-      run(k_cg_iteration_, cg_group_ * S_, cg_group_);
+      if (cg_per_group_) node_product(d_, q_);   // on a CPU cg_iteration does it
+      run_cg(k_cg_iteration_);
     }
     done += count;
     device_.queue().enqueueReadBuffer(active_, CL_TRUE, 0, S_ * sizeof(cl_uint), active.data());

@@ -68,6 +68,7 @@ class OpenClEnsemble : public DeviceEnsemble {
   void node_product(const cl::Buffer& d, const cl::Buffer& q);
   void conjugate_gradient();
   void run(cl::Kernel& kernel, std::size_t items, std::size_t local = 0) const;
+  void run_cg(cl::Kernel& kernel) const;   // cg_start or cg_iteration, as SF_CG_PER_GROUP
 
   mutable OpenClDevice device_;
   Model model_;                             // a copy: the ensemble outlives its caller's model
@@ -76,11 +77,13 @@ class OpenClEnsemble : public DeviceEnsemble {
   double tolerance_ = 0.0;
   std::size_t device_bytes_ = 0;
   std::vector<double> ligament_k_;          // per ligament and sigma, N/m per node: [l * S + s]
-  std::size_t cg_group_ = 64;               // SF_GROUP_SIZE: work-items per sigma point in CG
+  bool cg_per_group_ = true;                // SF_CG_PER_GROUP: CG kernels a group per sigma (GPU)
+  std::size_t cg_group_ = 64;               // SF_GROUP_SIZE: work-items per sigma point then
   int sigma_block_ = 1;                     // SF_SIGMA_BLOCK: sigma points per element work-item
+  int element_chunks_ = 0;                  // SF_ELEMENT_CHUNKS: element_product's chunks (CPU)
   int expected_iterations_ = 1;             // CG iterations the last step needed (at most)
   bool whole_solve_ = false;                // cg_solve (one launch) instead of per iteration
-  int solve_block_ = 1;                     // SF_SOLVE_BLOCK: sigma points per work-item of cg_solve
+  int cg_block_ = 1;                        // SF_CG_BLOCK: sigma points per CG work-item (CPU)
 
   // Shared data.
   cl::Buffer element_nodes_, element_rest_, incidence_offsets_, incidence_;

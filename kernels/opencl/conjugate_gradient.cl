@@ -1,27 +1,38 @@
 /* conjugate_gradient: Jacobi-preconditioned CG for all sigma points at once, with per-sigma
  * scalars and a per-sigma convergence flag (host: host/reference/conjugate_gradient.h, the
- * same stopping rule |r| <= tolerance |b|). Two ways to run it, chosen by the host
+ * same stopping rule |r| <= tolerance |b|). Ways to run it, chosen by the host
  * (OpenClEnsemble::conjugate_gradient):
  *
- * Per iteration (cg_start, then cg_iteration after every product q = A d). One work-group per
- * sigma point owns every row of that sigma point, so the rest of a CG iteration after the
- * product is one kernel: d.q, the update with r.r and r.z, the convergence test and the new
- * direction, with the dot products reduced inside the group (a fixed tree: the same bits
- * every run) and no host round trip. Per iteration the host enqueues three kernels
- * (element_product, node_product, cg_iteration). A sigma point that has converged (or hit the
- * iteration cap, or broke down) is inactive and its group returns at once, so the host may
- * enqueue several iterations between checks without changing anyone's result.
+ * Per iteration: cg_start, then cg_iteration after every product q = A d (element_product,
+ * node_product: three launches per iteration; on a CPU cg_iteration does node_product's
+ * part itself: two). A sigma point that has converged (or hit the
+ * iteration cap, or broke down) is inactive and left alone, so the host may enqueue several
+ * iterations between checks without changing anyone's result. Two forms of these kernels:
+ *  - a GPU (SF_CG_PER_GROUP = 1): one work-group per sigma point owns its rows and reduces
+ *    its dot products in the group (a fixed tree: the same bits every run);
+ *  - a CPU (SF_CG_PER_GROUP = 0): one work-item per block of SF_CG_BLOCK sigma points (S over
+ *    the compute units) goes down the rows with the block innermost, on contiguous data:
+ *    vectorised, and each cache line read once (one work-item per sigma point read a line per
+ *    sigma point, 16 times at S = 16). Dot products are summed in row order.
  *
- * The whole solve in one launch (cg_solve, below). One work-item takes a block of sigma
- * points and does their products itself, adding each element's product straight into q, so
- * a step costs one launch instead of three per iteration and no element outputs go through
- * memory: on a CPU, where a launch costs tens of microseconds, that is most of the time on
- * small meshes (the filter step).
+ * The whole solve in one launch (cg_solve, below), on a CPU: the blocked work-item also does
+ * its sigma points' products itself, adding each element's product straight into q, so a
+ * step costs one launch instead of three per iteration: where a launch costs tens of
+ * microseconds (PoCL), that is most of the time on small meshes (the filter step).
  *
  * Per-sigma scalars (arrays of S): bb = b.b, rr = r.r, rz = r.z, active (1 while iterating),
  * converged (1 converged, 0 hit the cap or broke down), iterations (products done). */
 #include "node_assembly.h"
 
+/* Sigma points per work-item of the blocked kernels, a divisor of S. */
+#ifndef SF_CG_BLOCK
+#  define SF_CG_BLOCK 1
+#endif
+#ifndef SF_CG_PER_GROUP
+#  define SF_CG_PER_GROUP 1
+#endif
+
+#if SF_CG_PER_GROUP
 /* Work-items per sigma point: a power of two (the host passes the same number). */
 #ifndef SF_GROUP_SIZE
 #  define SF_GROUP_SIZE 64
@@ -41,41 +52,31 @@ static inline real sf_group_sum(__local real* scratch, real value) {
 }
 
 /* The warm start's residual and the first direction: with q = A x (x = the last step's dv,
- * products in element_out), r = b - q, z = M^-1 r, d = z; bb, rr, rz; and whether the warm
- * start is already good enough (b = 0 counts as converged: the state update then uses
- * dv = 0, the exact solution). */
+ * from element_product and node_product), r = b - q, z = M^-1 r, d = z; bb, rr, rz; and
+ * whether the warm start is already good enough (b = 0 counts as converged: the state update
+ * then uses dv = 0, the exact solution). */
 __kernel __attribute__((reqd_work_group_size(SF_GROUP_SIZE, 1, 1)))
-void cg_start(uint S, uint node_count, __global const real* c,
-              __global const int* incidence_offsets, __global const int* incidence,
-              __global const int* ligament_offsets, __global const int* ligament_of_node,
-              __global const real* ligament_k, __global const real* control_k,
-              __global const real* mass, __global const real* element_out,
-              __global const real* b, __global const real* inverse_diagonal,
-              __global const real* x, __global real* r, __global real* z, __global real* d,
-              __global real* bb, __global real* rr, __global real* rz, __global uint* active,
-              __global uint* converged, __global int* iterations) {
+void cg_start(uint S, uint node_count, __global const real* c, __global const real* q,
+              __global const real* b, __global const real* inverse_diagonal, __global real* r,
+              __global real* z, __global real* d, __global real* bb, __global real* rr,
+              __global real* rz, __global uint* active, __global uint* converged,
+              __global int* iterations) {
   __local real scratch[SF_GROUP_SIZE];
   uint s = get_group_id(0);
   real sum_bb = (real)0;
   real sum_rr = (real)0;
   real sum_rz = (real)0;
-  for (uint n = get_local_id(0); n < node_count; n += SF_GROUP_SIZE) {
-    real spring = sf_node_spring(ligament_offsets, ligament_of_node, ligament_k, control_k, n, s, S);
-    real m = sf_solver_mass(mass[n], spring);
-    SF_UNROLL
-    for (int k = 0; k < 3; ++k) {
-      size_t row = ((size_t)3 * n + k) * S + s;
-      real q = sf_system_row(c, element_out, incidence_offsets, incidence, spring, m, x, n, k, s, S);
-      real bi = b[row];
-      real ri = bi - q;
-      real zi = inverse_diagonal[row] * ri;
-      r[row] = ri;
-      z[row] = zi;
-      d[row] = zi;
-      sum_bb += bi * bi;
-      sum_rr += ri * ri;
-      sum_rz += ri * zi;
-    }
+  for (uint row = get_local_id(0); row < 3 * node_count; row += SF_GROUP_SIZE) {
+    size_t at = (size_t)row * S + s;
+    real bi = b[at];
+    real ri = bi - q[at];
+    real zi = inverse_diagonal[at] * ri;
+    r[at] = ri;
+    z[at] = zi;
+    d[at] = zi;
+    sum_bb += bi * bi;
+    sum_rr += ri * ri;
+    sum_rz += ri * zi;
   }
   sum_bb = sf_group_sum(scratch, sum_bb);
   sum_rr = sf_group_sum(scratch, sum_rr);
@@ -156,14 +157,195 @@ void cg_iteration(uint S, uint node_count, int max_iterations, __global const re
     }
   }
 }
+#endif /* SF_CG_PER_GROUP */
 
-/* Sigma points per work-item of cg_solve, a divisor of S (the host sets it: S divided over
- * the compute units). */
-#ifndef SF_SOLVE_BLOCK
-#  define SF_SOLVE_BLOCK 1
+/* The warm start of the block first .. first + SF_CG_BLOCK - 1, given q = A x: r = b - q,
+ * z = M^-1 r, d = z, the scalars and the flags. Returns whether any of them goes on. */
+static inline __attribute__((always_inline)) int sf_block_cg_start(
+    uint first, uint S, uint rows, __global const real* restrict c,
+    __global const real* restrict q, __global const real* restrict b,
+    __global const real* restrict inverse_diagonal, __global real* restrict r,
+    __global real* restrict z, __global real* restrict d, __global real* restrict bb,
+    __global real* restrict rr, __global real* restrict rz, __global uint* restrict active,
+    __global uint* restrict converged, __global int* restrict iterations) {
+  real sum_bb[SF_CG_BLOCK];
+  real sum_rr[SF_CG_BLOCK];
+  real sum_rz[SF_CG_BLOCK];
+  for (uint i = 0; i < SF_CG_BLOCK; ++i) sum_bb[i] = sum_rr[i] = sum_rz[i] = (real)0;
+  for (uint row = 0; row < rows; ++row) {
+    for (uint i = 0; i < SF_CG_BLOCK; ++i) {
+      size_t at = (size_t)row * S + first + i;
+      real bi = b[at];
+      real ri = bi - q[at];
+      real zi = inverse_diagonal[at] * ri;
+      r[at] = ri;
+      z[at] = zi;
+      d[at] = zi;
+      sum_bb[i] += bi * bi;
+      sum_rr[i] += ri * ri;
+      sum_rz[i] += ri * zi;
+    }
+  }
+  int any = 0;
+  for (uint i = 0; i < SF_CG_BLOCK; ++i) {
+    uint s = first + i;
+    int done = sum_bb[i] == (real)0 || sum_rr[i] <= c[SF_CG_TOLERANCE2] * sum_bb[i];
+    bb[s] = sum_bb[i];
+    rr[s] = sum_rr[i];
+    rz[s] = sum_rz[i];
+    active[s] = done ? 0u : 1u;
+    converged[s] = done ? 1u : 0u;
+    iterations[s] = 0;
+    any |= !done;
+  }
+  return any;
+}
+
+/* One iteration of the block, given q = A d: d.q, alpha (0 for a sigma point that is done),
+ * x += alpha d, r -= alpha q, z = M^-1 r, the convergence test, the cap and breakdown (a
+ * residual that is not finite), and d = z + beta d for those that go on. Returns whether any
+ * of them goes on. */
+static inline __attribute__((always_inline)) int sf_block_cg_iteration(
+    uint first, uint S, uint rows, int max_iterations, __global const real* restrict c,
+    __global const real* restrict inverse_diagonal, __global real* restrict x,
+    __global real* restrict r, __global real* restrict z, __global real* restrict d,
+    __global const real* restrict q, __global const real* restrict bb,
+    __global real* restrict rr, __global real* restrict rz, __global uint* restrict active,
+    __global uint* restrict converged, __global int* restrict iterations) {
+  int going[SF_CG_BLOCK];
+  int any = 0;
+  for (uint i = 0; i < SF_CG_BLOCK; ++i) {
+    going[i] = active[first + i] != 0u;
+    any |= going[i];
+  }
+  if (!any) return 0;
+  real sum_dq[SF_CG_BLOCK];
+  for (uint i = 0; i < SF_CG_BLOCK; ++i) sum_dq[i] = (real)0;
+  for (uint row = 0; row < rows; ++row)
+    for (uint i = 0; i < SF_CG_BLOCK; ++i) {
+      size_t at = (size_t)row * S + first + i;
+      sum_dq[i] += d[at] * q[at];
+    }
+  real alpha[SF_CG_BLOCK];
+  real rr_new[SF_CG_BLOCK];
+  real rz_new[SF_CG_BLOCK];
+  for (uint i = 0; i < SF_CG_BLOCK; ++i) {
+    alpha[i] = going[i] ? rz[first + i] / sum_dq[i] : (real)0;
+    rr_new[i] = rz_new[i] = (real)0;
+  }
+  for (uint row = 0; row < rows; ++row) {
+    for (uint i = 0; i < SF_CG_BLOCK; ++i) {
+      size_t at = (size_t)row * S + first + i;
+      x[at] += alpha[i] * d[at];
+      real ri = r[at] - alpha[i] * q[at];
+      real zi = inverse_diagonal[at] * ri;
+      r[at] = ri;
+      z[at] = zi;
+      rr_new[i] += ri * ri;
+      rz_new[i] += ri * zi;
+    }
+  }
+  real beta[SF_CG_BLOCK];
+  any = 0;
+  for (uint i = 0; i < SF_CG_BLOCK; ++i) {
+    uint s = first + i;
+    beta[i] = (real)1;
+    if (!going[i]) continue;
+    int count = iterations[s] + 1;
+    int done = rr_new[i] <= c[SF_CG_TOLERANCE2] * bb[s];
+    going[i] = !(done || !isfinite(rr_new[i]) || count >= max_iterations);
+    beta[i] = rz_new[i] / rz[s];
+    iterations[s] = count;
+    rr[s] = rr_new[i];
+    rz[s] = rz_new[i];
+    if (done) converged[s] = 1u;
+    if (!going[i]) active[s] = 0u;
+    any |= going[i];
+  }
+  if (!any) return 0;
+  for (uint row = 0; row < rows; ++row) {
+    for (uint i = 0; i < SF_CG_BLOCK; ++i) {
+      size_t at = (size_t)row * S + first + i;
+      d[at] = going[i] ? z[at] + beta[i] * d[at] : d[at];
+    }
+  }
+  return 1;
+}
+
+#if !SF_CG_PER_GROUP
+/* q = A d for the block, from the element chunks' copies of K d (element_product.cl, summed
+ * in chunk order) and the nodal terms: node_product's arithmetic, done here so that the
+ * iteration needs no launch of its own for it and finds q in cache. */
+static inline __attribute__((always_inline)) void sf_block_node_product(
+    uint first, uint S, uint node_count, __global const real* restrict c,
+    __global const int* restrict ligament_offsets, __global const int* restrict ligament_of_node,
+    __global const real* restrict ligament_k, __global const real* restrict control_k,
+    __global const real* restrict mass, __global const real* restrict d,
+    __global const real* restrict element_out, __global real* restrict q) {
+  const size_t copy_size = (size_t)3 * node_count * S;
+  for (uint n = 0; n < node_count; ++n) {
+    real nodal[SF_CG_BLOCK];
+    for (uint i = 0; i < SF_CG_BLOCK; ++i) {
+      real spring = sf_node_spring(ligament_offsets, ligament_of_node, ligament_k, control_k, n,
+                                   first + i, S);
+      nodal[i] = c[SF_MASS_FACTOR] * sf_solver_mass(mass[n], spring) + c[SF_STIFFNESS_FACTOR] * spring;
+    }
+    SF_UNROLL
+    for (int k = 0; k < 3; ++k) {
+      size_t row = ((size_t)3 * n + k) * S + first;
+      real sum[SF_CG_BLOCK];
+      for (uint i = 0; i < SF_CG_BLOCK; ++i) sum[i] = (real)0;
+      for (uint chunk = 0; chunk < SF_ELEMENT_CHUNKS; ++chunk)
+        for (uint i = 0; i < SF_CG_BLOCK; ++i) sum[i] += element_out[chunk * copy_size + row + i];
+      for (uint i = 0; i < SF_CG_BLOCK; ++i)
+        q[row + i] = c[SF_STIFFNESS_FACTOR] * sum[i] + nodal[i] * d[row + i];
+    }
+  }
+}
+
+__kernel void cg_start(uint S, uint node_count, __global const real* restrict c,
+                       __global const real* restrict q, __global const real* restrict b,
+                       __global const real* restrict inverse_diagonal, __global real* restrict r,
+                       __global real* restrict z, __global real* restrict d,
+                       __global real* restrict bb, __global real* restrict rr,
+                       __global real* restrict rz, __global uint* restrict active,
+                       __global uint* restrict converged, __global int* restrict iterations) {
+  uint first = (uint)get_global_id(0) * SF_CG_BLOCK;
+  if (first >= S) return;
+  sf_block_cg_start(first, S, 3 * node_count, c, q, b, inverse_diagonal, r, z, d, bb, rr, rz,
+                    active, converged, iterations);
+}
+
+/* One iteration after element_product: q = A d (sf_block_node_product), then the update. */
+__kernel void cg_iteration(uint S, uint node_count, int max_iterations,
+                           __global const real* restrict c,
+                           __global const real* restrict inverse_diagonal,
+                           __global real* restrict x, __global real* restrict r,
+                           __global real* restrict z, __global real* restrict d,
+                           __global real* restrict q, __global const real* restrict bb,
+                           __global real* restrict rr, __global real* restrict rz,
+                           __global uint* restrict active, __global uint* restrict converged,
+                           __global int* restrict iterations,
+                           __global const int* restrict ligament_offsets,
+                           __global const int* restrict ligament_of_node,
+                           __global const real* restrict ligament_k,
+                           __global const real* restrict control_k,
+                           __global const real* restrict mass,
+                           __global const real* restrict element_out) {
+  uint first = (uint)get_global_id(0) * SF_CG_BLOCK;
+  if (first >= S) return;
+  int any = 0;
+  for (uint i = 0; i < SF_CG_BLOCK; ++i) any |= active[first + i] != 0u;
+  if (!any) return;
+  sf_block_node_product(first, S, node_count, c, ligament_offsets, ligament_of_node, ligament_k,
+                        control_k, mass, d, element_out, q);
+  sf_block_cg_iteration(first, S, 3 * node_count, max_iterations, c, inverse_diagonal, x, r, z,
+                        d, q, bb, rr, rz, active, converged, iterations);
+}
 #endif
 
-/* q = A d for sigma points first .. first + SF_SOLVE_BLOCK - 1: the nodal terms (mass and
+
+/* q = A d for sigma points first .. first + SF_CG_BLOCK - 1: the nodal terms (mass and
  * springs), then each element's product added at its four corners, element by element. One
  * work-item owns these sigma points' rows, so the sums need no atomics and come in the same
  * order every run; and no element outputs go through memory, as they must between the
@@ -176,7 +358,7 @@ static inline __attribute__((always_inline)) void sf_block_system_product(
     __global const real* restrict control_k, __global const real* restrict mass,
     __global const real* restrict d, __global real* restrict q) {
   for (uint n = 0; n < node_count; ++n) {
-    for (uint i = 0; i < SF_SOLVE_BLOCK; ++i) {
+    for (uint i = 0; i < SF_CG_BLOCK; ++i) {
       uint s = first + i;
       real spring = sf_node_spring(ligament_offsets, ligament_of_node, ligament_k, control_k, n, s, S);
       real nodal = c[SF_MASS_FACTOR] * sf_solver_mass(mass[n], spring) + c[SF_STIFFNESS_FACTOR] * spring;
@@ -195,7 +377,7 @@ static inline __attribute__((always_inline)) void sf_block_system_product(
     sf_load_rest(rest, e, grad, &vlambda, &vmu);
     int corner_nodes[4];
     sf_load_nodes(nodes, e, corner_nodes);
-    for (uint i = 0; i < SF_SOLVE_BLOCK; ++i) {
+    for (uint i = 0; i < SF_CG_BLOCK; ++i) {
       uint s = first + i;
       real frame[9];
       real corner[12];
@@ -213,11 +395,9 @@ static inline __attribute__((always_inline)) void sf_block_system_product(
   }
 }
 
-/* The whole CG solve of a block of sigma points (x = dv, warm-started), the same algorithm
- * as cg_start and cg_iteration with the dot products summed in row order. Work-item i takes
- * sigma points i * SF_SOLVE_BLOCK onwards; the solve of the block goes on until every sigma
- * point of it has stopped, the finished ones left as they are (their products are still
- * computed: the loops over the block then have no branch). */
+/* The whole CG solve of a block of sigma points (x = dv, warm-started) in one launch: the
+ * blocked warm start and iterations above, with the products done here. The solve of the
+ * block goes on until every sigma point of it has stopped. */
 __kernel void cg_solve(uint S, uint element_count, uint node_count, int max_iterations,
                        __global const real* restrict c, __global const int* restrict nodes,
                        __global const real* restrict rest, __global const real* restrict frames,
@@ -232,104 +412,17 @@ __kernel void cg_solve(uint S, uint element_count, uint node_count, int max_iter
                        __global real* restrict rr, __global real* restrict rz,
                        __global uint* restrict active, __global uint* restrict converged,
                        __global int* restrict iterations) {
-  const uint count = SF_SOLVE_BLOCK;
-  uint first = (uint)get_global_id(0) * count;
+  uint first = (uint)get_global_id(0) * SF_CG_BLOCK;
   if (first >= S) return;
-  const real tolerance2 = c[SF_CG_TOLERANCE2];
   const uint rows = 3 * node_count;
-
-  /* The warm start: r = b - A x, z = M^-1 r, d = z. */
   sf_block_system_product(first, S, element_count, node_count, c, nodes, rest, frames,
                           ligament_offsets, ligament_of_node, ligament_k, control_k, mass, x, q);
-  real sum_bb[SF_SOLVE_BLOCK];
-  real sum_rr[SF_SOLVE_BLOCK];
-  real sum_rz[SF_SOLVE_BLOCK];
-  for (uint i = 0; i < count; ++i) sum_bb[i] = sum_rr[i] = sum_rz[i] = (real)0;
-  for (uint row = 0; row < rows; ++row) {
-    for (uint i = 0; i < count; ++i) {
-      size_t at = (size_t)row * S + first + i;
-      real bi = b[at];
-      real ri = bi - q[at];
-      real zi = inverse_diagonal[at] * ri;
-      r[at] = ri;
-      z[at] = zi;
-      d[at] = zi;
-      sum_bb[i] += bi * bi;
-      sum_rr[i] += ri * ri;
-      sum_rz[i] += ri * zi;
-    }
-  }
-  int going[SF_SOLVE_BLOCK];
-  int count_done[SF_SOLVE_BLOCK];
-  int any = 0;
-  for (uint i = 0; i < count; ++i) {
-    int done = sum_bb[i] == (real)0 || sum_rr[i] <= tolerance2 * sum_bb[i];
-    converged[first + i] = done ? 1u : 0u;
-    going[i] = !done;
-    count_done[i] = 0;
-    any |= going[i];
-  }
-
+  int any = sf_block_cg_start(first, S, rows, c, q, b, inverse_diagonal, r, z, d, bb, rr, rz,
+                              active, converged, iterations);
   while (any) {
-    /* q = A d and d.q */
     sf_block_system_product(first, S, element_count, node_count, c, nodes, rest, frames,
                             ligament_offsets, ligament_of_node, ligament_k, control_k, mass, d, q);
-    real sum_dq[SF_SOLVE_BLOCK];
-    for (uint i = 0; i < count; ++i) sum_dq[i] = (real)0;
-    for (uint row = 0; row < rows; ++row)
-      for (uint i = 0; i < count; ++i) {
-        size_t at = (size_t)row * S + first + i;
-        sum_dq[i] += d[at] * q[at];
-      }
-    /* x += alpha d, r -= alpha q, z = M^-1 r; a finished sigma point gets alpha = 0. */
-    real alpha[SF_SOLVE_BLOCK];
-    real rr_new[SF_SOLVE_BLOCK];
-    real rz_new[SF_SOLVE_BLOCK];
-    for (uint i = 0; i < count; ++i) {
-      alpha[i] = going[i] ? sum_rz[i] / sum_dq[i] : (real)0;
-      rr_new[i] = rz_new[i] = (real)0;
-    }
-    for (uint row = 0; row < rows; ++row) {
-      for (uint i = 0; i < count; ++i) {
-        size_t at = (size_t)row * S + first + i;
-        x[at] += alpha[i] * d[at];
-        real ri = r[at] - alpha[i] * q[at];
-        real zi = inverse_diagonal[at] * ri;
-        r[at] = ri;
-        z[at] = zi;
-        rr_new[i] += ri * ri;
-        rz_new[i] += ri * zi;
-      }
-    }
-    /* The convergence test, the cap and breakdown, then d = z + beta d. */
-    real beta[SF_SOLVE_BLOCK];
-    any = 0;
-    for (uint i = 0; i < count; ++i) {
-      beta[i] = (real)1;
-      if (!going[i]) continue;
-      ++count_done[i];
-      sum_rr[i] = rr_new[i];
-      int done = rr_new[i] <= tolerance2 * sum_bb[i];
-      if (done) converged[first + i] = 1u;
-      going[i] = !(done || !isfinite(rr_new[i]) || count_done[i] >= max_iterations);
-      beta[i] = rz_new[i] / sum_rz[i];
-      sum_rz[i] = rz_new[i];
-      any |= going[i];
-    }
-    if (!any) break;
-    for (uint row = 0; row < rows; ++row) {
-      for (uint i = 0; i < count; ++i) {
-        size_t at = (size_t)row * S + first + i;
-        d[at] = going[i] ? z[at] + beta[i] * d[at] : d[at];
-      }
-    }
-  }
-  for (uint i = 0; i < count; ++i) {
-    uint s = first + i;
-    bb[s] = sum_bb[i];
-    rr[s] = sum_rr[i];
-    rz[s] = sum_rz[i];
-    active[s] = 0u;
-    iterations[s] = count_done[i];
+    any = sf_block_cg_iteration(first, S, rows, max_iterations, c, inverse_diagonal, x, r, z, d,
+                                q, bb, rr, rz, active, converged, iterations);
   }
 }

@@ -35,6 +35,12 @@ typedef SF_REAL real;
 #  define SF_SIGMA_BLOCK 1
 #endif
 
+/* Element chunks of element_product on a CPU (element_product.cl): 0 on a GPU, where each
+ * element writes its own outputs for node_product to gather. */
+#ifndef SF_ELEMENT_CHUNKS
+#  define SF_ELEMENT_CHUNKS 0
+#endif
+
 /* The item (element or node) and the first sigma point of the block that work-item `gid`
  * takes in the blocked kernels; 0 for a work-item past the end (the global size is rounded
  * up to whole work-groups). */

@@ -2,7 +2,8 @@
  * nodal terms of the implicit Euler system (host: host/reference/implicit_euler.h):
  *   node_rhs:     rhs = h (f - (h + a) K v - b M v) and the inverse Jacobi diagonal of A,
  *   node_product: q = A d, in every CG iteration (work-items as in element_product.cl: on a
- *                 CPU a node for all sigma points, vectorised over them). */
+ *                 CPU a node for all sigma points, vectorised over them, summing the element
+ *                 chunks' copies instead of gathering element outputs). */
 #include "node_assembly.h"
 
 __kernel void node_rhs(uint S, uint node_count, __global const real* c,
@@ -60,13 +61,21 @@ __kernel void node_product(uint S, uint node_count, __global const real* restric
   for (uint b = 0; b < SF_SIGMA_BLOCK; ++b) m[b] = sf_solver_mass(mass[n], spring[b]);
   SF_UNROLL
   for (int k = 0; k < 3; ++k) {
+    size_t row = ((size_t)3 * n + k) * S + first;
     real sum[SF_SIGMA_BLOCK];
     for (uint b = 0; b < SF_SIGMA_BLOCK; ++b) sum[b] = (real)0;
+#if SF_ELEMENT_CHUNKS > 0
+    /* The chunks' copies of K d (element_product.cl), in chunk order. */
+    for (uint chunk = 0; chunk < SF_ELEMENT_CHUNKS; ++chunk) {
+      __global const real* out = element_out + chunk * ((size_t)3 * node_count * S) + row;
+      for (uint b = 0; b < SF_SIGMA_BLOCK; ++b) sum[b] += out[b];
+    }
+#else
     for (int i = incidence_offsets[n]; i < incidence_offsets[n + 1]; ++i) {
       __global const real* out = element_out + ((size_t)3 * incidence[i] + k) * S + first;
       for (uint b = 0; b < SF_SIGMA_BLOCK; ++b) sum[b] += out[b];
     }
-    size_t row = ((size_t)3 * n + k) * S + first;
+#endif
     for (uint b = 0; b < SF_SIGMA_BLOCK; ++b) {
       real db = d[row + b];
       q[row + b] = c[SF_STIFFNESS_FACTOR] * (sum[b] + spring[b] * db) + c[SF_MASS_FACTOR] * m[b] * db;
