@@ -13,15 +13,6 @@ constexpr std::size_t kGroup = 64;        // work-group size of the element and 
 constexpr int kStepConstants = 12;        // SF_STEP_CONSTANTS in ensemble_layout.h
 constexpr int kMaxParameters = 16;        // SF_MAX_PARAMETERS in recenter.cl
 
-// The whole solve in one launch (cg_solve) where a launch per CG iteration costs more than
-// it brings: on a CPU device with at most two sigma points per compute unit, where the
-// per-iteration kernels cannot vectorise over many sigma points anyway. Measured on PoCL, 2
-// cores (bench/RESULTS.md): the liver filter step (S = 4) 9.1 -> 5.8 ms; at S = 16 the
-// per-iteration kernels are twice as fast.
-bool prefers_whole_solve(const OpenClDeviceInfo& info, int sigma_count) {
-  return info.type == "cpu" && sigma_count <= 2 * static_cast<int>(std::max(1u, info.compute_units));
-}
-
 std::size_t round_up(std::size_t n, std::size_t multiple) {
   return (n + multiple - 1) / multiple * multiple;
 }
@@ -136,8 +127,6 @@ OpenClEnsemble::OpenClEnsemble(const Model& model, std::vector<int> estimated,
   const int units = static_cast<int>(std::max(1u, info.compute_units));
   cg_block_ = (S_ + units - 1) / units;
   while (S_ % cg_block_ != 0) --cg_block_;
-  whole_solve_ = options.solve_launch == SolveLaunch::whole_solve ||
-                 (options.solve_launch == SolveLaunch::automatic && prefers_whole_solve(info, S_));
   device_.build_program("-DSF_SIGMA_BLOCK=" + std::to_string(sigma_block_) +
                         " -DSF_ELEMENT_CHUNKS=" + std::to_string(element_chunks_) +
                         " -DSF_CG_PER_GROUP=" + std::to_string(cg_per_group_ ? 1 : 0) +
@@ -185,7 +174,6 @@ OpenClEnsemble::OpenClEnsemble(const Model& model, std::vector<int> estimated,
     k_node_product_ = device_.kernel("node_product");
     k_cg_start_ = device_.kernel("cg_start");
     k_cg_iteration_ = device_.kernel("cg_iteration");
-    k_cg_solve_ = device_.kernel("cg_solve");
     k_state_update_ = device_.kernel("state_update");
     k_observation_gather_ = device_.kernel("observation_gather");
     k_recenter_ = device_.kernel("recenter");
@@ -216,10 +204,6 @@ OpenClEnsemble::OpenClEnsemble(const Model& model, std::vector<int> estimated,
       k_cg_iteration_.setArg(20, mass_);
       k_cg_iteration_.setArg(21, element_out_);
     }
-    set_args(k_cg_solve_, S, E, N, static_cast<cl_int>(model.solver.cg_max_iterations),
-             constants_, element_nodes_, element_rest_, frames_, ligament_offsets_,
-             ligament_of_node_, ligament_k_buffer_, control_k_, mass_, rhs_, inverse_diagonal_,
-             dv_, r_, z_, d_, q_, bb_, rr_, rz_, active_, converged_, iterations_);
     set_args(k_state_update_, S, rows, constants_, bb_, dv_, x_, v_);
     set_args(k_observation_gather_, S, static_cast<cl_uint>(observed_.size()), observed_nodes_,
              x_, observations_);
@@ -357,10 +341,6 @@ void OpenClEnsemble::node_product(const cl::Buffer& d, const cl::Buffer& q) {
 }
 
 void OpenClEnsemble::conjugate_gradient() {
-  if (whole_solve_) {
-    run(k_cg_solve_, S_ / cg_block_, 1);
-    return;
-  }
   // The warm start's residual (dv holds the last step's velocity change).
   element_product(dv_, all_active_);
   node_product(dv_, q_);
@@ -494,7 +474,7 @@ Eigen::MatrixXd OpenClEnsemble::system_product(const Eigen::MatrixXd& d) {
 std::string OpenClEnsemble::description() const {
   return std::string("opencl ") +
          (device_.precision() == Precision::single ? "single" : "double") + " on " +
-         device_.info().name + (whole_solve_ ? ", CG solve in one launch" : "");
+         device_.info().name;
 }
 
 }  // namespace sigmafem

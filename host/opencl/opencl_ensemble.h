@@ -60,7 +60,7 @@ class OpenClEnsemble : public DeviceEnsemble {
   void write_step_constants(const Eigen::Vector3d& so_position);
 
   // Enqueue the kernels of one step (kernels/opencl/<file>.cl holds the kernel of the same
-  // name; conjugate_gradient() enqueues cg_start and cg_iteration, or cg_solve).
+  // name; conjugate_gradient() enqueues cg_start and cg_iteration).
   std::size_t element_items() const;   // work-items of the element kernels
   void element_rhs();
   void node_rhs();
@@ -82,7 +82,6 @@ class OpenClEnsemble : public DeviceEnsemble {
   int sigma_block_ = 1;                     // SF_SIGMA_BLOCK: sigma points per element work-item
   int element_chunks_ = 0;                  // SF_ELEMENT_CHUNKS: element_product's chunks (CPU)
   int expected_iterations_ = 1;             // CG iterations the last step needed (at most)
-  bool whole_solve_ = false;                // cg_solve (one launch) instead of per iteration
   int cg_block_ = 1;                        // SF_CG_BLOCK: sigma points per CG work-item (CPU)
 
   // Shared data.
@@ -99,8 +98,7 @@ class OpenClEnsemble : public DeviceEnsemble {
 
   // Mutable: enqueueing a kernel (also from the const read-outs) changes no visible state.
   mutable cl::Kernel k_element_rhs_, k_node_rhs_, k_element_product_, k_node_product_;
-  mutable cl::Kernel k_cg_start_, k_cg_iteration_, k_cg_solve_, k_state_update_;
-  mutable cl::Kernel k_observation_gather_;
+  mutable cl::Kernel k_cg_start_, k_cg_iteration_, k_state_update_, k_observation_gather_;
   mutable cl::Kernel k_recenter_;
 };
 

@@ -1,11 +1,9 @@
 /* conjugate_gradient: Jacobi-preconditioned CG for all sigma points at once, with per-sigma
  * scalars and a per-sigma convergence flag (host: host/reference/conjugate_gradient.h, the
- * same stopping rule |r| <= tolerance |b|). Ways to run it, chosen by the host
- * (OpenClEnsemble::conjugate_gradient):
+ * same stopping rule |r| <= tolerance |b|).
  *
- * Per iteration: cg_start, then cg_iteration after every product q = A d (element_product,
- * node_product: three launches per iteration; on a CPU cg_iteration does node_product's
- * part itself: two). A sigma point that has converged (or hit the
+ * cg_start, then cg_iteration after every product q = A d (element_product, node_product:
+ * three launches per iteration; on a CPU cg_iteration does node_product's part itself: two). A sigma point that has converged (or hit the
  * iteration cap, or broke down) is inactive and left alone, so the host may enqueue several
  * iterations between checks without changing anyone's result. Two forms of these kernels:
  *  - a GPU (SF_CG_PER_GROUP = 1): one work-group per sigma point owns its rows and reduces
@@ -14,11 +12,6 @@
  *    the compute units) goes down the rows with the block innermost, on contiguous data:
  *    vectorised, and each cache line read once (one work-item per sigma point read a line per
  *    sigma point, 16 times at S = 16). Dot products are summed in row order.
- *
- * The whole solve in one launch (cg_solve, below), on a CPU: the blocked work-item also does
- * its sigma points' products itself, adding each element's product straight into q, so a
- * step costs one launch instead of three per iteration: where a launch costs tens of
- * microseconds (PoCL), that is most of the time on small meshes (the filter step).
  *
  * Per-sigma scalars (arrays of S): bb = b.b, rr = r.r, rz = r.z, active (1 while iterating),
  * converged (1 converged, 0 hit the cap or broke down), iterations (products done). */
@@ -343,86 +336,3 @@ __kernel void cg_iteration(uint S, uint node_count, int max_iterations,
                         d, q, bb, rr, rz, active, converged, iterations);
 }
 #endif
-
-
-/* q = A d for sigma points first .. first + SF_CG_BLOCK - 1: the nodal terms (mass and
- * springs), then each element's product added at its four corners, element by element. One
- * work-item owns these sigma points' rows, so the sums need no atomics and come in the same
- * order every run; and no element outputs go through memory, as they must between the
- * per-iteration kernels. */
-static inline __attribute__((always_inline)) void sf_block_system_product(
-    uint first, uint S, uint element_count, uint node_count, __global const real* restrict c,
-    __global const int* restrict nodes, __global const real* restrict rest,
-    __global const real* restrict frames, __global const int* restrict ligament_offsets,
-    __global const int* restrict ligament_of_node, __global const real* restrict ligament_k,
-    __global const real* restrict control_k, __global const real* restrict mass,
-    __global const real* restrict d, __global real* restrict q) {
-  for (uint n = 0; n < node_count; ++n) {
-    for (uint i = 0; i < SF_CG_BLOCK; ++i) {
-      uint s = first + i;
-      real spring = sf_node_spring(ligament_offsets, ligament_of_node, ligament_k, control_k, n, s, S);
-      real nodal = c[SF_MASS_FACTOR] * sf_solver_mass(mass[n], spring) + c[SF_STIFFNESS_FACTOR] * spring;
-      SF_UNROLL
-      for (int k = 0; k < 3; ++k) {
-        size_t row = ((size_t)3 * n + k) * S + s;
-        q[row] = nodal * d[row];
-      }
-    }
-  }
-  const real stiffness_factor = c[SF_STIFFNESS_FACTOR];
-  for (uint e = 0; e < element_count; ++e) {
-    real grad[12];
-    real vlambda;
-    real vmu;
-    sf_load_rest(rest, e, grad, &vlambda, &vmu);
-    int corner_nodes[4];
-    sf_load_nodes(nodes, e, corner_nodes);
-    for (uint i = 0; i < SF_CG_BLOCK; ++i) {
-      uint s = first + i;
-      real frame[9];
-      real corner[12];
-      real product[12];
-      sf_load_frame(frames, e, s, S, frame);
-      sf_gather_corners(d, corner_nodes, s, S, corner);
-      sf_element_product(frame, grad, vlambda, vmu, corner, product);
-      SF_UNROLL
-      for (int a = 0; a < 4; ++a) {
-        size_t base = (size_t)(3 * corner_nodes[a]) * S + s;
-        SF_UNROLL
-        for (int k = 0; k < 3; ++k) q[base + (size_t)k * S] += stiffness_factor * product[3 * a + k];
-      }
-    }
-  }
-}
-
-/* The whole CG solve of a block of sigma points (x = dv, warm-started) in one launch: the
- * blocked warm start and iterations above, with the products done here. The solve of the
- * block goes on until every sigma point of it has stopped. */
-__kernel void cg_solve(uint S, uint element_count, uint node_count, int max_iterations,
-                       __global const real* restrict c, __global const int* restrict nodes,
-                       __global const real* restrict rest, __global const real* restrict frames,
-                       __global const int* restrict ligament_offsets,
-                       __global const int* restrict ligament_of_node,
-                       __global const real* restrict ligament_k,
-                       __global const real* restrict control_k, __global const real* restrict mass,
-                       __global const real* restrict b, __global const real* restrict inverse_diagonal,
-                       __global real* restrict x, __global real* restrict r,
-                       __global real* restrict z, __global real* restrict d,
-                       __global real* restrict q, __global real* restrict bb,
-                       __global real* restrict rr, __global real* restrict rz,
-                       __global uint* restrict active, __global uint* restrict converged,
-                       __global int* restrict iterations) {
-  uint first = (uint)get_global_id(0) * SF_CG_BLOCK;
-  if (first >= S) return;
-  const uint rows = 3 * node_count;
-  sf_block_system_product(first, S, element_count, node_count, c, nodes, rest, frames,
-                          ligament_offsets, ligament_of_node, ligament_k, control_k, mass, x, q);
-  int any = sf_block_cg_start(first, S, rows, c, q, b, inverse_diagonal, r, z, d, bb, rr, rz,
-                              active, converged, iterations);
-  while (any) {
-    sf_block_system_product(first, S, element_count, node_count, c, nodes, rest, frames,
-                            ligament_offsets, ligament_of_node, ligament_k, control_k, mass, d, q);
-    any = sf_block_cg_iteration(first, S, rows, max_iterations, c, inverse_diagonal, x, r, z, d,
-                                q, bb, rr, rz, active, converged, iterations);
-  }
-}

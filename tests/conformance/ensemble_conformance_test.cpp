@@ -33,19 +33,13 @@ struct BackendCase {
   std::string backend;
   Precision precision;
   std::string name;  // for the test name
-  SolveLaunch solve_launch = SolveLaunch::automatic;
 };
 
 // The back ends to check: OpenCL device 0 in single and, where it has fp64, double precision.
 std::vector<BackendCase> backend_cases() {
   std::vector<BackendCase> cases;
-  // OpenCL's two ways of launching CG (kernels/opencl/conjugate_gradient.cl), each forced,
-  // since which one it picks by itself depends on the device and S.
-  cases.push_back({"opencl", Precision::single, "OpenClSingle", SolveLaunch::per_iteration});
-  cases.push_back({"opencl", Precision::double_precision, "OpenClDouble", SolveLaunch::per_iteration});
-  cases.push_back({"opencl", Precision::single, "OpenClSingleWholeSolve", SolveLaunch::whole_solve});
-  cases.push_back({"opencl", Precision::double_precision, "OpenClDoubleWholeSolve",
-                   SolveLaunch::whole_solve});
+  cases.push_back({"opencl", Precision::single, "OpenClSingle"});
+  cases.push_back({"opencl", Precision::double_precision, "OpenClDouble"});
   return cases;
 }
 
@@ -99,7 +93,6 @@ class EnsembleConformance : public ::testing::TestWithParam<Case> {
   std::unique_ptr<DeviceEnsemble> device_ensemble(const Model& model) const {
     DeviceOptions options;
     options.precision = GetParam().backend.precision;
-    options.solve_launch = GetParam().backend.solve_launch;
     std::unique_ptr<Ensemble> ensemble = make_ensemble(
         GetParam().backend.backend, model, estimated_, scenario_.observations.nodes, S_, options);
     return std::unique_ptr<DeviceEnsemble>(dynamic_cast<DeviceEnsemble*>(ensemble.release()));
@@ -307,13 +300,7 @@ std::vector<Case> all_cases() {
   std::vector<Case> cases;
   for (const BackendCase& backend : backend_cases())
     for (const char* scenario : {"box", "liver"})
-      for (int S : {1, 4, 16}) {
-        // The whole solve in one launch is for few sigma points (OpenClEnsemble picks it up
-        // to two per compute unit); at S = 16 its trajectories alone would take 3.5 minutes
-        // of CI on PoCL, 2 cores. S = 1 and 4 test it (on two cores: blocks of one and two).
-        if (backend.solve_launch == SolveLaunch::whole_solve && S > 4) continue;
-        cases.push_back({backend, scenario, S});
-      }
+      for (int S : {1, 4, 16}) cases.push_back({backend, scenario, S});
   return cases;
 }
 
