@@ -23,14 +23,23 @@ struct Backend {
   std::string name;        // make_ensemble's name
   Precision precision;
   std::string label;
+  SolveLaunch solve_launch = SolveLaunch::automatic;
 };
 
 const Backend kCpu{"cpu", Precision::double_precision, "cpu-reference double, all cores"};
 const Backend kOpenCl{"opencl", Precision::single, "opencl single, device 0"};
+// OpenCL's two ways of running CG, forced, to compare them (OpenClEnsemble chooses by itself).
+const Backend kOpenClPerIteration{"opencl", Precision::single,
+                                  "opencl single, device 0, CG launched per iteration",
+                                  SolveLaunch::per_iteration};
+const Backend kOpenClWholeSolve{"opencl", Precision::single,
+                                "opencl single, device 0, CG solve in one launch",
+                                SolveLaunch::whole_solve};
 
 DeviceOptions device_options(const Backend& backend) {
   DeviceOptions options;
   options.precision = backend.precision;
+  options.solve_launch = backend.solve_launch;
   return options;
 }
 
@@ -127,6 +136,12 @@ void BM_filter_step(benchmark::State& state, const Backend& backend) {
 // Against S, on the liver refined once (4768 tetrahedra).
 BENCHMARK_CAPTURE(BM_ensemble_step, opencl_liver_4768, kOpenCl, std::string("liver"), 1)
     ->RangeMultiplier(2)->Range(1, 256)->Unit(benchmark::kMillisecond)->UseRealTime();
+BENCHMARK_CAPTURE(BM_ensemble_step, opencl_per_iteration_liver_4768, kOpenClPerIteration,
+                  std::string("liver"), 1)
+    ->RangeMultiplier(2)->Range(1, 16)->Unit(benchmark::kMillisecond)->UseRealTime();
+BENCHMARK_CAPTURE(BM_ensemble_step, opencl_whole_solve_liver_4768, kOpenClWholeSolve,
+                  std::string("liver"), 1)
+    ->RangeMultiplier(2)->Range(1, 16)->Unit(benchmark::kMillisecond)->UseRealTime();
 BENCHMARK_CAPTURE(BM_ensemble_step, cpu_liver_4768, kCpu, std::string("liver"), 1)
     ->Arg(1)->Arg(16)->Unit(benchmark::kMillisecond)->UseRealTime();
 // Against mesh size, S = 16.
@@ -144,6 +159,10 @@ BENCHMARK_CAPTURE(BM_ensemble_step, cpu_box_large_117240, kCpu, std::string("box
     ->Arg(16)->Unit(benchmark::kMillisecond)->UseRealTime();
 // A whole filter step on the liver.
 BENCHMARK_CAPTURE(BM_filter_step, opencl, kOpenCl)->Unit(benchmark::kMillisecond)->UseRealTime();
+BENCHMARK_CAPTURE(BM_filter_step, opencl_per_iteration, kOpenClPerIteration)
+    ->Unit(benchmark::kMillisecond)->UseRealTime();
+BENCHMARK_CAPTURE(BM_filter_step, opencl_whole_solve, kOpenClWholeSolve)
+    ->Unit(benchmark::kMillisecond)->UseRealTime();
 BENCHMARK_CAPTURE(BM_filter_step, cpu, kCpu)->Unit(benchmark::kMillisecond)->UseRealTime();
 
 }  // namespace

@@ -123,6 +123,15 @@ OpenClEnsemble::OpenClEnsemble(const Model& model, std::vector<int> estimated,
   // a CPU a work-item per block of sigma points, the blocks shared out over the compute
   // units (and dividing S, so that the kernels' loops over a block have a fixed length).
   cg_per_group_ = info.type != "cpu";
+  // The whole solve in one launch (cg_solve, CPU only) where an iteration's work is small
+  // against two launches (several microseconds each on PoCL): up to kWholeSolveWork
+  // element-sigma pairs. Measured on PoCL, 2 cores (bench/RESULTS.md): the liver filter step
+  // (596 x 4) 4.5 -> 2.3 ms, liver 4768 x 4 38 -> 28 ms; 596 x 16 equal; 4768 x 16 slower
+  // (94 against 79 ms), as one core does what two did.
+  whole_solve_ = !cg_per_group_ &&
+                 (options.solve_launch == SolveLaunch::whole_solve ||
+                  (options.solve_launch == SolveLaunch::automatic &&
+                   static_cast<long long>(elements_) * S_ <= kWholeSolveWork));
   cg_group_ = cg_per_group_ ? 64 : 1;
   const int units = static_cast<int>(std::max(1u, info.compute_units));
   cg_block_ = (S_ + units - 1) / units;
@@ -174,6 +183,7 @@ OpenClEnsemble::OpenClEnsemble(const Model& model, std::vector<int> estimated,
     k_node_product_ = device_.kernel("node_product");
     k_cg_start_ = device_.kernel("cg_start");
     k_cg_iteration_ = device_.kernel("cg_iteration");
+    if (whole_solve_) k_cg_solve_ = device_.kernel("cg_solve");
     k_state_update_ = device_.kernel("state_update");
     k_observation_gather_ = device_.kernel("observation_gather");
     k_recenter_ = device_.kernel("recenter");
@@ -204,6 +214,12 @@ OpenClEnsemble::OpenClEnsemble(const Model& model, std::vector<int> estimated,
       k_cg_iteration_.setArg(20, mass_);
       k_cg_iteration_.setArg(21, element_out_);
     }
+    if (whole_solve_)
+      set_args(k_cg_solve_, S, E, N, static_cast<cl_int>(model.solver.cg_max_iterations),
+               constants_, element_nodes_, element_rest_, frames_, ligament_offsets_,
+               ligament_of_node_, ligament_k_buffer_, control_k_, mass_, rhs_,
+               inverse_diagonal_, dv_, r_, z_, d_, q_, element_out_, bb_, rr_, rz_, active_,
+               converged_, iterations_);
     set_args(k_state_update_, S, rows, constants_, bb_, dv_, x_, v_);
     set_args(k_observation_gather_, S, static_cast<cl_uint>(observed_.size()), observed_nodes_,
              x_, observations_);
@@ -341,6 +357,10 @@ void OpenClEnsemble::node_product(const cl::Buffer& d, const cl::Buffer& q) {
 }
 
 void OpenClEnsemble::conjugate_gradient() {
+  if (whole_solve_) {
+    run(k_cg_solve_, 1, 1);
+    return;
+  }
   // The warm start's residual (dv holds the last step's velocity change).
   element_product(dv_, all_active_);
   node_product(dv_, q_);

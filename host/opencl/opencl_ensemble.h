@@ -23,6 +23,8 @@ class OpenClEnsemble : public DeviceEnsemble {
  public:
   // The CG tolerance floor in single precision: about ten float32 epsilons.
   static constexpr double kSingleTolerance = 1e-6;
+  // Elements x sigma points up to which a CPU device runs the whole CG solve in one launch.
+  static constexpr long long kWholeSolveWork = 32768;
 
   // `estimated`: indices into model.ligaments whose log-stiffness the parameters are;
   // `observed`: node indices. Throws DeviceError (no device, build failure, too little memory).
@@ -82,6 +84,7 @@ class OpenClEnsemble : public DeviceEnsemble {
   int sigma_block_ = 1;                     // SF_SIGMA_BLOCK: sigma points per element work-item
   int element_chunks_ = 0;                  // SF_ELEMENT_CHUNKS: element_product's chunks (CPU)
   int expected_iterations_ = 1;             // CG iterations the last step needed (at most)
+  bool whole_solve_ = false;                // cg_solve: the whole CG solve in one launch (CPU)
   int cg_block_ = 1;                        // SF_CG_BLOCK: sigma points per CG work-item (CPU)
 
   // Shared data.
@@ -98,7 +101,8 @@ class OpenClEnsemble : public DeviceEnsemble {
 
   // Mutable: enqueueing a kernel (also from the const read-outs) changes no visible state.
   mutable cl::Kernel k_element_rhs_, k_node_rhs_, k_element_product_, k_node_product_;
-  mutable cl::Kernel k_cg_start_, k_cg_iteration_, k_state_update_, k_observation_gather_;
+  mutable cl::Kernel k_cg_start_, k_cg_iteration_, k_cg_solve_, k_state_update_;
+  mutable cl::Kernel k_observation_gather_;
   mutable cl::Kernel k_recenter_;
 };
 

@@ -15,6 +15,7 @@
  *
  * Per-sigma scalars (arrays of S): bb = b.b, rr = r.r, rz = r.z, active (1 while iterating),
  * converged (1 converged, 0 hit the cap or broke down), iterations (products done). */
+#include "element_chunk.h"
 #include "node_assembly.h"
 
 /* Sigma points per work-item of the blocked kernels, a divisor of S. */
@@ -152,21 +153,26 @@ void cg_iteration(uint S, uint node_count, int max_iterations, __global const re
 }
 #endif /* SF_CG_PER_GROUP */
 
-/* The warm start of the block first .. first + SF_CG_BLOCK - 1, given q = A x: r = b - q,
+#if !SF_CG_PER_GROUP
+/* The largest block (SF_SIGMA_BLOCK = S on a CPU): the helpers' arrays; `count` is a
+ * constant where they are inlined, so their loops have a fixed length. */
+#define SF_BLOCK_MAX SF_SIGMA_BLOCK
+
+/* The warm start of the block first .. first + count - 1, given q = A x: r = b - q,
  * z = M^-1 r, d = z, the scalars and the flags. Returns whether any of them goes on. */
 static inline __attribute__((always_inline)) int sf_block_cg_start(
-    uint first, uint S, uint rows, __global const real* restrict c,
+    uint first, uint count, uint S, uint rows, __global const real* restrict c,
     __global const real* restrict q, __global const real* restrict b,
     __global const real* restrict inverse_diagonal, __global real* restrict r,
     __global real* restrict z, __global real* restrict d, __global real* restrict bb,
     __global real* restrict rr, __global real* restrict rz, __global uint* restrict active,
     __global uint* restrict converged, __global int* restrict iterations) {
-  real sum_bb[SF_CG_BLOCK];
-  real sum_rr[SF_CG_BLOCK];
-  real sum_rz[SF_CG_BLOCK];
-  for (uint i = 0; i < SF_CG_BLOCK; ++i) sum_bb[i] = sum_rr[i] = sum_rz[i] = (real)0;
+  real sum_bb[SF_BLOCK_MAX];
+  real sum_rr[SF_BLOCK_MAX];
+  real sum_rz[SF_BLOCK_MAX];
+  for (uint i = 0; i < count; ++i) sum_bb[i] = sum_rr[i] = sum_rz[i] = (real)0;
   for (uint row = 0; row < rows; ++row) {
-    for (uint i = 0; i < SF_CG_BLOCK; ++i) {
+    for (uint i = 0; i < count; ++i) {
       size_t at = (size_t)row * S + first + i;
       real bi = b[at];
       real ri = bi - q[at];
@@ -180,7 +186,7 @@ static inline __attribute__((always_inline)) int sf_block_cg_start(
     }
   }
   int any = 0;
-  for (uint i = 0; i < SF_CG_BLOCK; ++i) {
+  for (uint i = 0; i < count; ++i) {
     uint s = first + i;
     int done = sum_bb[i] == (real)0 || sum_rr[i] <= c[SF_CG_TOLERANCE2] * sum_bb[i];
     bb[s] = sum_bb[i];
@@ -199,35 +205,35 @@ static inline __attribute__((always_inline)) int sf_block_cg_start(
  * residual that is not finite), and d = z + beta d for those that go on. Returns whether any
  * of them goes on. */
 static inline __attribute__((always_inline)) int sf_block_cg_iteration(
-    uint first, uint S, uint rows, int max_iterations, __global const real* restrict c,
+    uint first, uint count, uint S, uint rows, int max_iterations, __global const real* restrict c,
     __global const real* restrict inverse_diagonal, __global real* restrict x,
     __global real* restrict r, __global real* restrict z, __global real* restrict d,
     __global const real* restrict q, __global const real* restrict bb,
     __global real* restrict rr, __global real* restrict rz, __global uint* restrict active,
     __global uint* restrict converged, __global int* restrict iterations) {
-  int going[SF_CG_BLOCK];
+  int going[SF_BLOCK_MAX];
   int any = 0;
-  for (uint i = 0; i < SF_CG_BLOCK; ++i) {
+  for (uint i = 0; i < count; ++i) {
     going[i] = active[first + i] != 0u;
     any |= going[i];
   }
   if (!any) return 0;
-  real sum_dq[SF_CG_BLOCK];
-  for (uint i = 0; i < SF_CG_BLOCK; ++i) sum_dq[i] = (real)0;
+  real sum_dq[SF_BLOCK_MAX];
+  for (uint i = 0; i < count; ++i) sum_dq[i] = (real)0;
   for (uint row = 0; row < rows; ++row)
-    for (uint i = 0; i < SF_CG_BLOCK; ++i) {
+    for (uint i = 0; i < count; ++i) {
       size_t at = (size_t)row * S + first + i;
       sum_dq[i] += d[at] * q[at];
     }
-  real alpha[SF_CG_BLOCK];
-  real rr_new[SF_CG_BLOCK];
-  real rz_new[SF_CG_BLOCK];
-  for (uint i = 0; i < SF_CG_BLOCK; ++i) {
+  real alpha[SF_BLOCK_MAX];
+  real rr_new[SF_BLOCK_MAX];
+  real rz_new[SF_BLOCK_MAX];
+  for (uint i = 0; i < count; ++i) {
     alpha[i] = going[i] ? rz[first + i] / sum_dq[i] : (real)0;
     rr_new[i] = rz_new[i] = (real)0;
   }
   for (uint row = 0; row < rows; ++row) {
-    for (uint i = 0; i < SF_CG_BLOCK; ++i) {
+    for (uint i = 0; i < count; ++i) {
       size_t at = (size_t)row * S + first + i;
       x[at] += alpha[i] * d[at];
       real ri = r[at] - alpha[i] * q[at];
@@ -238,17 +244,17 @@ static inline __attribute__((always_inline)) int sf_block_cg_iteration(
       rz_new[i] += ri * zi;
     }
   }
-  real beta[SF_CG_BLOCK];
+  real beta[SF_BLOCK_MAX];
   any = 0;
-  for (uint i = 0; i < SF_CG_BLOCK; ++i) {
+  for (uint i = 0; i < count; ++i) {
     uint s = first + i;
     beta[i] = (real)1;
     if (!going[i]) continue;
-    int count = iterations[s] + 1;
+    int products = iterations[s] + 1;
     int done = rr_new[i] <= c[SF_CG_TOLERANCE2] * bb[s];
-    going[i] = !(done || !isfinite(rr_new[i]) || count >= max_iterations);
+    going[i] = !(done || !isfinite(rr_new[i]) || products >= max_iterations);
     beta[i] = rz_new[i] / rz[s];
-    iterations[s] = count;
+    iterations[s] = products;
     rr[s] = rr_new[i];
     rz[s] = rz_new[i];
     if (done) converged[s] = 1u;
@@ -257,7 +263,7 @@ static inline __attribute__((always_inline)) int sf_block_cg_iteration(
   }
   if (!any) return 0;
   for (uint row = 0; row < rows; ++row) {
-    for (uint i = 0; i < SF_CG_BLOCK; ++i) {
+    for (uint i = 0; i < count; ++i) {
       size_t at = (size_t)row * S + first + i;
       d[at] = going[i] ? z[at] + beta[i] * d[at] : d[at];
     }
@@ -265,20 +271,19 @@ static inline __attribute__((always_inline)) int sf_block_cg_iteration(
   return 1;
 }
 
-#if !SF_CG_PER_GROUP
 /* q = A d for the block, from the element chunks' copies of K d (element_product.cl, summed
  * in chunk order) and the nodal terms: node_product's arithmetic, done here so that the
  * iteration needs no launch of its own for it and finds q in cache. */
 static inline __attribute__((always_inline)) void sf_block_node_product(
-    uint first, uint S, uint node_count, __global const real* restrict c,
+    uint first, uint count, uint chunks, uint S, uint node_count, __global const real* restrict c,
     __global const int* restrict ligament_offsets, __global const int* restrict ligament_of_node,
     __global const real* restrict ligament_k, __global const real* restrict control_k,
     __global const real* restrict mass, __global const real* restrict d,
     __global const real* restrict element_out, __global real* restrict q) {
   const size_t copy_size = (size_t)3 * node_count * S;
   for (uint n = 0; n < node_count; ++n) {
-    real nodal[SF_CG_BLOCK];
-    for (uint i = 0; i < SF_CG_BLOCK; ++i) {
+    real nodal[SF_BLOCK_MAX];
+    for (uint i = 0; i < count; ++i) {
       real spring = sf_node_spring(ligament_offsets, ligament_of_node, ligament_k, control_k, n,
                                    first + i, S);
       nodal[i] = c[SF_MASS_FACTOR] * sf_solver_mass(mass[n], spring) + c[SF_STIFFNESS_FACTOR] * spring;
@@ -286,11 +291,11 @@ static inline __attribute__((always_inline)) void sf_block_node_product(
     SF_UNROLL
     for (int k = 0; k < 3; ++k) {
       size_t row = ((size_t)3 * n + k) * S + first;
-      real sum[SF_CG_BLOCK];
-      for (uint i = 0; i < SF_CG_BLOCK; ++i) sum[i] = (real)0;
-      for (uint chunk = 0; chunk < SF_ELEMENT_CHUNKS; ++chunk)
-        for (uint i = 0; i < SF_CG_BLOCK; ++i) sum[i] += element_out[chunk * copy_size + row + i];
-      for (uint i = 0; i < SF_CG_BLOCK; ++i)
+      real sum[SF_BLOCK_MAX];
+      for (uint i = 0; i < count; ++i) sum[i] = (real)0;
+      for (uint chunk = 0; chunk < chunks; ++chunk)
+        for (uint i = 0; i < count; ++i) sum[i] += element_out[chunk * copy_size + row + i];
+      for (uint i = 0; i < count; ++i)
         q[row + i] = c[SF_STIFFNESS_FACTOR] * sum[i] + nodal[i] * d[row + i];
     }
   }
@@ -305,7 +310,7 @@ __kernel void cg_start(uint S, uint node_count, __global const real* restrict c,
                        __global uint* restrict converged, __global int* restrict iterations) {
   uint first = (uint)get_global_id(0) * SF_CG_BLOCK;
   if (first >= S) return;
-  sf_block_cg_start(first, S, 3 * node_count, c, q, b, inverse_diagonal, r, z, d, bb, rr, rz,
+  sf_block_cg_start(first, SF_CG_BLOCK, S, 3 * node_count, c, q, b, inverse_diagonal, r, z, d, bb, rr, rz,
                     active, converged, iterations);
 }
 
@@ -330,9 +335,45 @@ __kernel void cg_iteration(uint S, uint node_count, int max_iterations,
   int any = 0;
   for (uint i = 0; i < SF_CG_BLOCK; ++i) any |= active[first + i] != 0u;
   if (!any) return;
-  sf_block_node_product(first, S, node_count, c, ligament_offsets, ligament_of_node, ligament_k,
+  sf_block_node_product(first, SF_CG_BLOCK, SF_ELEMENT_CHUNKS, S, node_count, c, ligament_offsets, ligament_of_node, ligament_k,
                         control_k, mass, d, element_out, q);
-  sf_block_cg_iteration(first, S, 3 * node_count, max_iterations, c, inverse_diagonal, x, r, z,
+  sf_block_cg_iteration(first, SF_CG_BLOCK, S, 3 * node_count, max_iterations, c, inverse_diagonal, x, r, z,
                         d, q, bb, rr, rz, active, converged, iterations);
+}
+
+/* The whole solve in one launch, for small meshes: one work-item takes every sigma point
+ * (a block of S) and does the products itself (one chunk of all the elements into
+ * element_out, then q), so a step costs one launch instead of two per iteration. Where a
+ * launch costs several microseconds (PoCL) and an iteration's work is tens of them, that
+ * is most of the time (the liver filter step). One core only: the host uses it on meshes
+ * small enough for that to pay (OpenClEnsemble). */
+__kernel void cg_solve(uint S, uint element_count, uint node_count, int max_iterations,
+                       __global const real* restrict c, __global const int* restrict nodes,
+                       __global const real* restrict rest, __global const real* restrict frames,
+                       __global const int* restrict ligament_offsets,
+                       __global const int* restrict ligament_of_node,
+                       __global const real* restrict ligament_k,
+                       __global const real* restrict control_k, __global const real* restrict mass,
+                       __global const real* restrict b, __global const real* restrict inverse_diagonal,
+                       __global real* restrict x, __global real* restrict r,
+                       __global real* restrict z, __global real* restrict d,
+                       __global real* restrict q, __global real* restrict element_out,
+                       __global real* restrict bb, __global real* restrict rr,
+                       __global real* restrict rz, __global uint* restrict active,
+                       __global uint* restrict converged, __global int* restrict iterations) {
+  if (get_global_id(0) != 0) return;
+  const uint rows = 3 * node_count;
+  sf_element_chunk_products(0, element_count, S, node_count, nodes, rest, frames, x, element_out);
+  sf_block_node_product(0, SF_SIGMA_BLOCK, 1, S, node_count, c, ligament_offsets, ligament_of_node,
+                        ligament_k, control_k, mass, x, element_out, q);
+  int any = sf_block_cg_start(0, SF_SIGMA_BLOCK, S, rows, c, q, b, inverse_diagonal, r, z, d, bb,
+                              rr, rz, active, converged, iterations);
+  while (any) {
+    sf_element_chunk_products(0, element_count, S, node_count, nodes, rest, frames, d, element_out);
+    sf_block_node_product(0, SF_SIGMA_BLOCK, 1, S, node_count, c, ligament_offsets,
+                          ligament_of_node, ligament_k, control_k, mass, d, element_out, q);
+    any = sf_block_cg_iteration(0, SF_SIGMA_BLOCK, S, rows, max_iterations, c, inverse_diagonal,
+                                x, r, z, d, q, bb, rr, rz, active, converged, iterations);
+  }
 }
 #endif

@@ -11,7 +11,7 @@
  * result; node_product sums the copies, in chunk order. The copies are small enough to stay
  * in cache, where the element outputs (12 E S numbers, 29 MB at 38k tetrahedra and S = 16)
  * went through memory twice per iteration. */
-#include "ensemble_layout.h"
+#include "element_chunk.h"
 
 __kernel void element_product(uint S, uint element_count, __global const int* restrict nodes,
                               __global const real* restrict rest, __global const real* restrict frames,
@@ -20,38 +20,10 @@ __kernel void element_product(uint S, uint element_count, __global const int* re
 #if SF_ELEMENT_CHUNKS > 0
   uint chunk = (uint)get_global_id(0);
   if (chunk >= SF_ELEMENT_CHUNKS) return;
-  const size_t copy_size = (size_t)3 * node_count * S;
-  __global real* restrict copy = out + chunk * copy_size;
-  for (size_t i = 0; i < copy_size; ++i) copy[i] = (real)0;
-  uint begin = (uint)((ulong)element_count * chunk / SF_ELEMENT_CHUNKS);
-  uint end = (uint)((ulong)element_count * (chunk + 1) / SF_ELEMENT_CHUNKS);
-  for (uint e = begin; e < end; ++e) {
-    real grad[12];
-    real vlambda;
-    real vmu;
-    sf_load_rest(rest, e, grad, &vlambda, &vmu);
-    int corner_nodes[4];
-    sf_load_nodes(nodes, e, corner_nodes);
-    /* The products of all sigma points first, then the additions, each a loop over the
-     * sigma points on contiguous data: the compiler vectorises both (with the additions in
-     * the first loop it could not, not knowing that the corners' nodes differ). */
-    real products[12][SF_SIGMA_BLOCK];
-    for (uint s = 0; s < SF_SIGMA_BLOCK; ++s) {
-      real frame[9];
-      real corner[12];
-      real product[12];
-      sf_load_frame(frames, e, s, S, frame);
-      sf_gather_corners(d, corner_nodes, s, S, corner);
-      sf_element_product(frame, grad, vlambda, vmu, corner, product);
-      SF_UNROLL
-      for (int i = 0; i < 12; ++i) products[i][s] = product[i];
-    }
-    SF_UNROLL
-    for (int i = 0; i < 12; ++i) {
-      __global real* restrict row = copy + (size_t)(3 * corner_nodes[i / 3] + i % 3) * S;
-      for (uint s = 0; s < SF_SIGMA_BLOCK; ++s) row[s] += products[i][s];
-    }
-  }
+  sf_element_chunk_products((uint)((ulong)element_count * chunk / SF_ELEMENT_CHUNKS),
+                            (uint)((ulong)element_count * (chunk + 1) / SF_ELEMENT_CHUNKS), S,
+                            node_count, nodes, rest, frames, d,
+                            out + chunk * ((size_t)3 * node_count * S));
 #else
   uint e;
   uint first;

@@ -33,13 +33,19 @@ struct BackendCase {
   std::string backend;
   Precision precision;
   std::string name;  // for the test name
+  SolveLaunch solve_launch = SolveLaunch::automatic;
 };
 
 // The back ends to check: OpenCL device 0 in single and, where it has fp64, double precision.
 std::vector<BackendCase> backend_cases() {
   std::vector<BackendCase> cases;
-  cases.push_back({"opencl", Precision::single, "OpenClSingle"});
-  cases.push_back({"opencl", Precision::double_precision, "OpenClDouble"});
+  // OpenCL's two ways of running CG (kernels/opencl/conjugate_gradient.cl), each forced,
+  // since which one it picks by itself depends on the device, the mesh and S.
+  cases.push_back({"opencl", Precision::single, "OpenClSingle", SolveLaunch::per_iteration});
+  cases.push_back({"opencl", Precision::double_precision, "OpenClDouble", SolveLaunch::per_iteration});
+  cases.push_back({"opencl", Precision::single, "OpenClSingleWholeSolve", SolveLaunch::whole_solve});
+  cases.push_back({"opencl", Precision::double_precision, "OpenClDoubleWholeSolve",
+                   SolveLaunch::whole_solve});
   return cases;
 }
 
@@ -93,6 +99,7 @@ class EnsembleConformance : public ::testing::TestWithParam<Case> {
   std::unique_ptr<DeviceEnsemble> device_ensemble(const Model& model) const {
     DeviceOptions options;
     options.precision = GetParam().backend.precision;
+    options.solve_launch = GetParam().backend.solve_launch;
     std::unique_ptr<Ensemble> ensemble = make_ensemble(
         GetParam().backend.backend, model, estimated_, scenario_.observations.nodes, S_, options);
     return std::unique_ptr<DeviceEnsemble>(dynamic_cast<DeviceEnsemble*>(ensemble.release()));

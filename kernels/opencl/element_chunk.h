@@ -1,0 +1,46 @@
+/* element_chunk.h: K d over a contiguous chunk of elements for all S sigma points, added into
+ * one 3N x S copy (element_product.cl's form on a CPU, and cg_solve's). The elements are
+ * taken in order and the copy belongs to the caller alone: no atomics, the same bits every
+ * run. SF_SIGMA_BLOCK = S here: the loops over the sigma points, on contiguous data, are
+ * vectorised. */
+#ifndef SIGMAFEM_ELEMENT_CHUNK_H
+#define SIGMAFEM_ELEMENT_CHUNK_H
+
+#include "ensemble_layout.h"
+
+static inline __attribute__((always_inline)) void sf_element_chunk_products(
+    uint begin, uint end, uint S, uint node_count, __global const int* restrict nodes,
+    __global const real* restrict rest, __global const real* restrict frames,
+    __global const real* restrict d, __global real* restrict copy) {
+  const size_t copy_size = (size_t)3 * node_count * S;
+  for (size_t i = 0; i < copy_size; ++i) copy[i] = (real)0;
+  for (uint e = begin; e < end; ++e) {
+    real grad[12];
+    real vlambda;
+    real vmu;
+    sf_load_rest(rest, e, grad, &vlambda, &vmu);
+    int corner_nodes[4];
+    sf_load_nodes(nodes, e, corner_nodes);
+    /* The products of all sigma points first, then the additions, each a loop over the
+     * sigma points on contiguous data: the compiler vectorises both (with the additions in
+     * the first loop it could not, not knowing that the corners' nodes differ). */
+    real products[12][SF_SIGMA_BLOCK];
+    for (uint s = 0; s < SF_SIGMA_BLOCK; ++s) {
+      real frame[9];
+      real corner[12];
+      real product[12];
+      sf_load_frame(frames, e, s, S, frame);
+      sf_gather_corners(d, corner_nodes, s, S, corner);
+      sf_element_product(frame, grad, vlambda, vmu, corner, product);
+      SF_UNROLL
+      for (int i = 0; i < 12; ++i) products[i][s] = product[i];
+    }
+    SF_UNROLL
+    for (int i = 0; i < 12; ++i) {
+      __global real* restrict row = copy + (size_t)(3 * corner_nodes[i / 3] + i % 3) * S;
+      for (uint s = 0; s < SF_SIGMA_BLOCK; ++s) row[s] += products[i][s];
+    }
+  }
+}
+
+#endif /* SIGMAFEM_ELEMENT_CHUNK_H */
