@@ -22,6 +22,7 @@
 #include "host/ensemble/make_ensemble.h"
 #include "host/model/model.h"
 #include "host/opencl/opencl_device.h"
+#include "host/vulkan/vulkan_device.h"
 #include "host/reference/implicit_euler.h"
 #include "host/reference/reference_simulation.h"
 #include "host/scenario/scenario.h"
@@ -35,11 +36,14 @@ struct BackendCase {
   std::string name;  // for the test name
 };
 
-// The back ends to check: OpenCL device 0 in single and, where it has fp64, double precision.
+// The back ends to check: OpenCL device 0 and Vulkan device 0, each in single and, where the
+// device has fp64, double precision.
 std::vector<BackendCase> backend_cases() {
   std::vector<BackendCase> cases;
   cases.push_back({"opencl", Precision::single, "OpenClSingle"});
   cases.push_back({"opencl", Precision::double_precision, "OpenClDouble"});
+  cases.push_back({"vulkan", Precision::single, "VulkanSingle"});
+  cases.push_back({"vulkan", Precision::double_precision, "VulkanDouble"});
   return cases;
 }
 
@@ -50,6 +54,13 @@ std::string unavailable(const BackendCase& c) {
     if (devices.empty()) return "no OpenCL platform on this machine";
     if (c.precision == Precision::double_precision && !devices[0].has_fp64)
       return "OpenCL device 0 has no fp64";
+  }
+  if (c.backend == "vulkan") {
+    std::string why;
+    const auto devices = list_vulkan_devices(&why);
+    if (devices.empty()) return why;
+    if (c.precision == Precision::double_precision && !devices[0].has_fp64)
+      return "Vulkan device 0 has no shaderFloat64";
   }
   return "";
 }
