@@ -8,10 +8,9 @@
 
 namespace sigmafem {
 
-EnsembleTables make_ensemble_tables(const Model& model, const std::vector<int>& estimated,
-                                    const std::vector<int>& observed, int S, const char* who) {
+void check_ensemble_arguments(const Model& model, const std::vector<int>& estimated,
+                              const std::vector<int>& observed, int S, const char* who) {
   const std::string name(who);
-  const int nodes = model.node_count(), elements = model.element_count();
   if (S < 1) throw std::invalid_argument(name + ": need at least one sigma point");
   if (static_cast<int>(estimated.size()) > kDeviceMaxParameters)
     throw std::invalid_argument(name + ": at most " + std::to_string(kDeviceMaxParameters) +
@@ -20,9 +19,12 @@ EnsembleTables make_ensemble_tables(const Model& model, const std::vector<int>& 
     if (l < 0 || l >= static_cast<int>(model.ligaments.size()))
       throw std::invalid_argument(name + ": no ligament " + std::to_string(l));
   for (int node : observed)
-    if (node < 0 || node >= nodes)
+    if (node < 0 || node >= model.node_count())
       throw std::invalid_argument(name + ": no node " + std::to_string(node));
+}
 
+EnsembleTables make_ensemble_tables(const Model& model, int S) {
+  const int nodes = model.node_count(), elements = model.element_count();
   EnsembleTables t;
   t.element_nodes.assign(4 * static_cast<std::size_t>(elements), 0);
   t.element_rest.assign(16 * static_cast<std::size_t>(elements), 0.0);
@@ -131,10 +133,9 @@ EnsembleMemory ensemble_memory(int nodes, int elements, int S, std::size_t real_
   return need;
 }
 
-std::string out_of_device_memory_message(const EnsembleMemory& need, int nodes, int elements,
-                                         int S, const std::string& device,
+std::string out_of_device_memory_message(const EnsembleMemory& need, int elements, int S,
+                                         const std::string& device,
                                          std::size_t device_memory, std::size_t largest_buffer) {
-  (void)nodes;
   return "out of device memory: " + std::to_string(S) + " sigma points on " +
          std::to_string(elements) + " tetrahedra need about " + std::to_string(need.total >> 20) +
          " MiB (largest buffer " + std::to_string(need.largest >> 20) + " MiB); " + device +

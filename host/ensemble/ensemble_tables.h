@@ -38,10 +38,13 @@ struct EnsembleTables {
   std::vector<double> initial_positions;  // the rest shape for every sigma point, 3N x S
 };
 
-// Checks the ensemble's arguments (std::invalid_argument naming `who`) and builds the tables.
-EnsembleTables make_ensemble_tables(const Model& model, const std::vector<int>& estimated,
-                                    const std::vector<int>& observed, int sigma_count,
-                                    const char* who);
+// Checks an ensemble's arguments: std::invalid_argument naming `who`.
+void check_ensemble_arguments(const Model& model, const std::vector<int>& estimated,
+                              const std::vector<int>& observed, int sigma_count, const char* who);
+
+// The tables for S = sigma_count (after the device-memory check: they are as big as the
+// per-sigma state).
+EnsembleTables make_ensemble_tables(const Model& model, int sigma_count);
 
 // Writes exp(theta(j, s)) / (nodes of ligament estimated[j]) into ligament_k (p x S theta).
 void set_ligament_stiffness(const Model& model, const std::vector<int>& estimated,
@@ -68,7 +71,7 @@ struct EnsembleMemory {
 EnsembleMemory ensemble_memory(int nodes, int elements, int sigma_count, std::size_t real_size);
 
 // The "out of device memory" message: what the ensemble needs and what `device` has.
-std::string out_of_device_memory_message(const EnsembleMemory& need, int nodes, int elements,
+std::string out_of_device_memory_message(const EnsembleMemory& need, int elements,
                                          int sigma_count, const std::string& device,
                                          std::size_t device_memory, std::size_t largest_buffer);
 

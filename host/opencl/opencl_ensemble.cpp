@@ -38,8 +38,7 @@ OpenClEnsemble::OpenClEnsemble(const Model& model, std::vector<int> estimated,
       S_(sigma_count),
       nodes_(model.node_count()),
       elements_(model.element_count()) {
-  EnsembleTables tables =
-      make_ensemble_tables(model, estimated_, observed_, S_, "OpenClEnsemble");
+  check_ensemble_arguments(model, estimated_, observed_, S_, "OpenClEnsemble");
   tolerance_ = options.precision == Precision::single
                    ? std::max(model.solver.cg_tolerance, kSingleTolerance)
                    : model.solver.cg_tolerance;
@@ -50,8 +49,9 @@ OpenClEnsemble::OpenClEnsemble(const Model& model, std::vector<int> estimated,
   const EnsembleMemory need = ensemble_memory(nodes_, elements_, S_, device_.real_size());
   const OpenClDeviceInfo& info = device_.info();
   if (need.largest > info.max_allocation || need.total > info.global_memory)
-    throw DeviceError(out_of_device_memory_message(need, nodes_, elements_, S_, info.name,
+    throw DeviceError(out_of_device_memory_message(need, elements_, S_, info.name,
                                                    info.global_memory, info.max_allocation));
+  EnsembleTables tables = make_ensemble_tables(model, S_);
   ligament_k_ = std::move(tables.ligament_k);
 
   // Element kernels: on a CPU device one work-item takes an element for all S sigma points,

@@ -30,8 +30,7 @@ VulkanEnsemble::VulkanEnsemble(const Model& model, std::vector<int> estimated,
       S_(sigma_count),
       nodes_(model.node_count()),
       elements_(model.element_count()) {
-  EnsembleTables tables =
-      make_ensemble_tables(model, estimated_, observed_, S_, "VulkanEnsemble");
+  check_ensemble_arguments(model, estimated_, observed_, S_, "VulkanEnsemble");
   tolerance_ = options.precision == Precision::single
                    ? std::max(model.solver.cg_tolerance, kSingleTolerance)
                    : model.solver.cg_tolerance;
@@ -42,12 +41,13 @@ VulkanEnsemble::VulkanEnsemble(const Model& model, std::vector<int> estimated,
   const EnsembleMemory need = ensemble_memory(nodes_, elements_, S_, device_.real_size());
   const VulkanDeviceInfo& info = device_.info();
   if (need.largest > info.max_buffer || need.total > info.memory)
-    throw DeviceError(out_of_device_memory_message(need, nodes_, elements_, S_, info.name,
+    throw DeviceError(out_of_device_memory_message(need, elements_, S_, info.name,
                                                    info.memory, info.max_buffer));
   // The CG shaders take one work-group per sigma point along x.
   if (static_cast<std::uint32_t>(S_) > device_.max_group_count())
     throw DeviceError("Vulkan device " + info.name + " runs at most " +
                       std::to_string(device_.max_group_count()) + " sigma points");
+  EnsembleTables tables = make_ensemble_tables(model, S_);
   ligament_k_ = std::move(tables.ligament_k);
   // Work-items per sigma point in CG: on a CPU (lavapipe) one SIMD register's worth, so that
   // a group's barriers cost nothing; on a GPU 64 (two warps, one wavefront).
