@@ -69,11 +69,11 @@ void main() {
   for (uint n = gl_LocalInvocationID.x; n < sf_push.count; n += gl_WorkGroupSize.x) {
     real spring = sf_node_spring(n, s, S);
     real m = sf_solver_mass(mass[n], spring);
+    real Kd[3];
+    SF_CORNER_SUMS(element_out, n, s, S, Kd)
     for (uint k = 0u; k < 3u; ++k) {
       uint row = (3u * n + k) * S + s;
-      real Kd;
-      SF_CORNER_SUM(element_out, n, k, s, S, Kd)
-      real q = sf_system_row(Kd, spring, m, x[row]);
+      real q = sf_system_row(Kd[k], spring, m, x[row]);
       real bi = b[row];
       real ri = bi - q;
       real zi = inverse_diagonal[row] * ri;

@@ -28,22 +28,23 @@ void main() {
   uint n = gid / S;
   real spring = sf_node_spring(n, s, S);
   real m = sf_solver_mass(mass[n], spring);
+  real f_elements[3];
+  real diagonal[3];
+  SF_CORNER_SUMS(element_rhs_out, n, s, S, f_elements)
+  SF_CORNER_SUMS(element_diagonal, n, s, S, diagonal)
   for (uint k = 0u; k < 3u; ++k) {
     uint row = (3u * n + k) * S + s;
     real xr = x[row];
     real vr = v[row];
     /* elastic force and (h + a) K v from the elements; springs pull towards rest (control
      * springs towards rest + so_shift); the springs' own (h + a) k v term. */
-    real f;
-    SF_CORNER_SUM(element_rhs_out, n, k, s, S, f)
+    real f = f_elements[k];
     f -= spring * (xr - rest_positions[3u * n + k]) - control_k[n] * c[SF_SO_SHIFT + k];
     f += mass[n] * c[SF_GRAVITY + k];
     f -= c[SF_VELOCITY_FACTOR] * spring * vr;
     rhs[row] = c[SF_H] * (f - c[SF_RAYLEIGH_MASS] * m * vr);
-    real diagonal;
-    SF_CORNER_SUM(element_diagonal, n, k, s, S, diagonal)
     inverse_diagonal[row] =
-        real(1) / (c[SF_MASS_FACTOR] * m + c[SF_STIFFNESS_FACTOR] * (diagonal + spring));
+        real(1) / (c[SF_MASS_FACTOR] * m + c[SF_STIFFNESS_FACTOR] * (diagonal[k] + spring));
   }
 }
 
@@ -60,11 +61,11 @@ void main() {
   uint n = gid / S;
   real spring = sf_node_spring(n, s, S);
   real m = sf_solver_mass(mass[n], spring);
+  real sum[3];
+  SF_CORNER_SUMS(element_out, n, s, S, sum)
   for (uint k = 0u; k < 3u; ++k) {
     uint row = (3u * n + k) * S + s;
-    real sum;
-    SF_CORNER_SUM(element_out, n, k, s, S, sum)
-    q[row] = sf_system_row(sum, spring, m, d[row]);
+    q[row] = sf_system_row(sum[k], spring, m, d[row]);
   }
 }
 

@@ -307,11 +307,21 @@ TEST_P(EnsembleConformance, IterationCapIsReported) {
   }
 }
 
+// Every back end on both scenarios with S = 1, 4, 16; but Vulkan in double precision with
+// S = 1 and 4 only. On lavapipe (Mesa's CPU Vulkan, where the tests run) every load at a
+// lane-varying address is a scalar gather, so its S = 16 double cases alone took 7 minutes
+// on the 2-core machine (box trajectory 141-360 s); they run the same shaders (compiled with
+// -DSF_USE_DOUBLE) over the same indexing that the single-precision S = 16 cases check.
 std::vector<Case> all_cases() {
   std::vector<Case> cases;
   for (const BackendCase& backend : backend_cases())
     for (const char* scenario : {"box", "liver"})
-      for (int S : {1, 4, 16}) cases.push_back({backend, scenario, S});
+      for (int S : {1, 4, 16}) {
+        if (backend.backend == "vulkan" && backend.precision == Precision::double_precision &&
+            S == 16)
+          continue;
+        cases.push_back({backend, scenario, S});
+      }
   return cases;
 }
 
