@@ -13,9 +13,12 @@ case "$mode" in run|test) ;; *) echo "usage: ./setup.sh run|test" >&2; exit 2 ;;
 
 # OpenCL: the ICD loader and C++ headers to build; PoCL runs the kernels on any CPU (a GPU
 # vendor's driver, where there is one, is picked up by the same loader).
+# Vulkan: headers and loader, glslang to compile the shaders at build time, Mesa's lavapipe
+# to run them on any CPU, and the Khronos validation layer that the tests switch on.
 packages="g++ cmake ninja-build pkg-config libeigen3-dev nlohmann-json3-dev libcli11-dev
           libgtest-dev libbenchmark-dev gnuplot-nox
-          ocl-icd-opencl-dev opencl-clhpp-headers pocl-opencl-icd"
+          ocl-icd-opencl-dev opencl-clhpp-headers pocl-opencl-icd
+          libvulkan-dev glslang-tools mesa-vulkan-drivers vulkan-validationlayers"
 missing=""
 for p in $packages; do
   dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q 'ok installed' || missing="$missing $p"

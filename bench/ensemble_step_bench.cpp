@@ -1,5 +1,5 @@
-// Speed of the ensembles (issue 4, "Speed"): one advance() of S sigma points, OpenCL beside
-// the CPU reference in the same run, against S on a ~5k-tetrahedron liver and against mesh
+// Speed of the ensembles (issues 4 and 5, "Speed"): one advance() of S sigma points, OpenCL
+// and Vulkan beside the CPU reference in the same run, against S on a ~5k-tetrahedron liver and against mesh
 // size at S = 16; and one whole ROUKF filter step on the liver (simplex, 3 ligaments).
 // Units (ARCHITECTURE.md): element-iterations per second (one element's product for one
 // sigma point in one CG iteration) and sigma-point steps per second. Results: bench/RESULTS.md.
@@ -42,6 +42,7 @@ DeviceOptions device_options(const Backend& backend) {
   options.solve_launch = backend.solve_launch;
   return options;
 }
+const Backend kVulkan{"vulkan", Precision::single, "vulkan single, device 0"};
 
 // An ensemble of S sigma points with stiffnesses spread around the scenario's, advanced a
 // few steps so that the organ is deformed and CG warm-starts as in a run.
@@ -142,18 +143,26 @@ BENCHMARK_CAPTURE(BM_ensemble_step, opencl_per_iteration_liver_4768, kOpenClPerI
 BENCHMARK_CAPTURE(BM_ensemble_step, opencl_whole_solve_liver_4768, kOpenClWholeSolve,
                   std::string("liver"), 1)
     ->RangeMultiplier(2)->Range(1, 16)->Unit(benchmark::kMillisecond)->UseRealTime();
+BENCHMARK_CAPTURE(BM_ensemble_step, vulkan_liver_4768, kVulkan, std::string("liver"), 1)
+    ->RangeMultiplier(2)->Range(1, 256)->Unit(benchmark::kMillisecond)->UseRealTime();
 BENCHMARK_CAPTURE(BM_ensemble_step, cpu_liver_4768, kCpu, std::string("liver"), 1)
     ->Arg(1)->Arg(16)->Unit(benchmark::kMillisecond)->UseRealTime();
 // Against mesh size, S = 16.
 BENCHMARK_CAPTURE(BM_ensemble_step, opencl_liver_596, kOpenCl, std::string("liver"), 0)
     ->Arg(16)->Unit(benchmark::kMillisecond)->UseRealTime();
+BENCHMARK_CAPTURE(BM_ensemble_step, vulkan_liver_596, kVulkan, std::string("liver"), 0)
+    ->Arg(16)->Unit(benchmark::kMillisecond)->UseRealTime();
 BENCHMARK_CAPTURE(BM_ensemble_step, cpu_liver_596, kCpu, std::string("liver"), 0)
     ->Arg(16)->Unit(benchmark::kMillisecond)->UseRealTime();
 BENCHMARK_CAPTURE(BM_ensemble_step, opencl_liver_fine_38144, kOpenCl, std::string("liver_fine"), 0)
     ->Arg(16)->Unit(benchmark::kMillisecond)->UseRealTime();
+BENCHMARK_CAPTURE(BM_ensemble_step, vulkan_liver_fine_38144, kVulkan, std::string("liver_fine"), 0)
+    ->Arg(16)->Unit(benchmark::kMillisecond)->UseRealTime();
 BENCHMARK_CAPTURE(BM_ensemble_step, cpu_liver_fine_38144, kCpu, std::string("liver_fine"), 0)
     ->Arg(16)->Unit(benchmark::kMillisecond)->UseRealTime();
 BENCHMARK_CAPTURE(BM_ensemble_step, opencl_box_large_117240, kOpenCl, std::string("box_large"), 0)
+    ->Arg(16)->Unit(benchmark::kMillisecond)->UseRealTime();
+BENCHMARK_CAPTURE(BM_ensemble_step, vulkan_box_large_117240, kVulkan, std::string("box_large"), 0)
     ->Arg(16)->Unit(benchmark::kMillisecond)->UseRealTime();
 BENCHMARK_CAPTURE(BM_ensemble_step, cpu_box_large_117240, kCpu, std::string("box_large"), 0)
     ->Arg(16)->Unit(benchmark::kMillisecond)->UseRealTime();
@@ -163,6 +172,7 @@ BENCHMARK_CAPTURE(BM_filter_step, opencl_per_iteration, kOpenClPerIteration)
     ->Unit(benchmark::kMillisecond)->UseRealTime();
 BENCHMARK_CAPTURE(BM_filter_step, opencl_whole_solve, kOpenClWholeSolve)
     ->Unit(benchmark::kMillisecond)->UseRealTime();
+BENCHMARK_CAPTURE(BM_filter_step, vulkan, kVulkan)->Unit(benchmark::kMillisecond)->UseRealTime();
 BENCHMARK_CAPTURE(BM_filter_step, cpu, kCpu)->Unit(benchmark::kMillisecond)->UseRealTime();
 
 }  // namespace

@@ -1,5 +1,5 @@
 // The options that choose where simulations run, shared by `estimate`, `generate` and `demo`:
-// --backend cpu|opencl, --device N, --precision single|double.
+// --backend cpu|opencl|vulkan, --device N, --precision single|double.
 #pragma once
 
 #include <CLI/CLI.hpp>

@@ -1,4 +1,4 @@
-// `sigmafem estimate SCENARIO --data DIR --out DIR [--backend cpu|opencl] [--device N]
+// `sigmafem estimate SCENARIO --data DIR --out DIR [--backend cpu|opencl|vulkan] [--device N]
 //  [--precision single|double] [--sigma simplex|star]`.
 #include <iostream>
 #include <memory>

@@ -1,7 +1,7 @@
 // sigmafem command line. Exit codes: 0 success, 1 a run that failed (the simulation), 2 bad
-// input (files, scenario, options), 3 a device that cannot run it (no OpenCL platform, a
-// kernel that fails to build, out of device memory), with a message on stderr that says
-// where and what.
+// input (files, scenario, options), 3 a device that cannot run it (no OpenCL platform or
+// Vulkan driver, a kernel or shader that fails to build or load, out of device memory),
+// with a message on stderr that says where and what.
 #include <CLI/CLI.hpp>
 #include <iostream>
 #include <map>

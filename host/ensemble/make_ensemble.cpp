@@ -3,10 +3,11 @@
 #include "host/common/input_error.h"
 #include "host/ensemble/cpu_ensemble.h"
 #include "host/opencl/opencl_ensemble.h"
+#include "host/vulkan/vulkan_ensemble.h"
 
 namespace sigmafem {
 
-std::vector<std::string> available_backends() { return {"cpu", "opencl"}; }
+std::vector<std::string> available_backends() { return {"cpu", "opencl", "vulkan"}; }
 
 std::unique_ptr<Ensemble> make_ensemble(const std::string& backend, const Model& model,
                                         const std::vector<int>& estimated,
@@ -15,6 +16,8 @@ std::unique_ptr<Ensemble> make_ensemble(const std::string& backend, const Model&
   if (backend == "cpu") return std::make_unique<CpuEnsemble>(model, estimated, observed, sigma_count);
   if (backend == "opencl")
     return std::make_unique<OpenClEnsemble>(model, estimated, observed, sigma_count, options);
+  if (backend == "vulkan")
+    return std::make_unique<VulkanEnsemble>(model, estimated, observed, sigma_count, options);
   std::string names;
   for (const std::string& name : available_backends()) names += (names.empty() ? "" : ", ") + name;
   throw InputError("--backend " + backend + ": unknown back end (available: " + names + ")");

@@ -1,4 +1,4 @@
-// make_ensemble: the one place that turns a back-end name ("cpu", "opencl") into an Ensemble,
+// make_ensemble: the one place that turns a back-end name ("cpu", "opencl", "vulkan") into an Ensemble,
 // for the command line, the tests and the benchmarks.
 #pragma once
 

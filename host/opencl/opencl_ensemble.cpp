@@ -6,12 +6,15 @@
 #include <stdexcept>
 #include <string>
 
+#include "host/ensemble/ensemble_tables.h"
+#include "step_constants.h"
+
 namespace sigmafem {
 namespace {
 
 constexpr std::size_t kGroup = 64;        // work-group size of the element and node kernels
-constexpr int kStepConstants = 12;        // SF_STEP_CONSTANTS in ensemble_layout.h
-constexpr int kMaxParameters = 16;        // SF_MAX_PARAMETERS in recenter.cl
+constexpr int kStepConstants = SF_STEP_CONSTANTS;
+constexpr int kMaxParameters = kDeviceMaxParameters;   // SF_MAX_PARAMETERS in recenter.cl
 
 std::size_t round_up(std::size_t n, std::size_t multiple) {
   return (n + multiple - 1) / multiple * multiple;
@@ -36,82 +39,21 @@ OpenClEnsemble::OpenClEnsemble(const Model& model, std::vector<int> estimated,
       S_(sigma_count),
       nodes_(model.node_count()),
       elements_(model.element_count()) {
-  if (S_ < 1) throw std::invalid_argument("OpenClEnsemble: need at least one sigma point");
-  if (static_cast<int>(estimated_.size()) > kMaxParameters)
-    throw std::invalid_argument("OpenClEnsemble: at most " + std::to_string(kMaxParameters) +
-                                " estimated parameters");
-  for (int l : estimated_)
-    if (l < 0 || l >= static_cast<int>(model.ligaments.size()))
-      throw std::invalid_argument("OpenClEnsemble: no ligament " + std::to_string(l));
-  for (int node : observed_)
-    if (node < 0 || node >= nodes_)
-      throw std::invalid_argument("OpenClEnsemble: no node " + std::to_string(node));
+  check_ensemble_arguments(model, estimated_, observed_, S_, "OpenClEnsemble");
   tolerance_ = options.precision == Precision::single
                    ? std::max(model.solver.cg_tolerance, kSingleTolerance)
                    : model.solver.cg_tolerance;
 
   // Check the memory before asking for it, to say how much is needed.
-  const std::size_t real = device_.real_size();
   const std::size_t dof = 3 * static_cast<std::size_t>(nodes_) * S_;
   const std::size_t per_element = static_cast<std::size_t>(elements_) * S_;
-  const std::size_t largest = 12 * per_element * real;
-  const std::size_t estimate = (9 * dof + 33 * per_element) * real;
+  const EnsembleMemory need = ensemble_memory(nodes_, elements_, S_, device_.real_size());
   const OpenClDeviceInfo& info = device_.info();
-  if (largest > info.max_allocation || estimate > info.global_memory)
-    throw DeviceError("out of device memory: " + std::to_string(S_) + " sigma points on " +
-                      std::to_string(elements_) + " tetrahedra need about " +
-                      std::to_string(estimate >> 20) + " MiB (largest buffer " +
-                      std::to_string(largest >> 20) + " MiB); " + info.name + " has " +
-                      std::to_string(info.global_memory >> 20) + " MiB (largest buffer " +
-                      std::to_string(info.max_allocation >> 20) +
-                      " MiB). Use fewer sigma points, a coarser mesh or another device");
-
-  // Shared data: elements, node incidence (a node's corners in element order: the gather
-  // order, hence the bits, is fixed), springs, mass, rest shape.
-  std::vector<int> element_nodes(4 * elements_);
-  std::vector<double> element_rest(16 * static_cast<std::size_t>(elements_), 0.0);
-  std::vector<int> incidence_offsets(nodes_ + 1, 0);
-  for (int e = 0; e < elements_; ++e) {
-    const ElementRest& element = model.elements[e];
-    for (int c = 0; c < 4; ++c) {
-      element_nodes[4 * e + c] = element.nodes[c];
-      ++incidence_offsets[element.nodes[c] + 1];
-    }
-    std::copy(element.grad.begin(), element.grad.end(), element_rest.begin() + 16 * e);
-    element_rest[16 * e + 12] = element.vlambda;
-    element_rest[16 * e + 13] = element.vmu;
-  }
-  for (int n = 0; n < nodes_; ++n) incidence_offsets[n + 1] += incidence_offsets[n];
-  std::vector<int> incidence(incidence_offsets[nodes_]);
-  std::vector<int> fill(incidence_offsets.begin(), incidence_offsets.end() - 1);
-  for (int e = 0; e < elements_; ++e)
-    for (int c = 0; c < 4; ++c) incidence[fill[element_nodes[4 * e + c]]++] = 4 * e + c;
-
-  const int L = static_cast<int>(model.ligaments.size());
-  std::vector<int> ligament_offsets(nodes_ + 1, 0);
-  for (const SpringSet& ligament : model.ligaments)
-    for (int node : ligament.nodes) ++ligament_offsets[node + 1];
-  for (int n = 0; n < nodes_; ++n) ligament_offsets[n + 1] += ligament_offsets[n];
-  std::vector<int> ligament_of_node(std::max(1, ligament_offsets[nodes_]));
-  fill.assign(ligament_offsets.begin(), ligament_offsets.end() - 1);
-  for (int l = 0; l < L; ++l)
-    for (int node : model.ligaments[l].nodes) ligament_of_node[fill[node]++] = l;
-  ligament_k_.assign(static_cast<std::size_t>(std::max(1, L)) * S_, 0.0);
-  for (int l = 0; l < L; ++l) {
-    const double per_node = model.ligaments[l].stiffness /
-                            static_cast<double>(model.ligaments[l].nodes.size());
-    for (int s = 0; s < S_; ++s) ligament_k_[static_cast<std::size_t>(l) * S_ + s] = per_node;
-  }
-  std::vector<double> control_k(nodes_, 0.0);
-  for (int node : model.control.nodes)
-    control_k[node] += model.control.stiffness / static_cast<double>(model.control.nodes.size());
-  std::vector<double> mass(model.mass.data(), model.mass.data() + nodes_);
-  std::vector<double> rest(3 * static_cast<std::size_t>(nodes_));
-  for (int n = 0; n < nodes_; ++n)
-    for (int k = 0; k < 3; ++k) rest[3 * n + k] = model.rest_positions[n][k];
-  std::vector<double> x0(dof);
-  for (std::size_t row = 0; row < 3 * static_cast<std::size_t>(nodes_); ++row)
-    for (int s = 0; s < S_; ++s) x0[row * S_ + s] = rest[row];
+  if (need.largest > info.max_allocation || need.total > info.global_memory)
+    throw DeviceError(out_of_device_memory_message(need, elements_, S_, info.name,
+                                                   info.global_memory, info.max_allocation));
+  EnsembleTables tables = make_ensemble_tables(model, S_);
+  ligament_k_ = std::move(tables.ligament_k);
 
   // Element kernels: on a CPU device one work-item takes an element for all S sigma points,
   // so the compiler vectorises over them; elsewhere one work-item per (element, sigma).
@@ -143,20 +85,20 @@ OpenClEnsemble::OpenClEnsemble(const Model& model, std::vector<int> estimated,
                         " -DSF_CG_BLOCK=" + std::to_string(cg_block_));
 
   try {
-    element_nodes_ = make_buffer(element_nodes, "element nodes");
-    element_rest_ = make_buffer(element_rest, "element rest state");
-    incidence_offsets_ = make_buffer(incidence_offsets, "node incidence");
-    incidence_ = make_buffer(incidence, "node incidence");
-    ligament_offsets_ = make_buffer(ligament_offsets, "ligament nodes");
-    ligament_of_node_ = make_buffer(ligament_of_node, "ligament nodes");
-    control_k_ = make_buffer(control_k, "control springs");
-    mass_ = make_buffer(mass, "mass");
-    rest_positions_ = make_buffer(rest, "rest positions");
+    element_nodes_ = make_buffer(tables.element_nodes, "element nodes");
+    element_rest_ = make_buffer(tables.element_rest, "element rest state");
+    incidence_offsets_ = make_buffer(tables.incidence_offsets, "node incidence");
+    incidence_ = make_buffer(tables.incidence, "node incidence");
+    ligament_offsets_ = make_buffer(tables.ligament_offsets, "ligament nodes");
+    ligament_of_node_ = make_buffer(tables.ligament_of_node, "ligament nodes");
+    control_k_ = make_buffer(tables.control_k, "control springs");
+    mass_ = make_buffer(tables.mass, "mass");
+    rest_positions_ = make_buffer(tables.rest_positions, "rest positions");
     observed_nodes_ = make_buffer(observed_.empty() ? std::vector<int>{0} : observed_,
                                   "observed nodes");
     constants_ = make_buffer(kStepConstants, "step constants");
     ligament_k_buffer_ = make_buffer(ligament_k_, "ligament stiffness");
-    x_ = make_buffer(x0, "positions");
+    x_ = make_buffer(tables.initial_positions, "positions");
     const std::vector<double> zeros(dof, 0.0);
     v_ = make_buffer(zeros, "velocities");
     dv_ = make_buffer(zeros, "velocity change");
@@ -302,21 +244,12 @@ void OpenClEnsemble::set_parameters(const Eigen::MatrixXd& theta) {
     throw std::invalid_argument("OpenClEnsemble::set_parameters: expected a " +
                                 std::to_string(parameter_count()) + " x " +
                                 std::to_string(sigma_count()) + " matrix");
-  for (int j = 0; j < parameter_count(); ++j) {
-    const int l = estimated_[j];
-    const double nodes = static_cast<double>(model_.ligaments[l].nodes.size());
-    for (int s = 0; s < S_; ++s)
-      ligament_k_[static_cast<std::size_t>(l) * S_ + s] = std::exp(theta(j, s)) / nodes;
-  }
+  set_ligament_stiffness(model_, estimated_, theta, S_, ligament_k_);
   write(ligament_k_buffer_, ligament_k_);
 }
 
 void OpenClEnsemble::write_step_constants(const Eigen::Vector3d& so_position) {
-  const Model& m = model_;
-  const double h = m.dt, a = m.damping.rayleigh_stiffness, b = m.damping.rayleigh_mass;
-  const Eigen::Vector3d shift = so_position - m.control_start;
-  write(constants_, {h, 1.0 + h * b, h * (h + a), b, h + a, m.gravity.x(), m.gravity.y(),
-                     m.gravity.z(), shift.x(), shift.y(), shift.z(), tolerance_ * tolerance_});
+  write(constants_, step_constants(model_, so_position, tolerance_));
 }
 
 void OpenClEnsemble::run(cl::Kernel& kernel, std::size_t items, std::size_t local) const {
@@ -432,24 +365,11 @@ void OpenClEnsemble::predicted_observations(Eigen::MatrixXd& y) const {
 }
 
 void OpenClEnsemble::recenter(const Recentering& r) {
-  const int p = parameter_count();
-  if (r.directions.rows() != p || r.directions.cols() != S_ || r.correction.size() != p ||
-      r.factor.rows() != p || r.factor.cols() != p)
-    throw std::invalid_argument("OpenClEnsemble::recenter: sizes do not match the ensemble");
-  const Eigen::MatrixXd weights = r.factor * r.directions;   // W = C I
-  std::vector<double> scalars(1 + kMaxParameters, 0.0), directions(p * S_), w(p * S_);
-  scalars[0] = r.alpha;
-  for (int j = 0; j < p; ++j) {
-    scalars[1 + j] = r.correction[j];
-    for (int s = 0; s < S_; ++s) {
-      directions[j * S_ + s] = r.directions(j, s);
-      w[j * S_ + s] = weights(j, s);
-    }
-  }
+  const RecenteringInputs in = pack_recentering(r, parameter_count(), S_, "OpenClEnsemble");
   try {
-    write(recenter_scalars_, scalars);
-    write(directions_, directions);
-    write(weights_, w);
+    write(recenter_scalars_, in.scalars);
+    write(directions_, in.directions);
+    write(weights_, in.weights);
     run(k_recenter_, 3 * static_cast<std::size_t>(nodes_));
   } catch (const cl::Error& error) {
     throw opencl_failure("re-centring the OpenCL ensemble", error);

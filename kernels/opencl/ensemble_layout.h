@@ -17,17 +17,8 @@
 
 typedef SF_REAL real;
 
-/* The implicit Euler constants of a step, in a small buffer the host writes each step
- * (a buffer, not a struct argument, so that host and device never disagree on padding). */
-#define SF_H 0                 /* time step h */
-#define SF_MASS_FACTOR 1       /* 1 + h b */
-#define SF_STIFFNESS_FACTOR 2  /* h (h + a) */
-#define SF_RAYLEIGH_MASS 3     /* b */
-#define SF_VELOCITY_FACTOR 4   /* h + a */
-#define SF_GRAVITY 5           /* 3 numbers */
-#define SF_SO_SHIFT 8          /* 3 numbers: so(t_{n+1}) - so(0), the control target shift */
-#define SF_CG_TOLERANCE2 11   /* squared relative CG tolerance */
-#define SF_STEP_CONSTANTS 12
+/* The implicit Euler constants of a step: SF_H, SF_MASS_FACTOR, ... */
+#include "step_constants.h"
 
 /* Sigma points per work-item in the element kernels: 1 on a GPU (a work-item per element and
  * sigma point), S on a CPU (the host sets it; see element_product.cl). */

@@ -249,3 +249,53 @@ TEST_F(CliTest, OpenClDeviceOutOfRangeIsAClearDeviceError) {
 
 }  // namespace
 }  // namespace sigmafem
+
+namespace sigmafem {
+namespace {
+
+// The Vulkan back end's failures likewise. VK_DRIVER_FILES (and VK_ICD_FILENAMES, its older
+// name) pointing at a driver manifest that does not exist hides every Vulkan driver from the
+// loader: a machine without Vulkan.
+std::string no_vulkan_driver(const fs::path& dir) {
+  const std::string manifest = (dir / "no-such-driver.json").string();
+  return "VK_DRIVER_FILES=" + manifest + " VK_ICD_FILENAMES=" + manifest;
+}
+
+TEST_F(CliTest, VulkanWithoutADriverIsAClearDeviceError) {
+  std::ofstream(dir_ / "box.json") << box_.dump(2);
+  const CommandRun run = run_sigmafem_with_env(
+      no_vulkan_driver(dir_), "generate " + (dir_ / "box.json").string() + " --out " +
+                                  (dir_ / "out").string() + " --backend vulkan --vtk-every 0 --quiet");
+  EXPECT_EQ(run.exit_code, 3) << run.output;
+  EXPECT_NE(run.output.find("no Vulkan"), std::string::npos) << run.output;
+  EXPECT_FALSE(fs::exists(dir_ / "out" / "observations.csv"));
+  const CommandRun devices = run_sigmafem_with_env(no_vulkan_driver(dir_), "devices");
+  EXPECT_EQ(devices.exit_code, 0) << devices.output;
+  EXPECT_NE(devices.output.find("Vulkan (--backend vulkan):\n  no Vulkan"), std::string::npos)
+      << devices.output;
+}
+
+TEST_F(CliTest, VulkanDeviceOutOfRangeIsAClearDeviceError) {
+  std::ofstream(dir_ / "box.json") << box_.dump(2);
+  const CommandRun run = run_sigmafem("generate " + (dir_ / "box.json").string() + " --out " +
+                                      (dir_ / "out").string() +
+                                      " --backend vulkan --device 99 --vtk-every 0 --quiet");
+  EXPECT_EQ(run.exit_code, 3) << run.output;
+  const bool named = run.output.find("no Vulkan device 99") != std::string::npos ||
+                     run.output.find("no Vulkan") != std::string::npos;
+  EXPECT_TRUE(named) << run.output;
+  EXPECT_FALSE(fs::exists(dir_ / "out" / "observations.csv"));
+}
+
+TEST_F(CliTest, DevicesListsVulkanAfterOpenCl) {
+  const CommandRun run = run_sigmafem("devices");
+  EXPECT_EQ(run.exit_code, 0) << run.output;
+  const std::size_t opencl = run.output.find("OpenCL (--backend opencl):");
+  const std::size_t vulkan = run.output.find("Vulkan (--backend vulkan):");
+  ASSERT_NE(opencl, std::string::npos) << run.output;
+  ASSERT_NE(vulkan, std::string::npos) << run.output;
+  EXPECT_LT(opencl, vulkan) << run.output;
+}
+
+}  // namespace
+}  // namespace sigmafem

@@ -1,6 +1,6 @@
 // A whole box estimation (1500 steps, the cut, 0.5 mm noise, simplex) on a device back end
 // agrees with the same run on the CPU back end: every estimate at every step within 0.5%
-// (issue 4). The device runs in float32 with a CG tolerance of 1e-6; the filter sees the
+// (issues 4 and 5), for every device back end present (OpenCL, Vulkan). The device runs in float32 with a CG tolerance of 1e-6; the filter sees the
 // observed positions to about 1e-7 m (tests/conformance/ensemble_conformance_test.cpp)
 // against 0.5 mm of noise, so its estimates can differ only by a small fraction of a percent.
 #include <gtest/gtest.h>
@@ -17,6 +17,7 @@
 #include "host/generator/generate.h"
 #include "host/model/model.h"
 #include "host/opencl/opencl_device.h"
+#include "host/vulkan/vulkan_device.h"
 #include "host/scenario/scenario.h"
 
 namespace sigmafem {
@@ -32,8 +33,14 @@ EstimationRun estimate_box(const Scenario& s, const ObservationTable& data,
   return run_estimation(*ensemble, options, data.times, data.so, data.points, {});
 }
 
-TEST(WholeRun, OpenClEstimatesMatchTheCpuBackEnd) {
-  if (list_opencl_devices().empty()) GTEST_SKIP() << "no OpenCL platform on this machine";
+class WholeRun : public ::testing::TestWithParam<std::string> {};
+
+TEST_P(WholeRun, EstimatesMatchTheCpuBackEnd) {
+  const std::string backend = GetParam();
+  std::string why;
+  if (backend == "opencl" && list_opencl_devices().empty()) why = "no OpenCL platform on this machine";
+  if (backend == "vulkan") list_vulkan_devices(&why);   // sets `why` when there is none
+  if (!why.empty()) GTEST_SKIP() << why;
   const Scenario s = load_scenario(std::string(SIGMAFEM_SOURCE_DIR) + "/scenarios/box.json");
   const fs::path dir = test::unique_temp_path("sigmafem_whole_run_test");
   GenerateOptions generate_options;
@@ -46,7 +53,7 @@ TEST(WholeRun, OpenClEstimatesMatchTheCpuBackEnd) {
   fs::remove_all(dir);
 
   const EstimationRun cpu = estimate_box(s, data, "cpu");
-  const EstimationRun device = estimate_box(s, data, "opencl");
+  const EstimationRun device = estimate_box(s, data, backend);
   ASSERT_TRUE(cpu.complete) << cpu.stop_reason;
   ASSERT_TRUE(device.complete) << device.stop_reason;
   ASSERT_EQ(cpu.steps.size(), device.steps.size());
@@ -62,9 +69,15 @@ TEST(WholeRun, OpenClEstimatesMatchTheCpuBackEnd) {
     EXPECT_EQ(device.steps[k].unconverged_sigma_points, 0) << "step " << cpu.steps[k].step;
   }
   EXPECT_LT(largest, 0.005) << "largest relative difference at step " << worst;
-  std::cout << "largest relative difference of the estimates over " << cpu.steps.size()
+  std::cout << backend << ": largest relative difference of the estimates over " << cpu.steps.size()
             << " steps: " << largest << " (step " << worst << ")\n";
 }
+
+std::string backend_name(const ::testing::TestParamInfo<std::string>& info) {
+  return info.param == "opencl" ? "OpenCl" : "Vulkan";
+}
+
+INSTANTIATE_TEST_SUITE_P(Backends, WholeRun, ::testing::Values("opencl", "vulkan"), backend_name);
 
 }  // namespace
 }  // namespace sigmafem

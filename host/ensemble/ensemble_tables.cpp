@@ -1,0 +1,147 @@
+#include "host/ensemble/ensemble_tables.h"
+
+#include <algorithm>
+#include <cmath>
+#include <stdexcept>
+
+#include "step_constants.h"
+
+namespace sigmafem {
+
+void check_ensemble_arguments(const Model& model, const std::vector<int>& estimated,
+                              const std::vector<int>& observed, int S, const char* who) {
+  const std::string name(who);
+  if (S < 1) throw std::invalid_argument(name + ": need at least one sigma point");
+  if (static_cast<int>(estimated.size()) > kDeviceMaxParameters)
+    throw std::invalid_argument(name + ": at most " + std::to_string(kDeviceMaxParameters) +
+                                " estimated parameters");
+  for (int l : estimated)
+    if (l < 0 || l >= static_cast<int>(model.ligaments.size()))
+      throw std::invalid_argument(name + ": no ligament " + std::to_string(l));
+  for (int node : observed)
+    if (node < 0 || node >= model.node_count())
+      throw std::invalid_argument(name + ": no node " + std::to_string(node));
+}
+
+EnsembleTables make_ensemble_tables(const Model& model, int S) {
+  const int nodes = model.node_count(), elements = model.element_count();
+  EnsembleTables t;
+  t.element_nodes.assign(4 * static_cast<std::size_t>(elements), 0);
+  t.element_rest.assign(16 * static_cast<std::size_t>(elements), 0.0);
+  t.incidence_offsets.assign(nodes + 1, 0);
+  for (int e = 0; e < elements; ++e) {
+    const ElementRest& element = model.elements[e];
+    for (int c = 0; c < 4; ++c) {
+      t.element_nodes[4 * e + c] = element.nodes[c];
+      ++t.incidence_offsets[element.nodes[c] + 1];
+    }
+    std::copy(element.grad.begin(), element.grad.end(), t.element_rest.begin() + 16 * e);
+    t.element_rest[16 * e + 12] = element.vlambda;
+    t.element_rest[16 * e + 13] = element.vmu;
+  }
+  for (int n = 0; n < nodes; ++n) t.incidence_offsets[n + 1] += t.incidence_offsets[n];
+  t.incidence.assign(t.incidence_offsets[nodes], 0);
+  std::vector<int> fill(t.incidence_offsets.begin(), t.incidence_offsets.end() - 1);
+  for (int e = 0; e < elements; ++e)
+    for (int c = 0; c < 4; ++c) t.incidence[fill[t.element_nodes[4 * e + c]]++] = 4 * e + c;
+
+  const int L = static_cast<int>(model.ligaments.size());
+  t.ligament_offsets.assign(nodes + 1, 0);
+  for (const SpringSet& ligament : model.ligaments)
+    for (int node : ligament.nodes) ++t.ligament_offsets[node + 1];
+  for (int n = 0; n < nodes; ++n) t.ligament_offsets[n + 1] += t.ligament_offsets[n];
+  t.ligament_of_node.assign(std::max(1, t.ligament_offsets[nodes]), 0);
+  fill.assign(t.ligament_offsets.begin(), t.ligament_offsets.end() - 1);
+  for (int l = 0; l < L; ++l)
+    for (int node : model.ligaments[l].nodes) t.ligament_of_node[fill[node]++] = l;
+  t.ligament_k.assign(static_cast<std::size_t>(std::max(1, L)) * S, 0.0);
+  for (int l = 0; l < L; ++l) {
+    const double per_node = model.ligaments[l].stiffness /
+                            static_cast<double>(model.ligaments[l].nodes.size());
+    for (int s = 0; s < S; ++s) t.ligament_k[static_cast<std::size_t>(l) * S + s] = per_node;
+  }
+  t.control_k.assign(nodes, 0.0);
+  for (int node : model.control.nodes)
+    t.control_k[node] += model.control.stiffness / static_cast<double>(model.control.nodes.size());
+  t.mass.assign(model.mass.data(), model.mass.data() + nodes);
+  t.rest_positions.resize(3 * static_cast<std::size_t>(nodes));
+  for (int n = 0; n < nodes; ++n)
+    for (int k = 0; k < 3; ++k) t.rest_positions[3 * n + k] = model.rest_positions[n][k];
+  t.initial_positions.resize(3 * static_cast<std::size_t>(nodes) * S);
+  for (std::size_t row = 0; row < 3 * static_cast<std::size_t>(nodes); ++row)
+    for (int s = 0; s < S; ++s) t.initial_positions[row * S + s] = t.rest_positions[row];
+  return t;
+}
+
+void set_ligament_stiffness(const Model& model, const std::vector<int>& estimated,
+                            const Eigen::MatrixXd& theta, int S, std::vector<double>& ligament_k) {
+  for (std::size_t j = 0; j < estimated.size(); ++j) {
+    const int l = estimated[j];
+    const double nodes = static_cast<double>(model.ligaments[l].nodes.size());
+    for (int s = 0; s < S; ++s)
+      ligament_k[static_cast<std::size_t>(l) * S + s] =
+          std::exp(theta(static_cast<Eigen::Index>(j), s)) / nodes;
+  }
+}
+
+std::vector<double> step_constants(const Model& m, const Eigen::Vector3d& so_position,
+                                   double cg_tolerance) {
+  const double h = m.dt, a = m.damping.rayleigh_stiffness, b = m.damping.rayleigh_mass;
+  const Eigen::Vector3d shift = so_position - m.control_start;
+  std::vector<double> c(SF_STEP_CONSTANTS);
+  c[SF_H] = h;
+  c[SF_MASS_FACTOR] = 1.0 + h * b;
+  c[SF_STIFFNESS_FACTOR] = h * (h + a);
+  c[SF_RAYLEIGH_MASS] = b;
+  c[SF_VELOCITY_FACTOR] = h + a;
+  for (int k = 0; k < 3; ++k) {
+    c[SF_GRAVITY + k] = m.gravity[k];
+    c[SF_SO_SHIFT + k] = shift[k];
+  }
+  c[SF_CG_TOLERANCE2] = cg_tolerance * cg_tolerance;
+  return c;
+}
+
+RecenteringInputs pack_recentering(const Recentering& r, int p, int S, const char* who) {
+  if (r.directions.rows() != p || r.directions.cols() != S || r.correction.size() != p ||
+      r.factor.rows() != p || r.factor.cols() != p)
+    throw std::invalid_argument(std::string(who) + "::recenter: sizes do not match the ensemble");
+  const Eigen::MatrixXd weights = r.factor * r.directions;   // W = C I
+  RecenteringInputs in;
+  in.scalars.assign(1 + kDeviceMaxParameters, 0.0);
+  in.directions.resize(static_cast<std::size_t>(p) * S);
+  in.weights.resize(static_cast<std::size_t>(p) * S);
+  in.scalars[0] = r.alpha;
+  for (int j = 0; j < p; ++j) {
+    in.scalars[1 + j] = r.correction[j];
+    for (int s = 0; s < S; ++s) {
+      in.directions[static_cast<std::size_t>(j) * S + s] = r.directions(j, s);
+      in.weights[static_cast<std::size_t>(j) * S + s] = weights(j, s);
+    }
+  }
+  return in;
+}
+
+EnsembleMemory ensemble_memory(int nodes, int elements, int S, std::size_t real_size) {
+  // Per dof and sigma: x, v, dv, rhs, the Jacobi diagonal, r, z, d, q; per element and sigma:
+  // the frame (9), the element outputs (12) and diagonals (12).
+  const std::size_t dof = 3 * static_cast<std::size_t>(nodes) * S;
+  const std::size_t per_element = static_cast<std::size_t>(elements) * S;
+  EnsembleMemory need;
+  need.largest = 12 * per_element * real_size;
+  need.total = (9 * dof + 33 * per_element) * real_size;
+  return need;
+}
+
+std::string out_of_device_memory_message(const EnsembleMemory& need, int elements, int S,
+                                         const std::string& device,
+                                         std::size_t device_memory, std::size_t largest_buffer) {
+  return "out of device memory: " + std::to_string(S) + " sigma points on " +
+         std::to_string(elements) + " tetrahedra need about " + std::to_string(need.total >> 20) +
+         " MiB (largest buffer " + std::to_string(need.largest >> 20) + " MiB); " + device +
+         " has " + std::to_string(device_memory >> 20) + " MiB (largest buffer " +
+         std::to_string(largest_buffer >> 20) +
+         " MiB). Use fewer sigma points, a coarser mesh or another device";
+}
+
+}  // namespace sigmafem

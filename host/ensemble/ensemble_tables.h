@@ -1,0 +1,78 @@
+// EnsembleTables: what every device back end (OpenCL, Vulkan) uploads and packs on the host,
+// built once here from a Model so that the back ends share one definition of the layout
+// (kernels/opencl/ensemble_layout.h, kernels/vulkan/ensemble_layout.h):
+//   shared data    one copy for all sigma points (mesh, rest state, springs, mass)
+//   per-sigma data sigma index innermost: value k of node n for sigma s at [(3n + k) S + s]
+// Also the per-step constants, the per-sigma ligament stiffnesses from the filter's theta,
+// the re-centring inputs and the device-memory estimate, packed the same way for both.
+#pragma once
+
+#include <Eigen/Core>
+#include <cstddef>
+#include <string>
+#include <vector>
+
+#include "filter/ensemble.h"
+#include "host/model/model.h"
+
+namespace sigmafem {
+
+// Estimated parameters a device ensemble takes at most (SF_MAX_PARAMETERS in recenter).
+constexpr int kDeviceMaxParameters = 16;
+
+struct EnsembleTables {
+  // Elements: element_nodes[4 e + c]; element_rest[16 e + i]: grad[12], vlambda, vmu, 0, 0.
+  std::vector<int> element_nodes;
+  std::vector<double> element_rest;
+  // Node incidence (CSR): corners 4 e + c of node n, in element order, at
+  // incidence[incidence_offsets[n] .. incidence_offsets[n + 1]). The node kernels gather in
+  // this order: no atomics, the same sums every run.
+  std::vector<int> incidence_offsets, incidence;
+  // Ligaments on node n (CSR): ligament_of_node[ligament_offsets[n] .. [n + 1]).
+  std::vector<int> ligament_offsets, ligament_of_node;
+  // Per ligament and sigma point, N/m per node: ligament_k[l S + s] (at least one entry).
+  std::vector<double> ligament_k;
+  std::vector<double> control_k;        // per node, N/m (shared)
+  std::vector<double> mass;             // per node, kg
+  std::vector<double> rest_positions;   // 3 per node, m
+  std::vector<double> initial_positions;  // the rest shape for every sigma point, 3N x S
+};
+
+// Checks an ensemble's arguments: std::invalid_argument naming `who`.
+void check_ensemble_arguments(const Model& model, const std::vector<int>& estimated,
+                              const std::vector<int>& observed, int sigma_count, const char* who);
+
+// The tables for S = sigma_count (after the device-memory check: they are as big as the
+// per-sigma state).
+EnsembleTables make_ensemble_tables(const Model& model, int sigma_count);
+
+// Writes exp(theta(j, s)) / (nodes of ligament estimated[j]) into ligament_k (p x S theta).
+void set_ligament_stiffness(const Model& model, const std::vector<int>& estimated,
+                            const Eigen::MatrixXd& theta, int sigma_count,
+                            std::vector<double>& ligament_k);
+
+// The SF_STEP_CONSTANTS numbers of one step (kernels/shared/step_constants.h).
+std::vector<double> step_constants(const Model& model, const Eigen::Vector3d& so_position,
+                                   double cg_tolerance);
+
+// The re-centring inputs, packed as the recenter kernels read them: scalars[1 + max p]
+// (alpha, the correction), directions and weights W = C I, each [j S + s].
+struct RecenteringInputs {
+  std::vector<double> scalars, directions, weights;
+};
+RecenteringInputs pack_recentering(const Recentering& r, int parameter_count, int sigma_count,
+                                   const char* who);
+
+// Device memory of an ensemble, in bytes, for `real_size`-byte reals.
+struct EnsembleMemory {
+  std::size_t total = 0;     // about: all buffers
+  std::size_t largest = 0;   // the largest single buffer (12 per element and sigma point)
+};
+EnsembleMemory ensemble_memory(int nodes, int elements, int sigma_count, std::size_t real_size);
+
+// The "out of device memory" message: what the ensemble needs and what `device` has.
+std::string out_of_device_memory_message(const EnsembleMemory& need, int elements,
+                                         int sigma_count, const std::string& device,
+                                         std::size_t device_memory, std::size_t largest_buffer);
+
+}  // namespace sigmafem

@@ -1,0 +1,150 @@
+// The Vulkan devices of this machine and one of them made ready for compute: the loader
+// opened at run time (a machine without libvulkan still runs the other back ends and gets a
+// clear message here), an instance without surface or window, device discovery (`sigmafem
+// devices`), a compute queue, storage buffers, compute pipelines from the SPIR-V embedded at
+// build time (host/vulkan/vulkan_shaders.h), one reusable command buffer and a fence.
+//
+// Validation: with SIGMAFEM_VULKAN_VALIDATION=1 and VK_LAYER_KHRONOS_validation installed,
+// the layer is switched on (with synchronization validation) and every message it sends is
+// printed on stderr and counted (vulkan_validation_message_count()), so tests assert none.
+#pragma once
+
+#include <vulkan/vulkan.h>
+
+#include <cstddef>
+#include <cstdint>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "host/common/device_error.h"
+
+namespace sigmafem {
+
+struct VulkanDeviceInfo {
+  int index = 0;                          // position in vkEnumeratePhysicalDevices' list
+  std::string name;
+  std::string type;                       // "cpu", "discrete gpu", "integrated gpu", ...
+  std::string api_version;                // "1.3.230"
+  bool has_fp64 = false;                  // shaderFloat64: --precision double is available
+  unsigned long long memory = 0;          // bytes of the largest device-local heap
+  unsigned long long max_buffer = 0;      // bytes, the largest storage buffer a shader sees
+};
+
+// Every Vulkan device, in the loader's order. Empty when there is no loader or no driver
+// (never an exception for that); `why_none` then says which.
+std::vector<VulkanDeviceInfo> list_vulkan_devices(std::string* why_none = nullptr);
+
+// Warnings and errors the validation layer reported in this process so far.
+int vulkan_validation_message_count();
+// Whether SIGMAFEM_VULKAN_VALIDATION=1 asks for the layer and the layer is installed.
+bool vulkan_validation_available();
+
+struct VulkanApi;  // the loader's function table (vulkan_device.cpp)
+
+// A storage buffer in device memory. Owned by the VulkanDevice that made it.
+struct VulkanBuffer {
+  VkBuffer buffer = VK_NULL_HANDLE;
+  VkDeviceSize bytes = 0;
+};
+
+// A compute pipeline: one entry shader, `bindings` storage buffers at bindings 0..n-1 of
+// set 0, and 16 bytes of push constants. Owned by the VulkanDevice that made it.
+struct VulkanKernel {
+  std::string name;
+  VkPipeline pipeline = VK_NULL_HANDLE;
+  VkPipelineLayout layout = VK_NULL_HANDLE;
+  VkDescriptorSetLayout set_layout = VK_NULL_HANDLE;
+  int bindings = 0;
+};
+
+// A device with its queue, ready to run the embedded shaders.
+class VulkanDevice {
+ public:
+  // Throws DeviceError: no loader, no device `index`, no shaderFloat64 for double precision.
+  VulkanDevice(int index, Precision precision);
+  ~VulkanDevice();
+  VulkanDevice(const VulkanDevice&) = delete;
+  VulkanDevice& operator=(const VulkanDevice&) = delete;
+
+  const VulkanDeviceInfo& info() const { return info_; }
+  Precision precision() const { return precision_; }
+  std::size_t real_size() const { return precision_ == Precision::single ? 4 : 8; }
+  std::uint32_t max_group_count() const { return max_group_count_; }
+
+  // A device-local storage buffer of `bytes` (at least 4). Throws DeviceError naming `what`
+  // when the device has too little memory.
+  VulkanBuffer buffer(std::size_t bytes, const char* what);
+  void upload(const VulkanBuffer& buffer, const void* data, std::size_t bytes);
+  void download(const VulkanBuffer& buffer, void* data, std::size_t bytes);
+
+  // The pipeline of embedded shader `name` in this device's precision. `group_size` > 0 sets
+  // specialization constant 0 (the work-group size of the CG shaders). Throws DeviceError
+  // when the shader is not embedded, is not SPIR-V or the driver rejects it.
+  VulkanKernel kernel(const char* name, int bindings, std::uint32_t group_size = 0);
+  // Same, from given SPIR-V words (tests: a module that fails to load).
+  VulkanKernel kernel_from_spirv(const std::string& name, const std::uint32_t* words,
+                                 std::size_t word_count, int bindings, std::uint32_t group_size);
+  // A descriptor set with `buffers` at bindings 0..n-1 for `kernel`.
+  VkDescriptorSet bind(const VulkanKernel& kernel, const std::vector<VulkanBuffer>& buffers);
+
+  // Recording into the device's one reusable command buffer: begin(), then dispatches,
+  // barriers, copies; then submit_and_wait() (one host wait).
+  VkCommandBuffer begin();
+  void dispatch(VkCommandBuffer cmd, const VulkanKernel& kernel, VkDescriptorSet set,
+                const void* push_constants, std::uint32_t groups);
+  // Every earlier shader write and transfer is visible to every later shader and transfer.
+  void barrier(VkCommandBuffer cmd);
+  void update(VkCommandBuffer cmd, const VulkanBuffer& buffer, const void* data, std::size_t bytes);
+  // Makes the host-visible read-back area at least `bytes` long (before recording copies).
+  void reserve_read_back(std::size_t bytes);
+  // Copies `bytes` of `buffer` into the read-back area at `offset` (after a barrier);
+  // read_back() gives the area after submit_and_wait().
+  void copy_to_host(VkCommandBuffer cmd, const VulkanBuffer& buffer, std::size_t bytes,
+                    std::size_t offset);
+  const void* read_back() const;
+  void submit_and_wait(VkCommandBuffer cmd);
+
+  static constexpr std::size_t kPushConstantBytes = 16;
+
+ private:
+  void release();   // every Vulkan object, in reverse order of creation
+  std::uint32_t memory_type(std::uint32_t allowed, VkMemoryPropertyFlags wanted,
+                            VkMemoryPropertyFlags preferred) const;
+  VkDeviceMemory allocate(VkMemoryRequirements needs, VkMemoryPropertyFlags wanted,
+                          VkMemoryPropertyFlags preferred, const char* what);
+  void ensure_staging(std::size_t bytes);
+  void check(VkResult result, const std::string& what) const;
+
+  std::shared_ptr<VulkanApi> api_;
+  VulkanDeviceInfo info_;
+  Precision precision_;
+  VkInstance instance_ = VK_NULL_HANDLE;
+  VkDebugUtilsMessengerEXT messenger_ = VK_NULL_HANDLE;
+  VkPhysicalDevice physical_ = VK_NULL_HANDLE;
+  VkPhysicalDeviceMemoryProperties memory_properties_{};
+  VkDevice device_ = VK_NULL_HANDLE;
+  VkQueue queue_ = VK_NULL_HANDLE;
+  std::uint32_t queue_family_ = 0;
+  std::uint32_t max_group_count_ = 65535;
+  VkCommandPool command_pool_ = VK_NULL_HANDLE;
+  VkCommandBuffer command_buffer_ = VK_NULL_HANDLE;
+  VkFence fence_ = VK_NULL_HANDLE;
+  VkDescriptorPool descriptor_pool_ = VK_NULL_HANDLE;
+  std::vector<std::pair<VkBuffer, VkDeviceMemory>> buffers_;   // all buffers made here
+  std::vector<VulkanKernel> kernels_;                          // all pipelines made here
+  // Host-visible buffers: staging for upload/download, and the read-back area.
+  VkBuffer staging_ = VK_NULL_HANDLE;
+  VkDeviceMemory staging_memory_ = VK_NULL_HANDLE;
+  void* staging_map_ = nullptr;
+  std::size_t staging_bytes_ = 0;
+  VkBuffer read_back_ = VK_NULL_HANDLE;
+  VkDeviceMemory read_back_memory_ = VK_NULL_HANDLE;
+  void* read_back_map_ = nullptr;
+  std::size_t read_back_bytes_ = 0;
+};
+
+// The name of a VkResult ("VK_ERROR_OUT_OF_DEVICE_MEMORY"), for messages.
+std::string vulkan_result_name(VkResult result);
+
+}  // namespace sigmafem

@@ -1,0 +1,382 @@
+#include "host/vulkan/vulkan_ensemble.h"
+
+#include <algorithm>
+#include <cmath>
+#include <cstring>
+#include <stdexcept>
+#include <string>
+
+#include "host/ensemble/ensemble_tables.h"
+#include "step_constants.h"
+
+namespace sigmafem {
+namespace {
+
+constexpr std::size_t kItemsPerGroup = 64;   // SF_ITEMS_PER_GROUP in kernels/vulkan/ensemble_layout.h
+
+std::uint32_t groups_for(std::size_t items) {
+  return static_cast<std::uint32_t>((items + kItemsPerGroup - 1) / kItemsPerGroup);
+}
+
+}  // namespace
+
+VulkanEnsemble::VulkanEnsemble(const Model& model, std::vector<int> estimated,
+                               std::vector<int> observed, int sigma_count,
+                               const DeviceOptions& options)
+    : device_(options.device, options.precision),
+      model_(model),
+      estimated_(std::move(estimated)),
+      observed_(std::move(observed)),
+      S_(sigma_count),
+      nodes_(model.node_count()),
+      elements_(model.element_count()) {
+  check_ensemble_arguments(model, estimated_, observed_, S_, "VulkanEnsemble");
+  tolerance_ = options.precision == Precision::single
+                   ? std::max(model.solver.cg_tolerance, kSingleTolerance)
+                   : model.solver.cg_tolerance;
+
+  // Check the memory before asking for it, to say how much is needed.
+  const std::size_t dof = 3 * static_cast<std::size_t>(nodes_) * S_;
+  const std::size_t per_element = static_cast<std::size_t>(elements_) * S_;
+  const EnsembleMemory need = ensemble_memory(nodes_, elements_, S_, device_.real_size());
+  const VulkanDeviceInfo& info = device_.info();
+  if (need.largest > info.max_buffer || need.total > info.memory)
+    throw DeviceError(out_of_device_memory_message(need, elements_, S_, info.name,
+                                                   info.memory, info.max_buffer));
+  // The CG shaders take one work-group per sigma point along x.
+  if (static_cast<std::uint32_t>(S_) > device_.max_group_count())
+    throw DeviceError("Vulkan device " + info.name + " runs at most " +
+                      std::to_string(device_.max_group_count()) + " sigma points");
+  EnsembleTables tables = make_ensemble_tables(model, S_);
+  ligament_k_ = std::move(tables.ligament_k);
+  // Work-items per sigma point in CG: on a CPU (lavapipe) one SIMD register's worth, so that
+  // a group's barriers cost nothing; on a GPU 64 (two warps, one wavefront).
+  cg_group_ = info.type == "cpu" ? 8 : 64;
+
+  element_nodes_ = make_buffer(tables.element_nodes, "element nodes");
+  element_rest_ = make_buffer(tables.element_rest, "element rest state");
+  incidence_offsets_ = make_buffer(tables.incidence_offsets, "node incidence");
+  incidence_ = make_buffer(tables.incidence, "node incidence");
+  ligament_offsets_ = make_buffer(tables.ligament_offsets, "ligament nodes");
+  ligament_of_node_ = make_buffer(tables.ligament_of_node, "ligament nodes");
+  control_k_ = make_buffer(tables.control_k, "control springs");
+  mass_ = make_buffer(tables.mass, "mass");
+  rest_positions_ = make_buffer(tables.rest_positions, "rest positions");
+  observed_nodes_ = make_buffer(observed_.empty() ? std::vector<int>{0} : observed_, "observed nodes");
+  constants_ = make_buffer(SF_STEP_CONSTANTS, "step constants");
+  ligament_k_buffer_ = make_buffer(ligament_k_, "ligament stiffness");
+  x_ = make_buffer(tables.initial_positions, "positions");
+  const std::vector<double> zeros(dof, 0.0);
+  v_ = make_buffer(zeros, "velocities");
+  dv_ = make_buffer(zeros, "velocity change");
+  for (VulkanBuffer* b : {&rhs_, &inverse_diagonal_, &r_, &z_, &d_, &q_})
+    *b = make_buffer(dof, "CG vectors");
+  frames_ = make_buffer(9 * per_element, "element frames");
+  element_out_ = make_buffer(12 * per_element, "element outputs");
+  element_diagonal_ = make_buffer(12 * per_element, "element diagonals");
+  const std::size_t observation_rows = std::max<std::size_t>(1, observed_.size()) * 3;
+  observations_ = make_buffer(observation_rows * S_, "observations");
+  for (VulkanBuffer* b : {&bb_, &rr_, &rz_}) *b = make_buffer(static_cast<std::size_t>(S_), "CG scalars");
+  for (VulkanBuffer* b : {&active_, &converged_, &iterations_})
+    *b = make_buffer(std::vector<int>(S_, 0), "CG flags");
+  all_active_ = make_buffer(std::vector<int>(S_, 1), "CG flags");
+  recenter_scalars_ = make_buffer(1 + kDeviceMaxParameters, "re-centring");
+  directions_ = make_buffer(static_cast<std::size_t>(kDeviceMaxParameters) * S_, "re-centring");
+  weights_ = make_buffer(static_cast<std::size_t>(kDeviceMaxParameters) * S_, "re-centring");
+  // Read-back area: 3 flags and 2 scalars per sigma point, then the observations.
+  device_.reserve_read_back(3 * 4 * static_cast<std::size_t>(S_) +
+                            (2 + observation_rows) * S_ * device_.real_size());
+
+  // Bindings in the order of each shader's (and the OpenCL kernel's) buffer arguments.
+  k_element_rhs_ = device_.kernel("element_rhs", 8);
+  k_node_rhs_ = device_.kernel("node_rhs", 15);
+  k_element_product_ = device_.kernel("element_product", 6);
+  k_node_product_ = device_.kernel("node_product", 11);
+  k_cg_start_ = device_.kernel("cg_start", 21, cg_group_);
+  k_cg_iteration_ = device_.kernel("cg_iteration", 13, cg_group_);
+  k_state_update_ = device_.kernel("state_update", 5);
+  k_observation_gather_ = device_.kernel("observation_gather", 3);
+  k_recenter_ = device_.kernel("recenter", 5);
+
+  s_element_rhs_ = device_.bind(k_element_rhs_, {element_nodes_, element_rest_, frames_, x_, v_,
+                                                 constants_, element_out_, element_diagonal_});
+  const std::vector<VulkanBuffer> node_shared = {constants_, incidence_offsets_, incidence_,
+                                                 ligament_offsets_, ligament_of_node_,
+                                                 ligament_k_buffer_, control_k_, mass_};
+  auto with_shared = [&](std::vector<VulkanBuffer> rest) {
+    std::vector<VulkanBuffer> all = node_shared;
+    all.insert(all.end(), rest.begin(), rest.end());
+    return all;
+  };
+  s_node_rhs_ = device_.bind(k_node_rhs_, with_shared({rest_positions_, x_, v_, element_out_,
+                                                       element_diagonal_, rhs_, inverse_diagonal_}));
+  s_product_warm_start_ = device_.bind(
+      k_element_product_, {element_nodes_, element_rest_, frames_, dv_, all_active_, element_out_});
+  s_product_cg_ = device_.bind(k_element_product_,
+                               {element_nodes_, element_rest_, frames_, d_, active_, element_out_});
+  s_product_all_ = device_.bind(
+      k_element_product_, {element_nodes_, element_rest_, frames_, d_, all_active_, element_out_});
+  s_node_product_ = device_.bind(k_node_product_, with_shared({d_, element_out_, q_}));
+  s_cg_start_ = device_.bind(k_cg_start_,
+                             with_shared({element_out_, rhs_, inverse_diagonal_, dv_, r_, z_, d_,
+                                          bb_, rr_, rz_, active_, converged_, iterations_}));
+  s_cg_iteration_ = device_.bind(k_cg_iteration_, {constants_, inverse_diagonal_, dv_, r_, z_, d_,
+                                                   q_, bb_, rr_, rz_, active_, converged_,
+                                                   iterations_});
+  s_state_update_ = device_.bind(k_state_update_, {constants_, bb_, dv_, x_, v_});
+  s_observation_gather_ = device_.bind(k_observation_gather_, {observed_nodes_, x_, observations_});
+  s_recenter_ = device_.bind(k_recenter_, {recenter_scalars_, directions_, weights_, x_, v_});
+}
+
+VulkanBuffer VulkanEnsemble::make_buffer(std::size_t count, const char* what) {
+  const std::size_t bytes = std::max<std::size_t>(1, count) * device_.real_size();
+  device_bytes_ += bytes;
+  return device_.buffer(bytes, what);
+}
+
+VulkanBuffer VulkanEnsemble::make_buffer(const std::vector<double>& values, const char* what) {
+  VulkanBuffer buffer = make_buffer(values.size(), what);
+  write(buffer, values);
+  return buffer;
+}
+
+VulkanBuffer VulkanEnsemble::make_buffer(const std::vector<int>& values, const char* what) {
+  const std::size_t bytes = values.size() * sizeof(std::int32_t);
+  device_bytes_ += bytes;
+  VulkanBuffer buffer = device_.buffer(bytes, what);
+  device_.upload(buffer, values.data(), bytes);
+  return buffer;
+}
+
+std::vector<unsigned char> VulkanEnsemble::to_device(const std::vector<double>& values) const {
+  std::vector<unsigned char> bytes(values.size() * device_.real_size());
+  if (device_.precision() == Precision::single) {
+    const std::vector<float> converted(values.begin(), values.end());
+    std::memcpy(bytes.data(), converted.data(), bytes.size());
+  } else {
+    std::memcpy(bytes.data(), values.data(), bytes.size());
+  }
+  return bytes;
+}
+
+std::vector<double> VulkanEnsemble::from_device(const void* data, std::size_t count) const {
+  if (device_.precision() == Precision::single) {
+    std::vector<float> values(count);
+    std::memcpy(values.data(), data, count * sizeof(float));
+    return std::vector<double>(values.begin(), values.end());
+  }
+  std::vector<double> values(count);
+  std::memcpy(values.data(), data, count * sizeof(double));
+  return values;
+}
+
+void VulkanEnsemble::write(const VulkanBuffer& buffer, const std::vector<double>& values) const {
+  const std::vector<unsigned char> bytes = to_device(values);
+  device_.upload(buffer, bytes.data(), bytes.size());
+}
+
+std::vector<double> VulkanEnsemble::read(const VulkanBuffer& buffer, std::size_t count) const {
+  std::vector<unsigned char> bytes(count * device_.real_size());
+  device_.download(buffer, bytes.data(), bytes.size());
+  return from_device(bytes.data(), count);
+}
+
+std::vector<double> VulkanEnsemble::sigma_column(const VulkanBuffer& buffer, std::size_t rows,
+                                                 int s) const {
+  if (s < 0 || s >= S_) throw std::out_of_range("VulkanEnsemble: no sigma point " + std::to_string(s));
+  const std::vector<double> all = read(buffer, rows * S_);
+  std::vector<double> column(rows);
+  for (std::size_t row = 0; row < rows; ++row) column[row] = all[row * S_ + s];
+  return column;
+}
+
+void VulkanEnsemble::set_parameters(const Eigen::MatrixXd& theta) {
+  if (theta.rows() != parameter_count() || theta.cols() != sigma_count())
+    throw std::invalid_argument("VulkanEnsemble::set_parameters: expected a " +
+                                std::to_string(parameter_count()) + " x " +
+                                std::to_string(sigma_count()) + " matrix");
+  set_ligament_stiffness(model_, estimated_, theta, S_, ligament_k_);
+  write(ligament_k_buffer_, ligament_k_);
+}
+
+void VulkanEnsemble::dispatch_items(VkCommandBuffer cmd, const VulkanKernel& kernel,
+                                    VkDescriptorSet set, std::size_t items,
+                                    std::uint32_t count) const {
+  PushConstants push;
+  push.S = static_cast<std::uint32_t>(S_);
+  push.count = count;
+  push.max_iterations = model_.solver.cg_max_iterations;
+  push.p = static_cast<std::uint32_t>(estimated_.size());
+  device_.dispatch(cmd, kernel, set, &push, groups_for(items));
+  device_.barrier(cmd);
+}
+
+void VulkanEnsemble::record_system_product(VkCommandBuffer cmd, VkDescriptorSet product_set) const {
+  const std::size_t S = static_cast<std::size_t>(S_);
+  dispatch_items(cmd, k_element_product_, product_set, elements_ * S, elements_);
+  dispatch_items(cmd, k_node_product_, s_node_product_, nodes_ * S, nodes_);
+}
+
+void VulkanEnsemble::record_cg_iterations(VkCommandBuffer cmd, int count) const {
+  PushConstants push;
+  push.S = static_cast<std::uint32_t>(S_);
+  push.count = static_cast<std::uint32_t>(nodes_);
+  push.max_iterations = model_.solver.cg_max_iterations;
+  for (int i = 0; i < count; ++i) {
+    record_system_product(cmd, s_product_cg_);
+    device_.dispatch(cmd, k_cg_iteration_, s_cg_iteration_, &push, static_cast<std::uint32_t>(S_));
+    device_.barrier(cmd);
+  }
+}
+
+StepReport VulkanEnsemble::advance(const Eigen::Vector3d& so_position) {
+  const std::size_t S = static_cast<std::size_t>(S_);
+  const std::size_t real = device_.real_size();
+  // Read-back offsets: active, iterations, converged (uint32), rr, bb, observations (reals).
+  const std::size_t at_active = 0, at_iterations = 4 * S, at_converged = 8 * S;
+  const std::size_t at_rr = 12 * S, at_bb = at_rr + real * S, at_observations = at_bb + real * S;
+  last_step_waits_ = 0;
+  observations_current_ = false;
+
+  // The right-hand side, the warm start and the first batch of iterations: as many as the
+  // last step needed (warm-started steps need about the same).
+  VkCommandBuffer cmd = device_.begin();
+  const std::vector<unsigned char> constants =
+      to_device(step_constants(model_, so_position, tolerance_));
+  device_.update(cmd, constants_, constants.data(), constants.size());
+  device_.barrier(cmd);
+  dispatch_items(cmd, k_element_rhs_, s_element_rhs_, elements_ * S, elements_);
+  dispatch_items(cmd, k_node_rhs_, s_node_rhs_, nodes_ * S, nodes_);
+  // The warm start's products K_e dv_e; cg_start gathers them itself.
+  dispatch_items(cmd, k_element_product_, s_product_warm_start_, elements_ * S, elements_);
+  PushConstants push;
+  push.S = static_cast<std::uint32_t>(S_);
+  push.count = static_cast<std::uint32_t>(nodes_);
+  device_.dispatch(cmd, k_cg_start_, s_cg_start_, &push, static_cast<std::uint32_t>(S_));
+  device_.barrier(cmd);
+
+  // Then batches until every sigma point is done or the cap is reached. A sigma point that
+  // is done is left alone by the shaders, so iterations past its end change nothing.
+  const int cap = model_.solver.cg_max_iterations;
+  int batch = std::max(1, expected_iterations_);
+  std::vector<std::uint32_t> active(S);
+  for (int done = 0; done < cap;) {
+    const int count = std::min(batch, cap - done);
+    record_cg_iterations(cmd, count);
+    done += count;
+    device_.copy_to_host(cmd, active_, 4 * S, at_active);
+    device_.submit_and_wait(cmd);
+    ++last_step_waits_;
+    std::memcpy(active.data(), static_cast<const unsigned char*>(device_.read_back()) + at_active,
+                4 * S);
+    cmd = device_.begin();
+    if (std::none_of(active.begin(), active.end(), [](std::uint32_t a) { return a != 0; })) break;
+    batch = std::max(2, expected_iterations_ / 8);
+  }
+
+  // The state update, the solver report and the observations, in one more submission.
+  dispatch_items(cmd, k_state_update_, s_state_update_, 3 * nodes_ * S,
+                 static_cast<std::uint32_t>(3 * nodes_));
+  const std::size_t rows = 3 * observed_.size();
+  if (rows > 0) {
+    dispatch_items(cmd, k_observation_gather_, s_observation_gather_, rows * S,
+                   static_cast<std::uint32_t>(observed_.size()));
+    device_.copy_to_host(cmd, observations_, rows * S * real, at_observations);
+  }
+  device_.copy_to_host(cmd, iterations_, 4 * S, at_iterations);
+  device_.copy_to_host(cmd, converged_, 4 * S, at_converged);
+  device_.copy_to_host(cmd, rr_, real * S, at_rr);
+  device_.copy_to_host(cmd, bb_, real * S, at_bb);
+  device_.submit_and_wait(cmd);
+  ++last_step_waits_;
+
+  const unsigned char* area = static_cast<const unsigned char*>(device_.read_back());
+  std::vector<std::int32_t> iterations(S);
+  std::vector<std::uint32_t> converged(S);
+  std::memcpy(iterations.data(), area + at_iterations, 4 * S);
+  std::memcpy(converged.data(), area + at_converged, 4 * S);
+  const std::vector<double> rr = from_device(area + at_rr, S);
+  const std::vector<double> bb = from_device(area + at_bb, S);
+  if (rows > 0) {
+    observations_cache_ = from_device(area + at_observations, rows * S);
+    observations_current_ = true;
+  }
+  StepReport report;
+  report.cg_iterations.assign(iterations.begin(), iterations.end());
+  report.converged.assign(converged.begin(), converged.end());
+  report.relative_residual.resize(S);
+  for (std::size_t s = 0; s < S; ++s)
+    report.relative_residual[s] = bb[s] > 0.0 ? std::sqrt(rr[s] / bb[s]) : 0.0;
+  expected_iterations_ = *std::max_element(iterations.begin(), iterations.end());
+  return report;
+}
+
+void VulkanEnsemble::predicted_observations(Eigen::MatrixXd& y) const {
+  const std::size_t rows = observed_.size() * 3;
+  y.resize(static_cast<Eigen::Index>(rows), S_);
+  if (rows == 0) return;
+  if (!observations_current_) {
+    VkCommandBuffer cmd = device_.begin();
+    dispatch_items(cmd, k_observation_gather_, s_observation_gather_, rows * S_,
+                   static_cast<std::uint32_t>(observed_.size()));
+    device_.copy_to_host(cmd, observations_, rows * S_ * device_.real_size(), 0);
+    device_.submit_and_wait(cmd);
+    observations_cache_ = from_device(device_.read_back(), rows * S_);
+    observations_current_ = true;
+  }
+  for (std::size_t row = 0; row < rows; ++row)
+    for (int s = 0; s < S_; ++s)
+      y(static_cast<Eigen::Index>(row), s) = observations_cache_[row * S_ + s];
+}
+
+void VulkanEnsemble::recenter(const Recentering& r) {
+  const RecenteringInputs in = pack_recentering(r, parameter_count(), S_, "VulkanEnsemble");
+  write(recenter_scalars_, in.scalars);
+  write(directions_, in.directions);
+  write(weights_, in.weights);
+  VkCommandBuffer cmd = device_.begin();
+  dispatch_items(cmd, k_recenter_, s_recenter_, 3 * static_cast<std::size_t>(nodes_),
+                 static_cast<std::uint32_t>(3 * nodes_));
+  device_.submit_and_wait(cmd);
+  observations_current_ = false;
+}
+
+Eigen::VectorXd VulkanEnsemble::positions(int s) const {
+  const std::vector<double> column = sigma_column(x_, 3 * static_cast<std::size_t>(nodes_), s);
+  return Eigen::Map<const Eigen::VectorXd>(column.data(), static_cast<Eigen::Index>(column.size()));
+}
+
+Eigen::VectorXd VulkanEnsemble::velocities(int s) const {
+  const std::vector<double> column = sigma_column(v_, 3 * static_cast<std::size_t>(nodes_), s);
+  return Eigen::Map<const Eigen::VectorXd>(column.data(), static_cast<Eigen::Index>(column.size()));
+}
+
+std::vector<double> VulkanEnsemble::frames(int s) const {
+  return sigma_column(frames_, 9 * static_cast<std::size_t>(elements_), s);
+}
+
+Eigen::MatrixXd VulkanEnsemble::system_product(const Eigen::MatrixXd& d) {
+  const std::size_t rows = 3 * static_cast<std::size_t>(nodes_);
+  if (static_cast<std::size_t>(d.rows()) != rows || d.cols() != S_)
+    throw std::invalid_argument("VulkanEnsemble::system_product: expected 3N x S");
+  std::vector<double> values(rows * S_);
+  for (std::size_t row = 0; row < rows; ++row)
+    for (int s = 0; s < S_; ++s) values[row * S_ + s] = d(static_cast<Eigen::Index>(row), s);
+  write(d_, values);
+  VkCommandBuffer cmd = device_.begin();
+  record_system_product(cmd, s_product_all_);
+  device_.submit_and_wait(cmd);
+  const std::vector<double> q = read(q_, rows * S_);
+  Eigen::MatrixXd y(d.rows(), d.cols());
+  for (std::size_t row = 0; row < rows; ++row)
+    for (int s = 0; s < S_; ++s) y(static_cast<Eigen::Index>(row), s) = q[row * S_ + s];
+  return y;
+}
+
+std::string VulkanEnsemble::description() const {
+  return std::string("vulkan ") +
+         (device_.precision() == Precision::single ? "single" : "double") + " on " +
+         device_.info().name;
+}
+
+}  // namespace sigmafem

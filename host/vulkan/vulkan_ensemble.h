@@ -1,0 +1,114 @@
+// VulkanEnsemble: the Ensemble (filter/ensemble.h) with all S sigma-point simulations
+// advancing together in Vulkan compute shaders (kernels/vulkan/, named as the OpenCL kernels
+// of kernels/opencl/), behind the same DeviceEnsemble interface as OpenClEnsemble, with the
+// same layout (host/ensemble/ensemble_tables.h) and the same deterministic assembly (a
+// per-node gather in a fixed order, fixed-tree reductions; no float atomics).
+//
+// A step is recorded into command buffers, not enqueued kernel by kernel: the right-hand
+// side, the warm start and a first batch of CG iterations (as many as the last step needed)
+// in one, then more batches if some sigma point is still iterating (the host reads the S
+// active flags after each), then the state update with the observation gather. Typically
+// two host waits per step; predicted_observations() then reads what the step gathered.
+//
+// Arithmetic and tolerances as OpenClEnsemble: float32 by default, the CG tolerance raised
+// to kSingleTolerance; --precision double needs shaderFloat64.
+#pragma once
+
+#include <Eigen/Core>
+#include <vector>
+
+#include "host/ensemble/device_ensemble.h"
+#include "host/model/model.h"
+#include "host/vulkan/vulkan_device.h"
+
+namespace sigmafem {
+
+class VulkanEnsemble : public DeviceEnsemble {
+ public:
+  // The CG tolerance floor in single precision (as OpenClEnsemble::kSingleTolerance).
+  static constexpr double kSingleTolerance = 1e-6;
+
+  // `estimated`: indices into model.ligaments whose log-stiffness the parameters are;
+  // `observed`: node indices. Throws DeviceError (no device, shader failure, too little memory).
+  VulkanEnsemble(const Model& model, std::vector<int> estimated, std::vector<int> observed,
+                 int sigma_count, const DeviceOptions& options);
+
+  int sigma_count() const override { return S_; }
+  int parameter_count() const override { return static_cast<int>(estimated_.size()); }
+  int observation_count() const override { return 3 * static_cast<int>(observed_.size()); }
+  void set_parameters(const Eigen::MatrixXd& theta) override;
+  StepReport advance(const Eigen::Vector3d& so_position) override;
+  void predicted_observations(Eigen::MatrixXd& y) const override;
+  void recenter(const Recentering& recentering) override;
+
+  Eigen::VectorXd positions(int s) const override;
+  Eigen::VectorXd velocities(int s) const override;
+  std::vector<double> frames(int s) const override;
+  Eigen::MatrixXd system_product(const Eigen::MatrixXd& d) override;
+  double cg_tolerance() const override { return tolerance_; }
+  std::string description() const override;
+  const VulkanDeviceInfo& device_info() const { return device_.info(); }
+  std::size_t device_bytes() const { return device_bytes_; }
+  // Host waits (command-buffer submissions) of the last advance().
+  int last_step_waits() const { return last_step_waits_; }
+
+ private:
+  // The scalar arguments of every shader (SfPush in kernels/vulkan/ensemble_layout.h).
+  struct PushConstants {
+    std::uint32_t S = 0;
+    std::uint32_t count = 0;
+    std::int32_t max_iterations = 0;
+    std::uint32_t p = 0;
+  };
+  VulkanBuffer make_buffer(std::size_t count, const char* what);
+  VulkanBuffer make_buffer(const std::vector<double>& values, const char* what);
+  VulkanBuffer make_buffer(const std::vector<int>& values, const char* what);
+  std::vector<unsigned char> to_device(const std::vector<double>& values) const;
+  std::vector<double> from_device(const void* data, std::size_t count) const;
+  void write(const VulkanBuffer& buffer, const std::vector<double>& values) const;
+  std::vector<double> read(const VulkanBuffer& buffer, std::size_t count) const;
+  std::vector<double> sigma_column(const VulkanBuffer& buffer, std::size_t rows, int s) const;
+
+  // Recording (kernels/vulkan/<file>.comp holds the shader of the same name).
+  void dispatch_items(VkCommandBuffer cmd, const VulkanKernel& kernel, VkDescriptorSet set,
+                      std::size_t items, std::uint32_t count) const;
+  void record_cg_iterations(VkCommandBuffer cmd, int count) const;
+  void record_system_product(VkCommandBuffer cmd, VkDescriptorSet element_product_set) const;
+
+  mutable VulkanDevice device_;
+  Model model_;
+  std::vector<int> estimated_, observed_;
+  int S_ = 0, nodes_ = 0, elements_ = 0;
+  double tolerance_ = 0.0;
+  std::size_t device_bytes_ = 0;
+  std::vector<double> ligament_k_;
+  std::uint32_t cg_group_ = 64;              // work-items per sigma point in the CG shaders
+  int expected_iterations_ = 1;              // CG iterations the last step needed (at most)
+  int last_step_waits_ = 0;
+  // The observations gathered at the end of the last advance(), until recenter() moves x.
+  mutable std::vector<double> observations_cache_;
+  mutable bool observations_current_ = false;
+
+  // Shared data.
+  VulkanBuffer element_nodes_, element_rest_, incidence_offsets_, incidence_;
+  VulkanBuffer ligament_offsets_, ligament_of_node_, control_k_, mass_, rest_positions_;
+  VulkanBuffer observed_nodes_, constants_;
+  // Per-sigma data.
+  VulkanBuffer ligament_k_buffer_, x_, v_, dv_, rhs_, inverse_diagonal_, r_, z_, d_, q_;
+  VulkanBuffer frames_, element_out_, element_diagonal_, observations_;
+  VulkanBuffer bb_, rr_, rz_, active_, converged_, iterations_, all_active_;
+  VulkanBuffer recenter_scalars_, directions_, weights_;
+
+  VulkanKernel k_element_rhs_, k_node_rhs_, k_element_product_, k_node_product_;
+  VulkanKernel k_cg_start_, k_cg_iteration_, k_state_update_, k_observation_gather_, k_recenter_;
+  // Descriptor sets; element_product has three: the warm start's product (dv, all active),
+  // the CG product (d, the active flags) and system_product()'s (d, all active).
+  VkDescriptorSet s_element_rhs_ = VK_NULL_HANDLE, s_node_rhs_ = VK_NULL_HANDLE;
+  VkDescriptorSet s_product_warm_start_ = VK_NULL_HANDLE, s_product_cg_ = VK_NULL_HANDLE;
+  VkDescriptorSet s_product_all_ = VK_NULL_HANDLE, s_node_product_ = VK_NULL_HANDLE;
+  VkDescriptorSet s_cg_start_ = VK_NULL_HANDLE, s_cg_iteration_ = VK_NULL_HANDLE;
+  VkDescriptorSet s_state_update_ = VK_NULL_HANDLE, s_observation_gather_ = VK_NULL_HANDLE;
+  VkDescriptorSet s_recenter_ = VK_NULL_HANDLE;
+};
+
+}  // namespace sigmafem

@@ -1,0 +1,36 @@
+/* element_product: y_e = R K_e R^T d_e for every element and sigma point, the cost of every
+ * CG iteration (as kernels/opencl/element_product.cl). Each element writes its own 12
+ * outputs; the node kernels sum them in a fixed order: no atomics, the same bits every run.
+ * One invocation per (element, sigma); a sigma point whose CG is done is skipped. */
+#version 450
+#extension GL_GOOGLE_include_directive : require
+#include "ensemble_layout.h"
+
+layout(local_size_x = SF_ITEMS_PER_GROUP) in;
+layout(std430, binding = 0) restrict readonly buffer Nodes { int nodes[]; };
+layout(std430, binding = 1) restrict readonly buffer Rest { real rest[]; };
+layout(std430, binding = 2) restrict readonly buffer Frames { real frames[]; };
+layout(std430, binding = 3) restrict readonly buffer D { real d[]; };
+layout(std430, binding = 4) restrict readonly buffer Active { uint active_flags[]; };
+layout(std430, binding = 5) restrict writeonly buffer Out { real out_values[]; };
+
+void main() {
+  uint S = sf_push.S;
+  uint gid = sf_global_id();
+  if (gid >= sf_push.count * S) return;
+  uint e = gid / S;
+  uint s = gid % S;
+  if (active_flags[s] == 0u) return; /* this sigma point's CG is done */
+  real grad[12];
+  real vlambda;
+  real vmu;
+  uint corner_nodes[4];
+  SF_LOAD_ELEMENT(rest, nodes, e, grad, vlambda, vmu, corner_nodes)
+  real frame[9];
+  real corner[12];
+  real product[12];
+  for (uint i = 0u; i < 9u; ++i) frame[i] = frames[(9u * e + i) * S + s];
+  SF_GATHER_CORNERS(d, corner_nodes, s, S, corner)
+  sf_element_product(frame, grad, vlambda, vmu, corner, product);
+  SF_STORE_CORNERS(out_values, e, s, S, product)
+}

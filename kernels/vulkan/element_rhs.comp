@@ -1,0 +1,46 @@
+/* element_rhs: the rotation step and each element's part of the implicit Euler right-hand
+ * side and of the Jacobi diagonal, per sigma point (as kernels/opencl/element_rhs.cl):
+ *   frame  = the element's QR frame at x   (stored: every CG product of the step uses it)
+ *   rhs_e  = f_e(x) - (h + a) K_e v_e
+ *   diag_e = diag(R K_e R^T)
+ * One invocation per (element, sigma). */
+#version 450
+#extension GL_GOOGLE_include_directive : require
+#include "ensemble_layout.h"
+
+layout(local_size_x = SF_ITEMS_PER_GROUP) in;
+layout(std430, binding = 0) restrict readonly buffer Nodes { int nodes[]; };
+layout(std430, binding = 1) restrict readonly buffer Rest { real rest[]; };
+layout(std430, binding = 2) restrict writeonly buffer Frames { real frames[]; };
+layout(std430, binding = 3) restrict readonly buffer X { real x[]; };
+layout(std430, binding = 4) restrict readonly buffer V { real v[]; };
+layout(std430, binding = 5) restrict readonly buffer C { real c[]; };
+layout(std430, binding = 6) restrict writeonly buffer RhsOut { real rhs_out[]; };
+layout(std430, binding = 7) restrict writeonly buffer DiagonalOut { real diagonal_out[]; };
+
+void main() {
+  uint S = sf_push.S;
+  uint gid = sf_global_id();
+  if (gid >= sf_push.count * S) return;
+  uint e = gid / S;
+  uint s = gid % S;
+  real grad[12];
+  real vlambda;
+  real vmu;
+  uint corner_nodes[4];
+  SF_LOAD_ELEMENT(rest, nodes, e, grad, vlambda, vmu, corner_nodes)
+  real frame[9];
+  real corner[12];
+  real force[12];
+  real product[12];
+  SF_GATHER_CORNERS(x, corner_nodes, s, S, corner)
+  sf_element_frame(corner, frame);
+  for (uint i = 0u; i < 9u; ++i) frames[(9u * e + i) * S + s] = frame[i];
+  sf_element_force(frame, grad, vlambda, vmu, corner, force);
+  SF_GATHER_CORNERS(v, corner_nodes, s, S, corner)
+  sf_element_product(frame, grad, vlambda, vmu, corner, product);
+  for (uint i = 0u; i < 12u; ++i) force[i] -= c[SF_VELOCITY_FACTOR] * product[i];
+  SF_STORE_CORNERS(rhs_out, e, s, S, force)
+  sf_element_diagonal(frame, grad, vlambda, vmu, product);
+  SF_STORE_CORNERS(diagonal_out, e, s, S, product)
+}

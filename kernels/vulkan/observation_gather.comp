@@ -1,0 +1,21 @@
+/* observation_gather: the observed nodes' positions of every sigma point, y[(3 k + axis) S + s]
+ * (as kernels/opencl/observation_gather.cl). The only per-step read-back of the state. */
+#version 450
+#extension GL_GOOGLE_include_directive : require
+#include "ensemble_layout.h"
+
+layout(local_size_x = SF_ITEMS_PER_GROUP) in;
+layout(std430, binding = 0) restrict readonly buffer Observed { int observed[]; };
+layout(std430, binding = 1) restrict readonly buffer X { real x[]; };
+layout(std430, binding = 2) restrict writeonly buffer Y { real y[]; };
+
+void main() {
+  uint S = sf_push.S;
+  uint gid = sf_global_id();
+  if (gid >= 3u * sf_push.count * S) return;
+  uint s = gid % S;
+  uint row = gid / S;
+  uint k = row / 3u;
+  uint axis = row % 3u;
+  y[gid] = x[(3u * uint(observed[k]) + axis) * S + s];
+}

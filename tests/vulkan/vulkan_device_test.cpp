@@ -1,0 +1,144 @@
+// The Vulkan device layer: device listing, failures as DeviceErrors that say what to do (a
+// shader that fails to load, an ensemble too big for the device, said before allocating),
+// and the validation layer, where it is installed, reporting nothing on a whole filter cycle.
+#include "host/vulkan/vulkan_device.h"
+
+#include <gtest/gtest.h>
+
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "host/model/model.h"
+#include "host/scenario/scenario.h"
+#include "host/vulkan/vulkan_ensemble.h"
+
+namespace sigmafem {
+namespace {
+
+// Every test in a process run with SIGMAFEM_VULKAN_VALIDATION=1 (the ctest `vulkan_validation`
+// in tests/CMakeLists.txt) must leave the validation layer silent: checked once at the end.
+class VulkanValidationEnvironment : public ::testing::Environment {
+ public:
+  void TearDown() override {
+    EXPECT_EQ(vulkan_validation_message_count(), 0)
+        << "the Vulkan validation layer reported problems (printed above on stderr)";
+  }
+};
+::testing::Environment* const validation_environment =
+    ::testing::AddGlobalTestEnvironment(new VulkanValidationEnvironment);
+
+class VulkanDeviceTest : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    std::string why;
+    if (list_vulkan_devices(&why).empty()) GTEST_SKIP() << why;
+  }
+};
+
+TEST_F(VulkanDeviceTest, ListsDevicesWithTheirProperties) {
+  const auto devices = list_vulkan_devices();
+  ASSERT_FALSE(devices.empty());
+  for (std::size_t i = 0; i < devices.size(); ++i) {
+    EXPECT_EQ(devices[i].index, static_cast<int>(i));
+    EXPECT_FALSE(devices[i].name.empty());
+    EXPECT_FALSE(devices[i].type.empty());
+    EXPECT_GT(devices[i].memory, 0u);
+    EXPECT_GT(devices[i].max_buffer, 0u);
+  }
+}
+
+TEST_F(VulkanDeviceTest, NoSuchDeviceSaysHowManyThereAre) {
+  try {
+    VulkanDevice device(99, Precision::single);
+    FAIL() << "expected no device 99";
+  } catch (const DeviceError& e) {
+    EXPECT_NE(std::string(e.what()).find("no Vulkan device 99"), std::string::npos) << e.what();
+  }
+}
+
+TEST_F(VulkanDeviceTest, AShaderThatFailsToLoadIsADeviceError) {
+  VulkanDevice device(0, Precision::single);
+  // Not SPIR-V: the driver never sees it (some crash on such input).
+  const std::vector<std::uint32_t> garbage = {0xdeadbeef, 1, 2, 3, 4, 5};
+  try {
+    device.kernel_from_spirv("garbage", garbage.data(), garbage.size(), 1, 0);
+    FAIL() << "expected a load failure";
+  } catch (const DeviceError& e) {
+    const std::string message = e.what();
+    EXPECT_NE(message.find("failed to load"), std::string::npos) << message;
+    EXPECT_NE(message.find("garbage"), std::string::npos) << message;
+  }
+  // A shader the build did not embed.
+  try {
+    device.kernel("no_such_shader", 1);
+    FAIL() << "expected a missing shader";
+  } catch (const DeviceError& e) {
+    EXPECT_NE(std::string(e.what()).find("no_such_shader"), std::string::npos) << e.what();
+  }
+}
+
+TEST_F(VulkanDeviceTest, TooBigAnEnsembleSaysHowMuchItNeeds) {
+  const Scenario scenario = load_scenario(std::string(SIGMAFEM_SOURCE_DIR) + "/scenarios/box.json");
+  const Model model = make_model(scenario);
+  // 1344 tetrahedra x 12 x S floats in one buffer: S = 2^26 needs about 4 TB.
+  try {
+    VulkanEnsemble ensemble(model, {0}, {}, 1 << 26, DeviceOptions{});
+    FAIL() << "expected an out-of-memory error";
+  } catch (const DeviceError& e) {
+    const std::string message = e.what();
+    EXPECT_NE(message.find("out of device memory"), std::string::npos) << message;
+    EXPECT_NE(message.find("MiB"), std::string::npos) << message;
+  }
+}
+
+// A filter cycle through every shader and every host path (advance with several CG batches,
+// observations, re-centring, the read-outs) in both precisions. Under the ctest
+// `vulkan_validation` the layer watches it (synchronization validation included) and the
+// environment above fails the run on any message; elsewhere it checks the results are finite.
+TEST_F(VulkanDeviceTest, AFilterCycleRunsCleanly) {
+  if (!vulkan_validation_available())
+    std::cout << "validation layer off (SIGMAFEM_VULKAN_VALIDATION=1 and "
+                 "VK_LAYER_KHRONOS_validation switch it on)\n";
+  const Scenario scenario = load_scenario(std::string(SIGMAFEM_SOURCE_DIR) + "/scenarios/box.json");
+  const Model model = make_model(scenario);
+  const std::vector<int>& estimated = scenario.filter->estimate;
+  const int p = static_cast<int>(estimated.size()), S = p + 1;
+  for (Precision precision : {Precision::single, Precision::double_precision}) {
+    if (precision == Precision::double_precision && !list_vulkan_devices()[0].has_fp64) continue;
+    DeviceOptions options;
+    options.precision = precision;
+    VulkanEnsemble ensemble(model, estimated, scenario.observations.nodes, S, options);
+    Eigen::MatrixXd theta(p, S);
+    for (int j = 0; j < p; ++j)
+      for (int s = 0; s < S; ++s)
+        theta(j, s) = std::log(model.ligaments[estimated[j]].stiffness) + 0.2 * std::sin(s + j);
+    ensemble.set_parameters(theta);
+    Eigen::MatrixXd y;
+    for (int k = 1; k <= 3; ++k) {
+      const StepReport report = ensemble.advance(
+          scenario.control.trajectory.position(k * scenario.time.dt, scenario.control.start));
+      EXPECT_EQ(report.unconverged_count(), 0);
+      ensemble.predicted_observations(y);
+      Recentering r;
+      r.alpha = 1.0 / S;
+      r.directions = Eigen::MatrixXd::Zero(p, S);
+      for (int j = 0; j < p; ++j) {
+        r.directions(j, j) = 1.0;
+        r.directions(j, S - 1) = -1.0;
+      }
+      r.correction = Eigen::VectorXd::Zero(p);
+      r.factor = Eigen::MatrixXd::Identity(p, p);
+      ensemble.recenter(r);
+    }
+    ensemble.predicted_observations(y);
+    EXPECT_TRUE(y.allFinite());
+    EXPECT_TRUE(ensemble.positions(0).allFinite());
+    EXPECT_EQ(static_cast<int>(ensemble.frames(S - 1).size()), 9 * model.element_count());
+    const Eigen::MatrixXd Ad = ensemble.system_product(Eigen::MatrixXd::Ones(model.dof_count(), S));
+    EXPECT_TRUE(Ad.allFinite());
+  }
+}
+
+}  // namespace
+}  // namespace sigmafem
