@@ -77,9 +77,6 @@ struct VulkanApi {
   PFN_vkCreateDebugUtilsMessengerEXT vkCreateDebugUtilsMessengerEXT = nullptr;
   PFN_vkDestroyDebugUtilsMessengerEXT vkDestroyDebugUtilsMessengerEXT = nullptr;
 
-  ~VulkanApi() {
-    if (library) dlclose(library);
-  }
   // Loads the instance-level functions (device functions too, through the loader's
   // trampolines) for `instance`.
   void load(VkInstance instance) {
@@ -98,11 +95,33 @@ namespace {
 constexpr const char* kValidationLayer = "VK_LAYER_KHRONOS_validation";
 std::atomic<int> validation_messages{0};
 
+// One instance held for the whole process, never destroyed, so that the loader keeps the
+// drivers loaded between devices: it unloads them with the last instance, and Mesa's
+// one-time initialisation (pthread_once) would then be redone for every ensemble and leave
+// its allocations to LeakSanitizer in a module that no longer exists.
+void keep_drivers_loaded(const VulkanApi& api) {
+  static const bool held = [&api] {
+    VkApplicationInfo app{};
+    app.sType = VK_STRUCTURE_TYPE_APPLICATION_INFO;
+    app.apiVersion = VK_API_VERSION_1_0;
+    VkInstanceCreateInfo create{};
+    create.sType = VK_STRUCTURE_TYPE_INSTANCE_CREATE_INFO;
+    create.pApplicationInfo = &app;
+    static VkInstance instance = VK_NULL_HANDLE;
+    return api.vkCreateInstance(&create, nullptr, &instance) == VK_SUCCESS;
+  }();
+  (void)held;
+}
+
 // The loader, or null with `why` set. Each instance gets its own table (function pointers
 // from vkGetInstanceProcAddr belong to their instance).
 std::shared_ptr<VulkanApi> open_loader(std::string& why) {
   auto api = std::make_shared<VulkanApi>();
-  api->library = dlopen("libvulkan.so.1", RTLD_NOW | RTLD_LOCAL);
+  // Opened once and never closed: the loader and the drivers it loads stay for the whole
+  // process (closing them would unload Mesa under live allocations of its own, which
+  // LeakSanitizer then reports from an unknown module that no suppression can name).
+  static void* const library = dlopen("libvulkan.so.1", RTLD_NOW | RTLD_LOCAL);
+  api->library = library;
   if (!api->library) {
     why = "no Vulkan loader (libvulkan.so.1) found: install it and a driver (on Debian, "
           "apt-get install libvulkan1 mesa-vulkan-drivers for lavapipe on the CPU) or use "
@@ -123,6 +142,7 @@ std::shared_ptr<VulkanApi> open_loader(std::string& why) {
     why = "the Vulkan loader lacks vkCreateInstance";
     return nullptr;
   }
+  keep_drivers_loaded(*api);
   return api;
 }
 
