@@ -50,8 +50,9 @@ echo "== tests (sanitizers)"
 # CPU-reference runs (200-step trajectories, repeated runs, 16 sigma points, the whole-run
 # comparison) ran above; the one-step, re-centring and iteration-cap tests with 1 and 4
 # sigma points run here and cover the same host code. The residual diagnostics' two 100-step
-# box runs (ResidualDiagnosticsBox) ran above too; their synthetic tests run here.
+# box runs (ResidualDiagnosticsBox) ran above too; their synthetic tests run here. So did the
+# whole diagnoses (DiagnoseBox, 4 to 8 filter runs each).
 ASAN_OPTIONS=detect_leaks=1:abort_on_error=1 UBSAN_OPTIONS=print_stacktrace=1:halt_on_error=1 \
   ctest --test-dir build-sanitize --output-on-failure -j "$jobs" \
-  -E 'BoxEstimation|ResidualDiagnosticsBox|WholeRun|Conformance.*(Trajectory|TwoRuns|_S16)'
+  -E 'BoxEstimation|ResidualDiagnosticsBox|DiagnoseBox|WholeRun|Conformance.*(Trajectory|TwoRuns|_S16)'
 

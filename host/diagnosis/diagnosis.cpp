@@ -272,6 +272,14 @@ Diagnosis diagnose(const Scenario& scenario, const ObservationTable& data,
       d.discovered.push_back(value);
     }
     text << " makes it consistent.";
+    // Another candidate that also made the residual consistent is an alternative the data
+    // cannot rule out (e.g. a scale of Young's modulus and a gravity along the known one,
+    // when that gravity is the only known force): say so rather than hide it.
+    for (const DiagnosisRound& r : d.rounds)
+      for (const CandidateScore& c : r.candidates)
+        if (!r.chosen.empty() && c.effect != r.chosen && c.complete && c.verdict == Consistency::consistent)
+          text << " Also consistent instead of " << r.chosen << ": " << describe_estimate(c.estimate)
+               << " (score " << format(c.score, 6) << "): the data may not tell the two apart.";
   } else if (after.residual.verdict.consistency == Consistency::too_few_steps) {
     d.outcome = DiagnosisOutcome::unexplained;
     text << "Too few filter steps to judge the residual: nothing was tested or added.";
