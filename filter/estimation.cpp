@@ -1,5 +1,6 @@
 #include "filter/estimation.h"
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <sstream>
@@ -28,10 +29,12 @@ EstimationRun run_estimation(Ensemble& ensemble, const EstimationOptions& option
       break;
     }
     step.log_std = result.theta_covariance.diagonal().cwiseSqrt();
+    step.theta = result.theta;
     step.stiffness = result.theta.array().exp();
     step.stiffness_std = step.stiffness.cwiseProduct(step.log_std);
     step.innovation_rms = result.innovation_rms;
     step.normalised_innovation = result.normalised_innovation;
+    step.log_det_innovation_covariance = result.log_det_innovation_covariance;
     step.observed_rows = result.observed_rows;
     step.innovation = Eigen::VectorXd::Constant(points.cols(), NAN);
     step.innovation_std = Eigen::VectorXd::Constant(points.cols(), NAN);
@@ -51,7 +54,10 @@ EstimationRun run_estimation(Ensemble& ensemble, const EstimationOptions& option
     step.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
     run.steps.push_back(step);
     if (on_step) on_step(step);
-    for (Eigen::Index j = 0; j < step.stiffness.size(); ++j) {
+    const Eigen::Index checked = options.stiffness_count >= 0
+                                     ? std::min<Eigen::Index>(options.stiffness_count, step.stiffness.size())
+                                     : step.stiffness.size();
+    for (Eigen::Index j = 0; j < checked; ++j) {
       const double k_j = step.stiffness[j];
       if (!(k_j >= options.min_stiffness && k_j <= options.max_stiffness)) {
         std::ostringstream reason;

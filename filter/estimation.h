@@ -21,12 +21,18 @@ struct EstimationOptions {
   ChangeDetectorOptions detector;
   double min_stiffness = 1e-6;     // N/m: below or above this range the filter has diverged
   double max_stiffness = 1e9;
+  // The first `stiffness_count` parameters are log-stiffnesses checked against the range
+  // above; the rest (effect parameters, host/model/effects.h) are not stiffnesses.
+  // -1: all of them.
+  int stiffness_count = -1;
 };
 
 struct EstimationStep {
   int step = 0;
   double time = 0.0;
-  Eigen::VectorXd stiffness;       // exp(theta_hat): the median estimate, N/m
+  Eigen::VectorXd theta;           // theta_hat, all p parameters
+  Eigen::VectorXd stiffness;       // exp(theta_hat): the median estimate, N/m (only the
+                                   // first stiffness_count rows are stiffnesses)
   Eigen::VectorXd stiffness_std;   // exp(theta_hat) * std(theta): first-order std, N/m
   Eigen::VectorXd log_std;         // std(theta)
   double innovation_rms = 0.0;     // m
@@ -37,6 +43,7 @@ struct EstimationStep {
   Eigen::VectorXd innovation;
   Eigen::VectorXd innovation_std;
   double normalised_innovation = 0.0;
+  double log_det_innovation_covariance = 0.0;   // log det S (Roukf)
   int observed_rows = 0;
   bool change_detected = false;
   int max_cg_iterations = 0;       // over the sigma points

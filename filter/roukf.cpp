@@ -23,10 +23,25 @@ Roukf::Roukf(const RoukfOptions& options, Ensemble& ensemble)
                                 " and " + std::to_string(points_.count()));
   if (!(options.observation_std > 0.0))
     throw std::invalid_argument("Roukf: observation_std must be positive");
+  if (options.initial_std.size() != 0 && options.initial_std.size() != p)
+    throw std::invalid_argument("Roukf: initial_std has " + std::to_string(options.initial_std.size()) +
+                                " values for " + std::to_string(p) + " parameters");
+  if (options.drift_std.size() != 0 && options.drift_std.size() != p)
+    throw std::invalid_argument("Roukf: drift_std has " + std::to_string(options.drift_std.size()) +
+                                " values for " + std::to_string(p) + " parameters");
+  const Eigen::VectorXd prior_std = options.initial_std.size() == p
+                                        ? options.initial_std
+                                        : Eigen::VectorXd::Constant(p, options.initial_log_std);
+  if (!(prior_std.array() > 0.0).all())
+    throw std::invalid_argument("Roukf: every prior std must be positive");
+  drift_variance_ = options.drift_std.size() == p
+                        ? Eigen::VectorXd(options.drift_std.array().square())
+                        : Eigen::VectorXd::Constant(p, options.parameter_drift_log_std *
+                                                           options.parameter_drift_log_std);
   theta_ = options.initial_theta;
   // L = [0; I_p], U^-1 = diag(sigma^2): the state is known, the parameters are not.
   L_theta_ = Eigen::MatrixXd::Identity(p, p);
-  U_inv_ = Eigen::MatrixXd::Identity(p, p) * (options.initial_log_std * options.initial_log_std);
+  U_inv_ = Eigen::MatrixXd(prior_std.array().square().matrix().asDiagonal());
   correction_ = Eigen::VectorXd::Zero(p);
 }
 
@@ -36,10 +51,10 @@ Eigen::MatrixXd Roukf::theta_covariance() const {
 
 void Roukf::inflate(double log_std) { pending_variance_ += log_std * log_std; }
 
-void Roukf::add_theta_variance(double variance) {
-  // P_theta + v I = L_theta (U^-1 + v L_theta^-1 L_theta^-T) L_theta^T: only U^-1 changes.
-  const Eigen::MatrixXd LtL = L_theta_.transpose() * L_theta_;
-  U_inv_ += variance * LtL.inverse();
+void Roukf::add_theta_variance(const Eigen::VectorXd& variance) {
+  // P_theta + D = L_theta (U^-1 + L_theta^-1 D L_theta^-T) L_theta^T: only U^-1 changes.
+  const Eigen::MatrixXd L_inv = L_theta_.inverse();
+  U_inv_ += L_inv * variance.asDiagonal() * L_inv.transpose();
   U_inv_ = 0.5 * (U_inv_ + U_inv_.transpose());   // keep it exactly symmetric for chol
 }
 
@@ -52,8 +67,8 @@ RoukfStep Roukf::step(const Eigen::Vector3d& so_position, const Eigen::VectorXd&
                                 std::to_string(ensemble_.observation_count()) +
                                 " observation values, got " + std::to_string(y.size()));
 
-  const double q = options_.parameter_drift_log_std;
-  if (q > 0.0 || pending_variance_ > 0.0) add_theta_variance(q * q + pending_variance_);
+  if (drift_variance_.maxCoeff() > 0.0 || pending_variance_ > 0.0)
+    add_theta_variance(drift_variance_.array() + pending_variance_);
   pending_variance_ = 0.0;
 
   // Sampling.
@@ -101,7 +116,7 @@ RoukfStep Roukf::step(const Eigen::Vector3d& so_position, const Eigen::VectorXd&
     const Eigen::VectorXd z_bar = alpha * Z.rowwise().sum();
     result.innovation = z_bar;
     result.innovation_rms = std::sqrt(z_bar.squaredNorm() / m);
-    result.normalised_innovation = correct(Z);
+    result.normalised_innovation = correct(Z, result.log_det_innovation_covariance);
     // diag(S) = row norms of HL (H P^- H^T = HL HL^T) plus R's diagonal: what standardises
     // each row's innovation for the residual diagnostics, at the cost of one m x p product.
     const Eigen::MatrixXd HL = alpha * Z * I.transpose();
@@ -116,7 +131,7 @@ RoukfStep Roukf::step(const Eigen::Vector3d& so_position, const Eigen::VectorXd&
   return result;
 }
 
-double Roukf::correct(const Eigen::MatrixXd& Z) {
+double Roukf::correct(const Eigen::MatrixXd& Z, double& log_det) {
   const int p = points_.parameter_count(), r = points_.count();
   const Eigen::MatrixXd& I = points_.directions;   // p x r (I^T is the r x p of ROUKF.md)
   const double alpha = points_.alpha;
@@ -148,18 +163,22 @@ double Roukf::correct(const Eigen::MatrixXd& Z) {
   U_inv_ = U_llt.solve(Eigen::MatrixXd::Identity(p, p));
   const Eigen::VectorXd HLt_Rinv_z = r_inv * HL_t * z_bar;
   correction_ = -U_inv_ * HLt_Rinv_z;
-  return normalised_innovation(Z, z_bar, r_inv);
+  return normalised_innovation(Z, z_bar, r_inv, log_det);
 }
 
 double Roukf::normalised_innovation(const Eigen::MatrixXd& Z, const Eigen::VectorXd& z_bar,
-                                    double r_inv) const {
+                                    double r_inv, double& log_det) const {
   // S = H P^- H^T + R with H P^- H^T = HL HL^T, HL = alpha sum Z_i I_i^T (for either set);
   // Woodbury: S^-1 = R^-1 - R^-1 HL (I + HL^T R^-1 HL)^-1 HL^T R^-1.
   const int p = points_.parameter_count();
   const Eigen::MatrixXd HL = points_.alpha * Z * points_.directions.transpose();
   const Eigen::MatrixXd U = Eigen::MatrixXd::Identity(p, p) + r_inv * HL.transpose() * HL;
   const Eigen::VectorXd w = r_inv * HL.transpose() * z_bar;
-  return r_inv * z_bar.squaredNorm() - w.dot(U.ldlt().solve(w));
+  const Eigen::LDLT<Eigen::MatrixXd> U_ldlt(U);
+  // det S = det(R) det(I_p + HL^T R^-1 HL), R = r I_m.
+  log_det = -static_cast<double>(Z.rows()) * std::log(r_inv) +
+            U_ldlt.vectorD().array().log().sum();
+  return r_inv * z_bar.squaredNorm() - w.dot(U_ldlt.solve(w));
 }
 
 }  // namespace sigmafem

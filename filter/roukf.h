@@ -28,6 +28,12 @@ struct RoukfOptions {
   Eigen::VectorXd initial_theta;        // p: prior mean of theta (log of the median stiffness)
   double initial_log_std = 1.0;         // prior standard deviation of each theta
   double parameter_drift_log_std = 0.0; // q: random-walk std of theta per step
+  // Per-parameter overrides (size p, or empty: every parameter takes the scalar above). The
+  // residual analysis appends effect parameters (host/model/effects.h) in coordinates scaled
+  // by their own prior std, which need prior std 1 and no drift (an effect is a constant),
+  // beside log-stiffnesses that keep the scenario's prior and drift.
+  Eigen::VectorXd initial_std;          // p: prior std of each theta
+  Eigen::VectorXd drift_std;            // p: random-walk std of each theta per step
   double observation_std = 1e-3;        // sqrt of R's diagonal
 };
 
@@ -40,6 +46,10 @@ struct RoukfStep {
   int observed_rows = 0;                // rows of y that were not missing
   double innovation_rms = 0.0;          // sqrt(mean z_bar^2) over the observed rows (NaN if none)
   double normalised_innovation = 0.0;   // z_bar^T S^-1 z_bar, S = H P^- H^T + R (chi^2, m dof)
+  // log det S: with the NIS, the step's Gaussian log-likelihood of the innovation
+  // -0.5 (NIS + log det S + m log 2 pi), the prediction-error decomposition the residual
+  // analysis compares models by. det S = det R det(I + HL^T R^-1 HL) (Sylvester).
+  double log_det_innovation_covariance = 0.0;
   StepReport ensemble;
 };
 
@@ -64,12 +74,14 @@ class Roukf {
   const Eigen::VectorXd& last_correction() const { return correction_; }
 
  private:
-  void add_theta_variance(double variance);
+  // P_theta += diag(variance) (p).
+  void add_theta_variance(const Eigen::VectorXd& variance);
   // Kalman correction from the innovations Z (m x r) of the observed rows: sets U_inv_ and
   // correction_, and returns the normalised innovation squared.
-  double correct(const Eigen::MatrixXd& Z);
+  double correct(const Eigen::MatrixXd& Z, double& log_det);
+  // z^T S^-1 z, and log det S in `log_det`.
   double normalised_innovation(const Eigen::MatrixXd& Z, const Eigen::VectorXd& z_bar,
-                               double r_inv) const;
+                               double r_inv, double& log_det) const;
 
   RoukfOptions options_;
   Ensemble& ensemble_;
@@ -79,6 +91,7 @@ class Roukf {
   Eigen::MatrixXd U_inv_;               // p x p
   Eigen::VectorXd correction_;          // k of the last correction, applied at re-sampling
   double pending_variance_ = 0.0;       // inflation to add before the next sampling
+  Eigen::VectorXd drift_variance_;      // p: q_j^2
 };
 
 }  // namespace sigmafem

@@ -12,6 +12,7 @@ using Action = std::function<int()>;
 
 Action add_generate_command(CLI::App& app);
 Action add_estimate_command(CLI::App& app);
+Action add_diagnose_command(CLI::App& app);
 Action add_demo_command(CLI::App& app);
 Action add_info_command(CLI::App& app);
 Action add_devices_command(CLI::App& app);

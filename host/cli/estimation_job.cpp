@@ -15,6 +15,7 @@
 #include "host/data/observation_table.h"
 #include "host/data/truth_table.h"
 #include "host/ensemble/make_ensemble.h"
+#include "host/model/effects.h"
 #include "host/model/model.h"
 #include "host/scenario/estimation_options.h"
 
@@ -29,12 +30,17 @@ json run_estimation_job(const Scenario& scenario, const EstimationJob& job) {
                      "block naming the ligaments to estimate and the prior");
   const FilterSpec& spec = *scenario.filter;
   const fs::path data(job.data_dir);
-  const ObservationTable table =
+  ObservationTable table =
       read_observations_csv((data / "observations.csv").string(),
                             static_cast<int>(scenario.observations.nodes.size()), scenario.time.dt);
   if (table.row_count() < 2)
     throw InputError("observations " + (data / "observations.csv").string() +
                      ": needs at least two rows (the rest state and one step)");
+  // A camera offset the scenario declares: the model's observations are the positions plus
+  // the offset, i.e. the positions are the data minus the offset.
+  const Eigen::Vector3d offset = camera_offset(scenario.effects);
+  for (Eigen::Index c = 0; c + 2 < table.points.cols(); c += 3)
+    table.points.middleCols(c, 3).rowwise() -= offset.transpose();
   std::optional<TruthTable> truth;
   if (fs::exists(data / "truth.csv")) truth = read_truth_csv((data / "truth.csv").string());
 

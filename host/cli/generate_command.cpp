@@ -17,6 +17,7 @@ Action add_generate_command(CLI::App& app) {
     BackendChoice backend;
     bool quiet = false;
     double noise_std = -1.0;
+    std::vector<std::string> inject;
   };
   auto options = std::make_shared<Options>();
   CLI::App* sub = app.add_subcommand(
@@ -33,10 +34,18 @@ Action add_generate_command(CLI::App& app) {
   sub->add_option("--noise-std", options->noise_std,
                   "Observation noise std in metres (default: the scenario's observations.noise_std)")
       ->check(CLI::NonNegativeNumber);
+  sub->add_option("--inject", options->inject,
+                  "Put an effect into the data without declaring it in the scenario, NAME=VALUE "
+                  "(repeatable), e.g. gravity=0,-9.81,0, young_scale=1.5, camera_offset=0.5e-3,0,0; "
+                  "effects: " + effect_names() + ". Recorded in truth.json")
+      ->expected(1)
+      ->multi_option_policy(CLI::MultiOptionPolicy::TakeAll);
   add_backend_options(sub, options->backend);
   sub->add_flag("--quiet", options->quiet, "No progress line and no summary");
   return [options]() {
     Scenario scenario = load_scenario(options->scenario);
+    for (const std::string& text : options->inject)
+      options->generate.inject.push_back(parse_effect_assignment(text, "--inject"));
     options->generate.backend = options->backend.backend;
     options->generate.device = options->backend.device_options();
     if (options->noise_std >= 0.0) scenario.observations.noise_std = options->noise_std;

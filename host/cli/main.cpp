@@ -17,6 +17,7 @@ int main(int argc, char** argv) {
   app.require_subcommand(1);
   std::map<CLI::App*, sigmafem::cli::Action> actions;
   for (auto add : {sigmafem::cli::add_generate_command, sigmafem::cli::add_estimate_command,
+                   sigmafem::cli::add_diagnose_command,
                    sigmafem::cli::add_demo_command, sigmafem::cli::add_info_command,
                    sigmafem::cli::add_devices_command}) {
     const std::size_t before = app.get_subcommands({}).size();

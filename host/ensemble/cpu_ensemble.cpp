@@ -59,6 +59,12 @@ void CpuEnsemble::set_parameters(const Eigen::MatrixXd& theta) {
   }
 }
 
+void CpuEnsemble::set_physics_effects(const std::vector<PhysicsEffects>& effects) {
+  if (static_cast<int>(effects.size()) != sigma_count())
+    throw std::invalid_argument("CpuEnsemble::set_physics_effects: expected one entry per sigma point");
+  for (int s = 0; s < sigma_count(); ++s) simulations_[s].set_physics_effects(effects[s]);
+}
+
 StepReport CpuEnsemble::advance(const Eigen::Vector3d& so_position) {
   const int S = sigma_count();
   StepReport report;

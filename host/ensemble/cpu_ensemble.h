@@ -31,6 +31,10 @@ class CpuEnsemble : public Ensemble {
   void predicted_observations(Eigen::MatrixXd& y) const override;
   void recenter(const Recentering& recentering) override;
 
+  // Per sigma point s, physics effects on top of the model (diagnose's candidates; one entry
+  // per sigma point). Kept until changed.
+  void set_physics_effects(const std::vector<PhysicsEffects>& effects);
+
   // Sigma point s's simulation (tests compare it with a lone ReferenceSimulation).
   const ReferenceSimulation& simulation(int s) const { return simulations_[s]; }
 

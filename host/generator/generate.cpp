@@ -15,7 +15,9 @@
 #include "host/data/truth_table.h"
 #include "host/generator/gaussian_noise.h"
 #include "host/generator/vtk_series.h"
+#include "host/model/effects.h"
 #include "host/model/model.h"
+#include <nlohmann/json.hpp>
 #include "host/generator/truth_simulation.h"
 
 namespace sigmafem {
@@ -28,7 +30,11 @@ GenerateResult generate(const Scenario& scenario, const GenerateOptions& options
   fs::create_directories(options.out_dir, error);
   if (error) throw InputError(options.out_dir + ": cannot create output folder: " + error.message());
 
-  TruthSimulation simulation(make_model(scenario), options);
+  Model truth_model = make_model(scenario);   // declared effects included
+  apply_effects(options.inject, truth_model);
+  // What a camera adds to every observed position: declared and injected registration errors.
+  const Eigen::Vector3d offset = camera_offset(scenario.effects) + camera_offset(options.inject);
+  TruthSimulation simulation(std::move(truth_model), options);
   const Model& model = simulation.model();
   const int steps = scenario.time.steps;
   const double dt = scenario.time.dt;
@@ -60,7 +66,7 @@ GenerateResult generate(const Scenario& scenario, const GenerateOptions& options
     for (std::size_t p = 0; p < observed.size(); ++p)
       for (int a = 0; a < 3; ++a)
         table.points(k, static_cast<Eigen::Index>(3 * p + a)) =
-            positions[3 * observed[p] + a] +
+            positions[3 * observed[p] + a] + offset[a] +
             scenario.observations.noise_std * noise.next();
     truth.steps.push_back(k);
     truth.times.push_back(t);
@@ -103,6 +109,17 @@ GenerateResult generate(const Scenario& scenario, const GenerateOptions& options
   write_file_atomically((out / "observations.csv").string(), format_observations_csv(table));
   write_file_atomically((out / "truth.csv").string(),
                         format_truth_csv(truth));
+  auto effects_json = [](const std::vector<EffectValue>& effects) {
+    nlohmann::ordered_json list = nlohmann::ordered_json::array();
+    for (const EffectValue& effect : effects) list.push_back({{"name", effect.name}, {"value", effect.value}});
+    return list;
+  };
+  nlohmann::ordered_json truth_json = {{"format", "sigmafem-truth/1"},
+                                       {"scenario", scenario.name},
+                                       {"seed", options.seed},
+                                       {"declared_effects", effects_json(scenario.effects)},
+                                       {"injected_effects", effects_json(options.inject)}};
+  write_file_atomically((out / "truth.json").string(), truth_json.dump(2) + "\n");
   if (vtk) {
     vtk->finish();
     result.vtk_frames = vtk->frame_count();

@@ -5,6 +5,8 @@
 //   <out>/observations.csv  SO position and observed node positions per step, with Gaussian
 //                           noise of the scenario's noise_std (docs/FORMATS.md)
 //   <out>/truth.csv         each ligament's true stiffness per step
+//   <out>/truth.json        the effects in the data: declared in the scenario, and injected
+//                           (--inject) without being declared (docs/FORMATS.md)
 //   <out>/<name>.pvd + <out>/vtk/*.vtu   the organ every vtk_every steps, for ParaView
 // Row k of each CSV is the state after k steps (time k dt); row 0 is the rest state. A step
 // uses the SO position and the ligament stiffnesses at its END time (an event at time T acts
@@ -16,6 +18,7 @@
 #include <string>
 
 #include "host/common/device_error.h"
+#include "host/scenario/effect_catalogue.h"
 #include "host/scenario/scenario.h"
 
 namespace sigmafem {
@@ -27,6 +30,9 @@ struct GenerateOptions {
   bool progress = false;           // a progress line on stderr (when it is a terminal)
   std::string backend = "cpu";     // make_ensemble's names; "cpu" is the double-precision reference
   DeviceOptions device;            // for a device back end
+  // Effects put into the data but not into the scenario (`--inject NAME=VALUE`): the model
+  // a filter builds from the scenario lacks them. Recorded in truth.json.
+  std::vector<EffectValue> inject;
 };
 
 struct GenerateResult {

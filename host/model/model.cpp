@@ -3,6 +3,7 @@
 #include <Eigen/Dense>
 #include <cmath>
 
+#include "host/model/effects.h"
 #include "host/model/shared_element.h"
 
 namespace sigmafem {
@@ -104,6 +105,9 @@ Model make_model(const Scenario& scenario) {
     model.ligaments.push_back({ligament.name, ligament.nodes, ligament.stiffness});
   model.control = {"control", scenario.control.nodes, scenario.control.stiffness};
   model.control_start = scenario.control.start;
+  // Effects the scenario declares part of the model (the observation-side ones act on the
+  // data instead: the estimation subtracts a declared camera offset).
+  apply_effects(scenario.effects, model);
   return model;
 }
 

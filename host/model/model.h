@@ -53,7 +53,7 @@ struct Model {
 Model make_model(const Mesh& mesh, const Material& material);
 
 // The full model of a scenario: mesh, material, damping, gravity, dt, solver, the ligaments
-// with their initial stiffness and the control spring.
+// with their initial stiffness, the control spring, and the physics effects it declares.
 Model make_model(const Scenario& scenario);
 
 // The rest state of the tetrahedron with these corners (world coordinates, positively

@@ -16,6 +16,20 @@ ReferenceSimulation::ReferenceSimulation(Model model) : model_(std::move(model))
   for (int i = 0; i < n; ++i) x_.segment<3>(3 * i) = model_.rest_positions[i];
   v_ = Eigen::VectorXd::Zero(3 * n);
   dv_ = Eigen::VectorXd::Zero(3 * n);
+  base_gravity_ = model_.gravity;
+}
+
+void ReferenceSimulation::set_physics_effects(const PhysicsEffects& effects) {
+  model_.gravity = base_gravity_ + effects.gravity;
+  if (effects.young_scale == young_scale_) return;
+  if (base_lame_.empty())
+    for (const ElementRest& element : model_.elements) base_lame_.emplace_back(element.vlambda, element.vmu);
+  // Scaled from the model's values each time, so that no rounding accumulates over steps.
+  for (std::size_t e = 0; e < model_.elements.size(); ++e) {
+    model_.elements[e].vlambda = effects.young_scale * base_lame_[e][0];
+    model_.elements[e].vmu = effects.young_scale * base_lame_[e][1];
+  }
+  young_scale_ = effects.young_scale;
 }
 
 void ReferenceSimulation::set_ligament_stiffness(const std::vector<double>& stiffness) {

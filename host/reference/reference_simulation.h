@@ -11,6 +11,7 @@
 #include <Eigen/Core>
 #include <vector>
 
+#include "host/model/effects.h"
 #include "host/model/model.h"
 #include "host/reference/conjugate_gradient.h"
 #include "host/reference/corotational.h"
@@ -31,6 +32,10 @@ class ReferenceSimulation {
   const std::vector<double>& ligament_stiffness() const { return ligament_stiffness_; }
 
   void set_linear_solver(LinearSolver solver) { solver_ = solver; }
+
+  // Physics effects on top of the model given at construction (diagnose estimates them per
+  // sigma point); PhysicsEffects{} restores the model.
+  void set_physics_effects(const PhysicsEffects& effects);
 
   // Advances one time step with the SO at `so_position` (the SO at the end of the step).
   // Throws std::runtime_error if the state becomes non-finite.
@@ -55,6 +60,9 @@ class ReferenceSimulation {
   Eigen::VectorXd x_, v_;
   Eigen::VectorXd dv_;                 // last velocity change: the CG warm start
   std::vector<Frame> frames_;
+  Eigen::Vector3d base_gravity_;
+  std::vector<Eigen::Vector2d> base_lame_;   // per element: vlambda, vmu of the model
+  double young_scale_ = 1.0;
 };
 
 }  // namespace sigmafem

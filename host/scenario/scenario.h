@@ -11,6 +11,7 @@
 #include <vector>
 
 #include "host/mesh/mesh.h"
+#include "host/scenario/effect_catalogue.h"
 
 namespace sigmafem {
 
@@ -131,6 +132,9 @@ struct Scenario {
   Observations observations;
   std::optional<FilterSpec> filter;
   OutputSpec output;
+  // Effects declared part of the model (docs/FORMATS.md `effects`; host/model/effects.h):
+  // generate simulates them, estimate and diagnose model them, with these fixed values.
+  std::vector<EffectValue> effects;
 
   // Index of the ligament called `name`, or -1.
   int ligament_index(const std::string& name) const;

@@ -720,6 +720,30 @@ void read_filter(const Checker& c, const json& root, Scenario& s) {
   s.filter = std::move(spec);
 }
 
+void read_effects(const Checker& c, const json& root, Scenario& s) {
+  if (!root.contains("effects")) return;
+  const json& effects = c.array(root.at("effects"), "effects");
+  for (size_t i = 0; i < effects.size(); ++i) {
+    const std::string path = element("effects", i);
+    c.check_object(effects[i], path, {"name", "value"}, {"name", "value"});
+    EffectValue effect;
+    effect.name = c.string(effects[i].at("name"), child(path, "name"));
+    const EffectDefinition* definition = find_effect(effect.name);
+    c.require(definition != nullptr, child(path, "name"),
+              "unknown effect " + in_quotes(effect.name) + "; known: " + effect_names());
+    const json& value = effects[i].at("value");
+    if (value.is_array()) {
+      for (size_t k = 0; k < value.size(); ++k)
+        effect.value.push_back(c.number(value[k], element(child(path, "value"), k)));
+    } else {
+      effect.value.push_back(c.number(value, child(path, "value")));
+    }
+    const std::string problem = effect_value_problem(*definition, effect.value);
+    c.require(problem.empty(), child(path, "value"), effect.name + " " + problem);
+    s.effects.push_back(std::move(effect));
+  }
+}
+
 void read_output(const Checker& c, const json& root, Scenario& s) {
   if (!root.contains("output")) return;
   const json& output = root.at("output");
@@ -749,7 +773,8 @@ Scenario load_scenario(const std::string& path) {
             "this program reads " + in_quotes(kFormat) + ", found " + in_quotes(s.format));
   c.check_object(root, "",
                  {"format", "name", "description", "mesh", "material", "damping", "gravity", "time",
-                  "solver", "ligaments", "control", "events", "observations", "filter", "output"},
+                  "solver", "ligaments", "control", "events", "observations", "filter", "output",
+                  "effects"},
                  {"format", "mesh", "material", "time", "control"});
 
   s.name =
@@ -765,6 +790,7 @@ Scenario load_scenario(const std::string& path) {
   read_observations(c, root, s);
   read_filter(c, root, s);
   read_output(c, root, s);
+  read_effects(c, root, s);
   return s;
 }
 

@@ -1,0 +1,98 @@
+// `sigmafem diagnose SCENARIO --data DIR --out DIR [--candidates a,b] [--max-rounds N]`:
+// estimate with the declared model, and while the residual is inconsistent, find the
+// candidate effect the data lack, add it and estimate again (host/diagnosis/diagnosis.h).
+#include <filesystem>
+#include <fstream>
+#include <iostream>
+#include <memory>
+#include <sstream>
+
+#include "host/cli/backend_options.h"
+#include "host/cli/commands.h"
+#include "host/cli/diagnosis_report.h"
+#include "host/common/input_error.h"
+#include "host/diagnosis/diagnosis.h"
+#include "host/scenario/scenario.h"
+
+namespace sigmafem::cli {
+namespace fs = std::filesystem;
+
+Action add_diagnose_command(CLI::App& app) {
+  struct Options {
+    std::string scenario, data_dir, out_dir;
+    std::string candidates;
+    int max_rounds = 3;
+    double burn_in = 0.2;
+    BackendChoice backend;
+    bool quiet = false;
+  };
+  auto options = std::make_shared<Options>();
+  CLI::App* sub = app.add_subcommand(
+      "diagnose", "Estimate with the declared model; while the residual is inconsistent, score every candidate "
+                  "effect (" + effect_names(true) + ") by its likelihood gain, add the best and estimate again. "
+                  "Writes report.md, report.json, residual_before.png, residual_after.png and, when explained, "
+                  "scenario.json with the effect declared");
+  sub->add_option("scenario", options->scenario, "Scenario JSON file (with a filter block)")->required();
+  sub->add_option("--data", options->data_dir, "Folder with observations.csv (truth.csv, truth.json optional)")
+      ->required();
+  sub->add_option("--out", options->out_dir, "Output folder (created if missing)")->required();
+  sub->add_option("--candidates", options->candidates,
+                  "Comma-separated candidate effects to try (default: all: " + effect_names(true) + ")");
+  sub->add_option("--max-rounds", options->max_rounds, "Effects added at most")
+      ->check(CLI::Range(1, 10))
+      ->capture_default_str();
+  sub->add_option("--burn-in", options->burn_in,
+                  "Share of the steps the residual tests leave out at the start while the filter settles")
+      ->check(CLI::Range(0.0, 0.9))
+      ->capture_default_str();
+  add_backend_options(sub, options->backend);
+  sub->add_flag("--quiet", options->quiet, "No progress lines and no summary");
+  return [options]() {
+    const Scenario scenario = load_scenario(options->scenario);
+    if (!scenario.filter)
+      throw InputError("scenario " + scenario.path + ": filter: missing; diagnose needs a filter block");
+    const fs::path data(options->data_dir);
+    const ObservationTable table = read_observations_csv(
+        (data / "observations.csv").string(), static_cast<int>(scenario.observations.nodes.size()), scenario.time.dt);
+    if (table.row_count() < 2)
+      throw InputError("observations " + (data / "observations.csv").string() +
+                       ": needs at least two rows (the rest state and one step)");
+    std::optional<TruthTable> truth;
+    if (fs::exists(data / "truth.csv")) truth = read_truth_csv((data / "truth.csv").string());
+    DiagnosisReport report;
+    report.data_dir = options->data_dir;
+    report.out_dir = options->out_dir;
+    report.backend = options->backend.backend;
+    if (fs::exists(data / "truth.json")) {
+      std::ifstream in(data / "truth.json");
+      try {
+        const nlohmann::ordered_json t = nlohmann::ordered_json::parse(in);
+        report.truth_effects = {{"declared", t.value("declared_effects", nlohmann::ordered_json::array())},
+                                {"injected", t.value("injected_effects", nlohmann::ordered_json::array())}};
+      } catch (const std::exception& e) {
+        throw InputError((data / "truth.json").string() + ": invalid JSON: " + e.what());
+      }
+    }
+    DiagnoseOptions diagnose_options;
+    diagnose_options.backend = options->backend.backend;
+    diagnose_options.device = options->backend.device_options();
+    diagnose_options.max_rounds = options->max_rounds;
+    diagnose_options.burn_in_fraction = options->burn_in;
+    std::stringstream names(options->candidates);
+    for (std::string name; std::getline(names, name, ',');)
+      if (!name.empty()) diagnose_options.candidates.push_back(name);
+    diagnose_options.log = options->quiet ? nullptr : &std::cerr;
+    if (!options->quiet) std::cerr << "diagnose " << scenario.name << ":\n";
+    const Diagnosis diagnosis = diagnose(scenario, table, truth, diagnose_options);
+    const nlohmann::ordered_json j = write_diagnosis_report(scenario, diagnosis, diagnose_options, report);
+    if (!options->quiet) {
+      std::cout << "outcome: " << j["outcome"].get<std::string>() << "\n" << j["conclusion"].get<std::string>() << "\n"
+                << "  " << (fs::path(options->out_dir) / "report.md").string() << "\n  "
+                << (fs::path(options->out_dir) / "report.json").string() << '\n';
+      if (j["files"].contains("scenario")) std::cout << "  " << j["files"]["scenario"].get<std::string>() << '\n';
+    }
+    return 0;
+  };
+}
+
+}  // namespace sigmafem::cli

@@ -1,0 +1,245 @@
+#include "host/cli/diagnosis_report.h"
+
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+
+#include "host/cli/plot.h"
+#include "host/cli/residual_report.h"
+#include "host/common/atomic_file.h"
+#include "host/common/input_error.h"
+
+namespace sigmafem::cli {
+namespace fs = std::filesystem;
+using json = nlohmann::ordered_json;
+
+namespace {
+
+json number(double x) { return std::isfinite(x) ? json(x) : json(nullptr); }
+json optional_number(const std::optional<double>& x) { return x ? number(*x) : json(nullptr); }
+
+std::string model_name(const ModelFit& fit) {
+  std::string name = "declared";
+  for (const std::string& e : fit.effects) name += " + " + e;
+  return name;
+}
+
+json estimate_json(const EffectEstimate& e) {
+  return {{"name", e.name}, {"parameters", e.parameters}, {"units", e.units}, {"value", e.value}, {"std", e.std}};
+}
+
+// The failed tests of a fit, each with its one-line detail.
+json failed_details(const ModelFit& fit) {
+  json failed = json::array();
+  for (const DiagnosticTest& test : fit.residual.verdict.tests)
+    if (!test.passed) failed.push_back({{"name", test.name}, {"detail", test.detail}});
+  return failed;
+}
+
+json fit_json(const ModelFit& fit) {
+  json stiffness = json::object();
+  for (std::size_t j = 0; j < fit.ligaments.size(); ++j) {
+    const auto jj = static_cast<Eigen::Index>(j);
+    stiffness[fit.ligaments[j]] = {{"stiffness_n_per_m", number(fit.stiffness.size() > jj ? fit.stiffness[jj] : NAN)},
+                                   {"std_n_per_m", number(fit.stiffness_std.size() > jj ? fit.stiffness_std[jj] : NAN)}};
+  }
+  json estimates = json::array();
+  for (const EffectEstimate& e : fit.estimates) estimates.push_back(estimate_json(e));
+  return {{"model", model_name(fit)},
+          {"refined", fit.refined},
+          {"effects", estimates},
+          {"complete", fit.run.complete},
+          {"stop_reason", fit.run.stop_reason},
+          {"verdict", to_string(fit.residual.verdict.consistency)},
+          {"failed_tests", failed_details(fit)},
+          {"log_likelihood", number(fit.log_likelihood)},
+          {"innovation_rms_mm", number(1e3 * fit.innovation_rms)},
+          {"stiffness", stiffness},
+          {"stiffness_error_n_per_m", optional_number(fit.stiffness_error)},
+          {"stiffness_relative_error", optional_number(fit.stiffness_relative_error)}};
+}
+
+std::string fixed(double x, int digits) {
+  if (!std::isfinite(x)) return "n/a";
+  std::ostringstream out;
+  out.setf(std::ios::fixed);
+  out.precision(digits);
+  out << x;
+  return out.str();
+}
+
+std::string general(double x) {
+  std::ostringstream out;
+  out.precision(4);
+  out << x;
+  return out.str();
+}
+
+std::string estimate_text(const EffectEstimate& e) {
+  std::ostringstream out;
+  out << "`" << e.name << "` = (";
+  for (std::size_t j = 0; j < e.value.size(); ++j) out << (j ? ", " : "") << general(e.value[j]);
+  out << ") +- (";
+  for (std::size_t j = 0; j < e.std.size(); ++j) out << (j ? ", " : "") << general(e.std[j]);
+  out << ")";
+  if (!e.units.empty() && !e.units[0].empty()) out << " " << e.units[0];
+  return out.str();
+}
+
+// The scenario with `effects` declared, paths made absolute so that it works from anywhere.
+std::string scenario_with_effects(const Scenario& scenario, const std::vector<EffectValue>& discovered) {
+  std::ifstream in(scenario.path);
+  json root = json::parse(in);
+  const fs::path folder = fs::absolute(fs::path(scenario.path)).parent_path();
+  root["mesh"]["file"] = (folder / root["mesh"]["file"].get<std::string>()).lexically_normal().string();
+  if (root["control"]["trajectory"].contains("file"))
+    root["control"]["trajectory"]["file"] =
+        (folder / root["control"]["trajectory"]["file"].get<std::string>()).lexically_normal().string();
+  json effects = root.contains("effects") ? root["effects"] : json::array();
+  for (const EffectValue& effect : discovered)
+    effects.push_back({{"name", effect.name},
+                       {"value", effect.value.size() == 1 ? json(effect.value[0]) : json(effect.value)}});
+  root["effects"] = effects;
+  root["description"] = "Discovered by sigmafem diagnose from " + scenario.path + ": " +
+                        root.value("description", std::string());
+  return root.dump(2) + "\n";
+}
+
+}  // namespace
+
+json write_diagnosis_report(const Scenario& scenario, const Diagnosis& d, const DiagnoseOptions& options,
+                            const DiagnosisReport& report) {
+  const fs::path out(report.out_dir);
+  std::error_code error;
+  fs::create_directories(out, error);
+  if (error) throw InputError(report.out_dir + ": cannot create output folder: " + error.message());
+
+  json j;
+  j["scenario"] = scenario.path;
+  j["data"] = report.data_dir;
+  j["backend"] = report.backend;
+  j["outcome"] = to_string(d.outcome);
+  j["conclusion"] = d.conclusion;
+  j["penalty"] = "BIC: 0.5 k log N, k the candidate's parameters, N the observed scalars";
+  j["candidate_library"] = effect_names(true);
+  json discovered = json::array();
+  for (const EffectValue& e : d.discovered) discovered.push_back({{"name", e.name}, {"value", e.value}});
+  j["discovered_effects"] = discovered;
+  j["claimed_estimates"] = json::array();
+  if (d.outcome == DiagnosisOutcome::explained)
+    for (const EffectEstimate& e : d.after().estimates) j["claimed_estimates"].push_back(estimate_json(e));
+  j["truth_effects"] = report.truth_effects;
+  j["before"] = fit_json(d.before());
+  j["after"] = fit_json(d.after());
+  json rounds = json::array();
+  for (std::size_t r = 0; r < d.rounds.size(); ++r) {
+    const DiagnosisRound& round = d.rounds[r];
+    json candidates = json::array();
+    for (const CandidateScore& c : round.candidates) {
+      candidates.push_back({{"effect", c.effect},
+                            {"parameters", c.parameters},
+                            {"log_likelihood", number(c.log_likelihood)},
+                            {"gain", number(c.gain)},
+                            {"penalty", number(c.penalty)},
+                            {"score", number(c.score)},
+                            {"complete", c.complete},
+                            {"stop_reason", c.stop_reason},
+                            {"verdict_with_it", to_string(c.verdict)},
+                            {"failed_tests_with_it", failed_details(d.fits[static_cast<std::size_t>(c.fit)])},
+                            {"estimate", estimate_json(c.estimate)}});
+    }
+    const ModelFit& fit = d.fits[static_cast<std::size_t>(round.fit)];
+    rounds.push_back({{"round", r + 1},
+                      {"model", model_name(fit)},
+                      {"verdict", to_string(round.verdict)},
+                      {"failed_tests", fit.residual.verdict.failed()},
+                      {"log_likelihood", number(fit.log_likelihood)},
+                      {"innovation_rms_mm", number(1e3 * fit.innovation_rms)},
+                      {"candidates", candidates},
+                      {"chosen", round.chosen.empty() ? json(nullptr) : json(round.chosen)}});
+  }
+  j["rounds"] = rounds;
+
+  // Plots of the residual before and after.
+  json files;
+  files["report_md"] = (out / "report.md").string();
+  if (gnuplot_available()) {
+    try {
+      plot_residuals(d.before().residual, d.before().series, scenario.name + ", declared model",
+                     (out / "residual_before.png").string());
+      plot_residuals(d.after().residual, d.after().series, scenario.name + ", " + model_name(d.after()),
+                     (out / "residual_after.png").string());
+      files["residual_before"] = (out / "residual_before.png").string();
+      files["residual_after"] = (out / "residual_after.png").string();
+    } catch (const std::exception& e) {
+      files["plots_skipped"] = e.what();
+    }
+  } else {
+    files["plots_skipped"] = "gnuplot with PNG output is not installed";
+  }
+  if (d.outcome == DiagnosisOutcome::explained) {
+    write_file_atomically((out / "scenario.json").string(), scenario_with_effects(scenario, d.discovered));
+    files["scenario"] = (out / "scenario.json").string();
+  }
+  j["files"] = files;
+
+  std::ostringstream md;
+  md << "# sigmafem diagnose: " << scenario.name << "\n\n"
+     << "Scenario `" << scenario.path << "`, data `" << report.data_dir << "`, back end " << report.backend
+     << ".\n\n**Outcome: " << to_string(d.outcome) << ".** " << d.conclusion << "\n\n";
+  if (!report.truth_effects.is_null()) md << "Effects in the data (truth.json): `" << report.truth_effects.dump() << "`\n\n";
+  md << "## Before and after\n\n| | before (" << model_name(d.before()) << ") | after (" << model_name(d.after())
+     << ") |\n|---|---|---|\n"
+     << "| residual verdict | " << to_string(d.before().residual.verdict.consistency) << " | "
+     << to_string(d.after().residual.verdict.consistency) << " |\n"
+     << "| innovation RMS (mm) | " << fixed(1e3 * d.before().innovation_rms, 4) << " | "
+     << fixed(1e3 * d.after().innovation_rms, 4) << " |\n"
+     << "| log-likelihood | " << fixed(d.before().log_likelihood, 1) << " | " << fixed(d.after().log_likelihood, 1) << " |\n";
+  if (d.before().stiffness_error && d.after().stiffness_error)
+    md << "| stiffness error, mean over ligaments and the last 20% of steps (N/m) | "
+       << fixed(*d.before().stiffness_error, 2) << " | " << fixed(*d.after().stiffness_error, 2) << " |\n"
+       << "| relative stiffness error | " << fixed(100.0 * *d.before().stiffness_relative_error, 1) << "% | "
+       << fixed(100.0 * *d.after().stiffness_relative_error, 1) << "% |\n";
+  for (std::size_t l = 0; l < d.before().ligaments.size(); ++l) {
+    const auto ll = static_cast<Eigen::Index>(l);
+    md << "| " << d.before().ligaments[l] << " (N/m) | " << fixed(d.before().stiffness[ll], 1) << " +- "
+       << fixed(d.before().stiffness_std[ll], 1) << " | " << fixed(d.after().stiffness[ll], 1) << " +- "
+       << fixed(d.after().stiffness_std[ll], 1) << " |\n";
+  }
+  for (const EffectEstimate& e : d.after().estimates) md << "| effect | | " << estimate_text(e) << " |\n";
+  md << "\n";
+  if (files.contains("residual_before"))
+    md << "![residual before](residual_before.png)\n\n![residual after](residual_after.png)\n\n";
+  md << "## Rounds\n\nScore = log-likelihood gain of the innovations with the candidate's parameters "
+        "estimated, minus the BIC penalty 0.5 k log N.\n\n";
+  for (std::size_t r = 0; r < d.rounds.size(); ++r) {
+    const DiagnosisRound& round = d.rounds[r];
+    const ModelFit& fit = d.fits[static_cast<std::size_t>(round.fit)];
+    md << "### Round " << r + 1 << ": " << model_name(fit) << "\n\nResidual " << to_string(round.verdict);
+    const std::vector<std::string> failed = fit.residual.verdict.failed();
+    if (!failed.empty()) {
+      md << " (failed:";
+      for (const std::string& name : failed) md << ' ' << name;
+      md << ')';
+    }
+    md << ", innovation RMS " << fixed(1e3 * fit.innovation_rms, 4) << " mm.\n\n";
+    if (round.candidates.empty()) continue;
+    md << "| candidate | k | gain | penalty | score | residual with it | estimate |\n|---|---|---|---|---|---|---|\n";
+    for (const CandidateScore& c : round.candidates)
+      md << "| " << c.effect << " | " << c.parameters << " | " << fixed(c.gain, 1) << " | " << fixed(c.penalty, 1)
+         << " | " << fixed(c.score, 1) << (c.complete ? "" : " (diverged)") << " | " << to_string(c.verdict)
+         << " | " << estimate_text(c.estimate) << " |\n";
+    md << "\nChosen: " << (round.chosen.empty() ? std::string("none (no positive score)") : "`" + round.chosen + "`")
+       << "\n\n";
+  }
+  if (files.contains("scenario"))
+    md << "The scenario with the discovered effects declared: `scenario.json` (run `sigmafem estimate "
+       << (out / "scenario.json").string() << " --data " << report.data_dir << " --out DIR`).\n";
+  write_file_atomically((out / "report.md").string(), md.str());
+  write_file_atomically((out / "report.json").string(), j.dump(2) + "\n");
+  (void)options;
+  return j;
+}
+
+}  // namespace sigmafem::cli

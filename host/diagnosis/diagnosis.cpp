@@ -1,0 +1,309 @@
+#include "host/diagnosis/diagnosis.h"
+
+#include <algorithm>
+#include <cmath>
+#include <sstream>
+
+#include "host/common/input_error.h"
+#include "host/ensemble/effect_ensemble.h"
+#include "host/ensemble/make_ensemble.h"
+#include "host/model/effects.h"
+#include "host/model/model.h"
+#include "host/scenario/estimation_options.h"
+
+namespace sigmafem {
+namespace {
+
+constexpr double kLog2Pi = 1.8378770664093453;
+
+std::string format(double x, int precision = 3) {
+  std::ostringstream out;
+  out.precision(precision);
+  out << x;
+  return out.str();
+}
+
+std::string describe_estimate(const EffectEstimate& e) {
+  std::ostringstream out;
+  out << e.name << " = ";
+  for (std::size_t j = 0; j < e.value.size(); ++j)
+    out << (j ? ", " : "") << format(e.value[j]) << " +- " << format(e.std[j], 2);
+  if (!e.units.empty() && !e.units[0].empty()) out << ' ' << e.units[0];
+  return out.str();
+}
+
+}  // namespace
+
+const char* to_string(DiagnosisOutcome outcome) {
+  switch (outcome) {
+    case DiagnosisOutcome::consistent: return "consistent";
+    case DiagnosisOutcome::explained: return "explained";
+    case DiagnosisOutcome::unexplained: return "unexplained";
+  }
+  return "?";
+}
+
+ModelFit fit_model(const Scenario& scenario, const ObservationTable& data,
+                   const std::optional<TruthTable>& truth, const std::vector<std::string>& effects,
+                   const DiagnoseOptions& options, const Eigen::VectorXd& start,
+                   const Eigen::VectorXd& start_std) {
+  if (!scenario.filter)
+    throw InputError("scenario " + scenario.path + ": filter: missing; diagnose needs a filter block");
+  const FilterSpec& spec = *scenario.filter;
+  ModelFit fit;
+  fit.effects = effects;
+  for (int l : spec.estimate) fit.ligaments.push_back(scenario.ligaments[static_cast<std::size_t>(l)].name);
+
+  // The prior: the scenario's for the stiffnesses; N(0, 1) in the coordinates of every
+  // effect parameter (EffectEnsemble), without drift: an effect is a constant.
+  EstimationOptions estimation = estimation_options(scenario);
+  const int p0 = static_cast<int>(spec.estimate.size());
+  int p = p0;
+  for (const std::string& name : effects) {
+    const EffectDefinition* definition = find_effect(name);
+    if (!definition || !definition->candidate)
+      throw InputError("--candidates " + name + ": not in the candidate library (" + effect_names(true) + ")");
+    p += static_cast<int>(definition->parameters.size());
+  }
+  RoukfOptions& roukf = estimation.roukf;
+  roukf.initial_theta.conservativeResize(p);
+  roukf.initial_theta.tail(p - p0).setZero();
+  roukf.initial_std = Eigen::VectorXd::Ones(p);
+  roukf.initial_std.head(p0).setConstant(spec.initial_log_std);
+  roukf.drift_std = Eigen::VectorXd::Zero(p);
+  roukf.drift_std.head(p0).setConstant(spec.parameter_drift_log_std);
+  if (start.size() == p && start_std.size() == p) {
+    roukf.initial_std = start_std.cwiseMin(roukf.initial_std);
+    roukf.initial_theta = start;
+    fit.refined = true;
+  }
+  estimation.stiffness_count = p0;
+  fit.parameter_count = p;
+
+  const int sigma_count = sigma_point_count(roukf.sigma_points, p);
+  EffectEnsemble ensemble(make_ensemble(options.backend, make_model(scenario), spec.estimate,
+                                        scenario.observations.nodes, sigma_count, options.device),
+                          effects);
+  // A camera offset the scenario declares: the positions are the data minus the offset.
+  Eigen::MatrixXd points = data.points;
+  const Eigen::Vector3d offset = camera_offset(scenario.effects);
+  for (Eigen::Index c = 0; c + 2 < points.cols(); c += 3) points.middleCols(c, 3).rowwise() -= offset.transpose();
+
+  fit.run = run_estimation(ensemble, estimation, data.times, data.so, points, {});
+  fit.series = innovation_series(fit.run);
+  ResidualDiagnosticsOptions residual = options.residual;
+  if (residual.burn_in_steps < 0)
+    residual.burn_in_steps = static_cast<int>(options.burn_in_fraction * static_cast<double>(data.row_count() - 1));
+  fit.residual = diagnose_residuals(fit.series, mean_observed_positions(points), residual);
+  if (!fit.run.complete) {
+    // A filter that diverged did not explain the data, however few steps it made.
+    DiagnosticTest diverged;
+    diverged.name = "filter_completed";
+    diverged.passed = false;
+    diverged.statistic = static_cast<double>(fit.run.steps.size());
+    diverged.accept_low = static_cast<double>(data.row_count() - 1);
+    diverged.accept_high = NAN;
+    diverged.p_value = NAN;
+    diverged.detail = "the filter stopped: " + fit.run.stop_reason;
+    fit.residual.verdict.tests.push_back(diverged);
+    fit.residual.verdict.consistency = Consistency::inconsistent;
+  }
+  for (const EstimationStep& step : fit.run.steps) {
+    const double ll = step.observed_rows == 0 ? 0.0
+                                              : -0.5 * (step.normalised_innovation + step.log_det_innovation_covariance +
+                                                        step.observed_rows * kLog2Pi);
+    fit.step_log_likelihood.push_back(ll);
+    fit.log_likelihood += ll;
+    fit.observed_scalars += step.observed_rows;
+  }
+  double sum = 0.0;
+  long long count = 0;
+  for (int k : fit.residual.used)
+    for (Eigen::Index i = 0; i < fit.series.innovation.cols(); ++i) {
+      const double z = fit.series.innovation(k, i);
+      if (!std::isnan(z)) sum += z * z, ++count;
+    }
+  fit.innovation_rms = count > 0 ? std::sqrt(sum / static_cast<double>(count)) : NAN;
+  if (fit.run.steps.empty()) return fit;
+
+  const EstimationStep& last = fit.run.steps.back();
+  fit.stiffness = last.stiffness.head(p0);
+  fit.stiffness_std = last.stiffness_std.head(p0);
+  fit.theta = last.theta;
+  fit.theta_std = last.log_std;
+  int row = p0;
+  for (const std::string& name : effects) {
+    const EffectDefinition& definition = *find_effect(name);
+    const int k = static_cast<int>(definition.parameters.size());
+    EffectEstimate estimate;
+    estimate.name = name;
+    for (const EffectParameter& parameter : definition.parameters) {
+      estimate.parameters.push_back(parameter.name);
+      estimate.units.push_back(parameter.unit);
+    }
+    EffectEnsemble::effect_estimate(definition, last.theta.segment(row, k), last.log_std.segment(row, k),
+                                    estimate.value, estimate.std);
+    fit.estimates.push_back(estimate);
+    row += k;
+  }
+  if (truth) {
+    const std::size_t n = fit.run.steps.size();
+    const std::size_t first = n - std::max<std::size_t>(1, n / 5);
+    double absolute = 0.0, relative = 0.0;
+    int terms = 0;
+    bool ok = true;
+    for (std::size_t k = first; k < n && ok; ++k) {
+      const EstimationStep& step = fit.run.steps[k];
+      for (int j = 0; j < p0; ++j) {
+        const int column = truth->column(fit.ligaments[static_cast<std::size_t>(j)]);
+        if (column < 0 || step.step >= truth->stiffness.rows()) {
+          ok = false;
+          break;
+        }
+        const double t = truth->stiffness(step.step, column);
+        absolute += std::abs(step.stiffness[j] - t);
+        relative += std::abs(step.stiffness[j] - t) / std::max(t, 1e-12);
+        ++terms;
+      }
+    }
+    if (ok && terms > 0) {
+      fit.stiffness_error = absolute / terms;
+      fit.stiffness_relative_error = relative / terms;
+    }
+  }
+  return fit;
+}
+
+Diagnosis diagnose(const Scenario& scenario, const ObservationTable& data,
+                   const std::optional<TruthTable>& truth, const DiagnoseOptions& options) {
+  std::vector<std::string> library = options.candidates;
+  if (library.empty())
+    for (const EffectDefinition& definition : effect_catalogue())
+      if (definition.candidate) library.push_back(definition.name);
+  for (const std::string& name : library) {
+    const EffectDefinition* definition = find_effect(name);
+    if (!definition || !definition->candidate)
+      throw InputError("--candidates " + name + ": not in the candidate library (" + effect_names(true) + ")");
+  }
+  auto log_fit = [&](const ModelFit& fit) {
+    if (!options.log) return;
+    std::string name = "declared model";
+    for (const std::string& e : fit.effects) name += " + " + e;
+    *options.log << "  " << name << ": log-likelihood " << format(fit.log_likelihood, 8) << ", residual "
+                 << to_string(fit.residual.verdict.consistency) << ", innovation RMS "
+                 << format(1e3 * fit.innovation_rms) << " mm"
+                 << (fit.run.complete ? "" : " (stopped: " + fit.run.stop_reason + ")") << '\n';
+  };
+
+  Diagnosis d;
+  d.fits.push_back(fit_model(scenario, data, truth, {}, options));
+  log_fit(d.fits[0]);
+  d.path.push_back(0);
+  std::vector<std::string> current;
+  for (int round = 0;; ++round) {
+    // Copies: d.fits grows below, which moves its elements.
+    const ModelFit& fit = d.fits[static_cast<std::size_t>(d.path.back())];
+    DiagnosisRound r;
+    r.fit = d.path.back();
+    r.verdict = fit.residual.verdict.consistency;
+    if (r.verdict != Consistency::inconsistent || round >= options.max_rounds) {
+      d.rounds.push_back(r);
+      break;
+    }
+    const std::vector<double> base_ll = fit.step_log_likelihood;
+    const bool base_complete = fit.run.complete;
+    const double log_n = std::log(static_cast<double>(std::max<long long>(fit.observed_scalars, 2)));
+    for (const std::string& name : library) {
+      if (std::find(current.begin(), current.end(), name) != current.end()) continue;
+      std::vector<std::string> effects = current;
+      effects.push_back(name);
+      d.fits.push_back(fit_model(scenario, data, truth, effects, options));
+      const ModelFit& candidate = d.fits.back();
+      log_fit(candidate);
+      CandidateScore score;
+      score.effect = name;
+      score.parameters = static_cast<int>(find_effect(name)->parameters.size());
+      score.log_likelihood = candidate.log_likelihood;
+      const std::size_t common = std::min(base_ll.size(), candidate.step_log_likelihood.size());
+      for (std::size_t k = 0; k < common; ++k) score.gain += candidate.step_log_likelihood[k] - base_ll[k];
+      score.penalty = 0.5 * score.parameters * log_n;
+      score.score = score.gain - score.penalty;
+      // A candidate with which the filter diverges explains nothing; one that runs where the
+      // round's model diverged is eligible on its gain over the steps both made.
+      score.complete = candidate.run.complete || (!base_complete && candidate.run.steps.size() > base_ll.size());
+      score.stop_reason = candidate.run.stop_reason;
+      score.verdict = candidate.residual.verdict.consistency;
+      if (!candidate.estimates.empty()) score.estimate = candidate.estimates.back();
+      score.fit = static_cast<int>(d.fits.size()) - 1;
+      r.candidates.push_back(score);
+    }
+    std::sort(r.candidates.begin(), r.candidates.end(), [](const CandidateScore& a, const CandidateScore& b) {
+      if (a.complete != b.complete) return a.complete;
+      return a.score > b.score;
+    });
+    const bool found = !r.candidates.empty() && r.candidates[0].complete && r.candidates[0].score > 0.0;
+    if (found) {
+      r.chosen = r.candidates[0].effect;
+      current.push_back(r.chosen);
+      const ModelFit& first = d.fits[static_cast<std::size_t>(r.candidates[0].fit)];
+      const Eigen::VectorXd start = first.theta;
+      const Eigen::VectorXd start_std = (10.0 * first.theta_std).cwiseMax(0.05);
+      d.fits.push_back(fit_model(scenario, data, truth, current, options, start, start_std));
+      if (options.log) *options.log << "  refined:";
+      log_fit(d.fits.back());
+      d.path.push_back(static_cast<int>(d.fits.size()) - 1);
+    }
+    d.rounds.push_back(r);
+    if (!found) break;
+  }
+
+  const ModelFit& after = d.after();
+  std::ostringstream text;
+  if (d.path.size() == 1 && after.residual.verdict.consistency == Consistency::consistent) {
+    d.outcome = DiagnosisOutcome::consistent;
+    text << "The declared model explains the data: the residual is consistent, nothing was added.";
+  } else if (after.residual.verdict.consistency == Consistency::consistent) {
+    d.outcome = DiagnosisOutcome::explained;
+    text << "The declared model left an inconsistent residual; adding ";
+    for (std::size_t j = 0; j < after.estimates.size(); ++j) {
+      const EffectEstimate& e = after.estimates[j];
+      text << (j ? ", then " : "") << describe_estimate(e);
+      EffectValue value{e.name, e.value};
+      d.discovered.push_back(value);
+    }
+    text << " makes it consistent.";
+    // Another candidate that also made the residual consistent is an alternative the data
+    // cannot rule out (e.g. a scale of Young's modulus and a gravity along the known one,
+    // when that gravity is the only known force): say so rather than hide it.
+    for (const DiagnosisRound& r : d.rounds)
+      for (const CandidateScore& c : r.candidates)
+        if (!r.chosen.empty() && c.effect != r.chosen && c.complete && c.verdict == Consistency::consistent)
+          text << " Also consistent instead of " << r.chosen << ": " << describe_estimate(c.estimate)
+               << " (score " << format(c.score, 6) << "): the data may not tell the two apart.";
+  } else if (after.residual.verdict.consistency == Consistency::too_few_steps) {
+    d.outcome = DiagnosisOutcome::unexplained;
+    text << "Too few filter steps to judge the residual: nothing was tested or added.";
+  } else {
+    d.outcome = DiagnosisOutcome::unexplained;
+    text << "The residual stays unexplained: ";
+    if (d.path.size() == 1) {
+      text << "no candidate effect (" << (library.empty() ? "none" : "") ;
+      for (std::size_t j = 0; j < library.size(); ++j) text << (j ? ", " : "") << library[j];
+      text << ") raised the likelihood by more than its penalty.";
+    } else {
+      text << "the effects tried (";
+      for (std::size_t j = 0; j < after.estimates.size(); ++j)
+        text << (j ? ", " : "") << describe_estimate(after.estimates[j]);
+      text << ") raise the likelihood but leave the residual inconsistent, so none is claimed; "
+              "the data hold an effect outside the library (or more than one).";
+    }
+    text << " Failed tests: ";
+    const std::vector<std::string> failed = after.residual.verdict.failed();
+    for (std::size_t j = 0; j < failed.size(); ++j) text << (j ? ", " : "") << failed[j];
+    text << '.';
+  }
+  d.conclusion = text.str();
+  return d;
+}
+
+}  // namespace sigmafem

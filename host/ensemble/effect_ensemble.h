@@ -1,0 +1,59 @@
+// EffectEnsemble: an Ensemble whose parameters are the inner ensemble's log-stiffnesses
+// followed by the parameters of candidate effects (host/scenario/effect_catalogue.h), so that
+// the ROUKF estimates the effects as extra sigma-point dimensions with no change to the filter.
+//
+// Rows of theta: [inner parameters (p0); effect coordinates], the coordinate of an effect
+// parameter being (u - prior_mean) / prior_std with u = log(value) or value (its transform):
+// prior N(0, 1) for every effect coordinate.
+//   physics effects (gravity, young_scale): per sigma point through
+//     CpuEnsemble::set_physics_effects; another back end is refused with an InputError
+//     (its kernels take only stiffnesses for now);
+//   observation effects (camera_offset): added to the inner ensemble's predicted
+//     observations, per sigma point, on any back end.
+#pragma once
+
+#include <Eigen/Core>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "filter/ensemble.h"
+#include "host/scenario/effect_catalogue.h"
+
+namespace sigmafem {
+
+class CpuEnsemble;
+
+class EffectEnsemble : public Ensemble {
+ public:
+  // `effects`: names of candidate effects, each at most once. Throws InputError for an
+  // unknown name, one that is not a candidate, or a physics effect on a non-CPU back end.
+  EffectEnsemble(std::unique_ptr<Ensemble> inner, const std::vector<std::string>& effects);
+
+  int sigma_count() const override { return inner_->sigma_count(); }
+  int parameter_count() const override { return inner_->parameter_count() + effect_parameter_count_; }
+  int observation_count() const override { return inner_->observation_count(); }
+  void set_parameters(const Eigen::MatrixXd& theta) override;
+  StepReport advance(const Eigen::Vector3d& so_position) override;
+  void predicted_observations(Eigen::MatrixXd& y) const override;
+  void recenter(const Recentering& recentering) override;
+
+  const std::vector<const EffectDefinition*>& effects() const { return effects_; }
+
+  // The value of `definition` (natural units) at its coordinates `coordinates`.
+  static std::vector<double> effect_value(const EffectDefinition& definition,
+                                          const Eigen::VectorXd& coordinates);
+  // The value and its first-order standard deviation from the coordinates' mean and std.
+  static void effect_estimate(const EffectDefinition& definition, const Eigen::VectorXd& coordinates,
+                              const Eigen::VectorXd& coordinate_std, std::vector<double>& value,
+                              std::vector<double>& value_std);
+
+ private:
+  std::unique_ptr<Ensemble> inner_;
+  CpuEnsemble* cpu_ = nullptr;                     // inner_ as the CPU back end, if it is
+  std::vector<const EffectDefinition*> effects_;
+  int effect_parameter_count_ = 0;
+  Eigen::MatrixXd camera_offsets_;                 // 3 x S
+};
+
+}  // namespace sigmafem
