@@ -54,8 +54,8 @@ echo "== tests (sanitizers)"
 # comparison) ran above; the one-step, re-centring and iteration-cap tests with 1 and 4
 # sigma points run here and cover the same host code. The residual diagnostics' two 100-step
 # box runs (ResidualDiagnosticsBox) ran above too; their synthetic tests run here. So did the
-# whole diagnoses (DiagnoseBox, 4 to 8 filter runs each). The same goes for the Vulkan-against-OpenCL comparison (two 200-step runs on the device back ends,
-# no host code of its own).
+# whole diagnoses (DiagnoseBox, 4 to 8 filter runs each) and the Vulkan-against-OpenCL
+# comparison (two 200-step runs on the device back ends, no host code of its own).
 # Vulkan on lavapipe runs under the sanitizers as it is: Mesa is not instrumented, and the
 # Vulkan device holds one instance for the process so that the loader does not unload Mesa
 # under its one-time allocations (host/vulkan/vulkan_device.cpp), which LeakSanitizer would
