@@ -14,6 +14,9 @@ import subprocess
 import sys
 import tempfile
 
+# The meshes the benchmark runs on, as its capture names end.
+MESHES = ["liver_4768", "liver_596", "liver_fine_38144", "box_large_117240"]
+
 
 def main():
     if len(sys.argv) != 3:
@@ -24,8 +27,9 @@ def main():
         name = r["name"]
         if not name.startswith("BM_ensemble_step/") or "error_occurred" in r:
             continue
-        capture = name.split("/")[1]               # e.g. opencl_liver_4768
-        backend = capture.split("_")[0]
+        capture = name.split("/")[1]               # e.g. opencl_per_iteration_liver_4768
+        mesh = next(m for m in MESHES if capture.endswith("_" + m))
+        backend = capture[: -len(mesh) - 1]          # e.g. opencl_per_iteration
         rate = r["element_iterations_per_s"]
         if capture.endswith("liver_4768"):
             series.setdefault(("sigma", backend), []).append((r["S"], rate))
