@@ -3,15 +3,17 @@
  * same stopping rule |r| <= tolerance |b|).
  *
  * cg_start, then cg_iteration after every product q = A d (element_product, node_product:
- * three launches per iteration; on a CPU cg_iteration does node_product's part itself: two). A sigma point that has converged (or hit the
- * iteration cap, or broke down) is inactive and left alone, so the host may enqueue several
- * iterations between checks without changing anyone's result. Two forms of these kernels:
+ * three launches per iteration; on a CPU cg_iteration does node_product's part itself: two).
+ * A sigma point that has converged (or hit the iteration cap, or broke down) is inactive and
+ * left alone, so the host may enqueue several iterations between checks without changing
+ * anyone's result. Two forms of these kernels:
  *  - a GPU (SF_CG_PER_GROUP = 1): one work-group per sigma point owns its rows and reduces
  *    its dot products in the group (a fixed tree: the same bits every run);
  *  - a CPU (SF_CG_PER_GROUP = 0): one work-item per block of SF_CG_BLOCK sigma points (S over
  *    the compute units) goes down the rows with the block innermost, on contiguous data:
  *    vectorised, and each cache line read once (one work-item per sigma point read a line per
  *    sigma point, 16 times at S = 16). Dot products are summed in row order.
+ * And on a CPU with a small mesh, the whole solve in one launch (cg_solve, at the end).
  *
  * Per-sigma scalars (arrays of S): bb = b.b, rr = r.r, rz = r.z, active (1 while iterating),
  * converged (1 converged, 0 hit the cap or broke down), iterations (products done). */
