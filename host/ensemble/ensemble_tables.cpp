@@ -8,6 +8,11 @@
 
 namespace sigmafem {
 
+double device_cg_tolerance(const Model& model, Precision precision) {
+  return precision == Precision::single ? std::max(model.solver.cg_tolerance, kSingleCgTolerance)
+                                        : model.solver.cg_tolerance;
+}
+
 void check_ensemble_arguments(const Model& model, const std::vector<int>& estimated,
                               const std::vector<int>& observed, int S, const char* who) {
   const std::string name(who);

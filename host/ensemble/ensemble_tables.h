@@ -13,6 +13,7 @@
 #include <vector>
 
 #include "filter/ensemble.h"
+#include "host/common/device_error.h"
 #include "host/model/model.h"
 
 namespace sigmafem {
@@ -41,6 +42,14 @@ struct EnsembleTables {
 // Checks an ensemble's arguments: std::invalid_argument naming `who`.
 void check_ensemble_arguments(const Model& model, const std::vector<int>& estimated,
                               const std::vector<int>& observed, int sigma_count, const char* who);
+
+// The CG tolerance floor of a float32 device ensemble: about ten float32 epsilons (float32
+// cannot reach the scenario's 1e-10).
+constexpr double kSingleCgTolerance = 1e-6;
+
+// The CG tolerance a device ensemble solves to: the scenario's, raised to kSingleCgTolerance
+// in single precision.
+double device_cg_tolerance(const Model& model, Precision precision);
 
 // The tables for S = sigma_count (after the device-memory check: they are as big as the
 // per-sigma state).

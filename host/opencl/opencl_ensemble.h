@@ -6,7 +6,7 @@
 //
 // Arithmetic is float32 by default. float32 cannot reach the scenario's CG tolerance (1e-10
 // is far below its rounding), so in single precision the tolerance is raised to
-// kSingleTolerance; double precision keeps the scenario's and agrees with the CPU reference
+// kSingleCgTolerance; double precision keeps the scenario's and agrees with the CPU reference
 // to about 1e-10 (tests/opencl/).
 #pragma once
 
@@ -21,8 +21,6 @@ namespace sigmafem {
 
 class OpenClEnsemble : public DeviceEnsemble {
  public:
-  // The CG tolerance floor in single precision: about ten float32 epsilons.
-  static constexpr double kSingleTolerance = 1e-6;
   // Elements x sigma points up to which a CPU device runs the whole CG solve in one launch.
   static constexpr long long kWholeSolveWork = 32768;
 

@@ -440,10 +440,8 @@ void VulkanDevice::release() {
       api_->vkFreeMemory(device_, memory, nullptr);
     }
     buffers_.clear();
-    if (staging_) api_->vkDestroyBuffer(device_, staging_, nullptr);
-    if (staging_memory_) api_->vkFreeMemory(device_, staging_memory_, nullptr);
-    if (read_back_) api_->vkDestroyBuffer(device_, read_back_, nullptr);
-    if (read_back_memory_) api_->vkFreeMemory(device_, read_back_memory_, nullptr);
+    destroy(staging_);
+    destroy(read_back_);
     if (descriptor_pool_) api_->vkDestroyDescriptorPool(device_, descriptor_pool_, nullptr);
     if (fence_) api_->vkDestroyFence(device_, fence_, nullptr);
     if (command_pool_) api_->vkDestroyCommandPool(device_, command_pool_, nullptr);
@@ -520,46 +518,51 @@ VulkanBuffer VulkanDevice::buffer(std::size_t bytes, const char* what) {
   return result;
 }
 
-void VulkanDevice::ensure_staging(std::size_t bytes) {
-  if (bytes <= staging_bytes_) return;
-  if (staging_) api_->vkDestroyBuffer(device_, staging_, nullptr);
-  if (staging_memory_) api_->vkFreeMemory(device_, staging_memory_, nullptr);
-  staging_ = VK_NULL_HANDLE;
-  staging_memory_ = VK_NULL_HANDLE;
-  staging_bytes_ = 0;
+void VulkanDevice::destroy(HostBuffer& host) {
+  if (host.buffer) api_->vkDestroyBuffer(device_, host.buffer, nullptr);
+  if (host.memory) api_->vkFreeMemory(device_, host.memory, nullptr);
+  host = HostBuffer{};
+}
+
+void VulkanDevice::grow(HostBuffer& host, std::size_t bytes, VkBufferUsageFlags usage,
+                        const char* what) {
+  if (bytes <= host.bytes) return;
+  destroy(host);
   VkBufferCreateInfo info{};
   info.sType = VK_STRUCTURE_TYPE_BUFFER_CREATE_INFO;
   info.size = bytes;
-  info.usage = VK_BUFFER_USAGE_TRANSFER_SRC_BIT | VK_BUFFER_USAGE_TRANSFER_DST_BIT;
-  check(api_->vkCreateBuffer(device_, &info, nullptr, &staging_), "creating a staging buffer");
+  info.usage = usage;
+  check(api_->vkCreateBuffer(device_, &info, nullptr, &host.buffer), std::string("creating ") + what);
   VkMemoryRequirements needs;
-  api_->vkGetBufferMemoryRequirements(device_, staging_, &needs);
-  staging_memory_ = allocate(needs, VK_MEMORY_PROPERTY_HOST_VISIBLE_BIT | VK_MEMORY_PROPERTY_HOST_COHERENT_BIT,
-                             VK_MEMORY_PROPERTY_HOST_CACHED_BIT, "a staging buffer");
-  check(api_->vkBindBufferMemory(device_, staging_, staging_memory_, 0), "binding a staging buffer");
-  check(api_->vkMapMemory(device_, staging_memory_, 0, VK_WHOLE_SIZE, 0, &staging_map_),
-        "mapping a staging buffer");
-  staging_bytes_ = bytes;
+  api_->vkGetBufferMemoryRequirements(device_, host.buffer, &needs);
+  host.memory = allocate(needs, VK_MEMORY_PROPERTY_HOST_VISIBLE_BIT | VK_MEMORY_PROPERTY_HOST_COHERENT_BIT,
+                         VK_MEMORY_PROPERTY_HOST_CACHED_BIT, what);
+  check(api_->vkBindBufferMemory(device_, host.buffer, host.memory, 0), std::string("binding ") + what);
+  check(api_->vkMapMemory(device_, host.memory, 0, VK_WHOLE_SIZE, 0, &host.map),
+        std::string("mapping ") + what);
+  host.bytes = bytes;
 }
 
 void VulkanDevice::upload(const VulkanBuffer& buffer, const void* data, std::size_t bytes) {
   if (bytes == 0) return;
-  ensure_staging(bytes);
-  std::memcpy(staging_map_, data, bytes);
+  grow(staging_, bytes, VK_BUFFER_USAGE_TRANSFER_SRC_BIT | VK_BUFFER_USAGE_TRANSFER_DST_BIT,
+       "a staging buffer");
+  std::memcpy(staging_.map, data, bytes);
   VkCommandBuffer cmd = begin();
   VkBufferCopy region{0, 0, bytes};
-  api_->vkCmdCopyBuffer(cmd, staging_, buffer.buffer, 1, &region);
+  api_->vkCmdCopyBuffer(cmd, staging_.buffer, buffer.buffer, 1, &region);
   barrier(cmd);
   submit_and_wait(cmd);
 }
 
 void VulkanDevice::download(const VulkanBuffer& buffer, void* data, std::size_t bytes) {
   if (bytes == 0) return;
-  ensure_staging(bytes);
+  grow(staging_, bytes, VK_BUFFER_USAGE_TRANSFER_SRC_BIT | VK_BUFFER_USAGE_TRANSFER_DST_BIT,
+       "a staging buffer");
   VkCommandBuffer cmd = begin();
   barrier(cmd);
   VkBufferCopy region{0, 0, bytes};
-  api_->vkCmdCopyBuffer(cmd, buffer.buffer, staging_, 1, &region);
+  api_->vkCmdCopyBuffer(cmd, buffer.buffer, staging_.buffer, 1, &region);
   VkMemoryBarrier host{};
   host.sType = VK_STRUCTURE_TYPE_MEMORY_BARRIER;
   host.srcAccessMask = VK_ACCESS_TRANSFER_WRITE_BIT;
@@ -567,7 +570,7 @@ void VulkanDevice::download(const VulkanBuffer& buffer, void* data, std::size_t 
   api_->vkCmdPipelineBarrier(cmd, VK_PIPELINE_STAGE_TRANSFER_BIT, VK_PIPELINE_STAGE_HOST_BIT, 0, 1,
                              &host, 0, nullptr, 0, nullptr);
   submit_and_wait(cmd);
-  std::memcpy(data, staging_map_, bytes);
+  std::memcpy(data, staging_.map, bytes);
 }
 
 VulkanKernel VulkanDevice::kernel(const char* name, int bindings, std::uint32_t group_size) {
@@ -715,36 +718,16 @@ void VulkanDevice::update(VkCommandBuffer cmd, const VulkanBuffer& buffer, const
 }
 
 void VulkanDevice::reserve_read_back(std::size_t bytes) {
-  if (bytes <= read_back_bytes_) return;
-  if (read_back_) api_->vkDestroyBuffer(device_, read_back_, nullptr);
-  if (read_back_memory_) api_->vkFreeMemory(device_, read_back_memory_, nullptr);
-  read_back_ = VK_NULL_HANDLE;
-  read_back_memory_ = VK_NULL_HANDLE;
-  read_back_bytes_ = 0;
-  VkBufferCreateInfo info{};
-  info.sType = VK_STRUCTURE_TYPE_BUFFER_CREATE_INFO;
-  info.size = bytes;
-  info.usage = VK_BUFFER_USAGE_TRANSFER_DST_BIT;
-  check(api_->vkCreateBuffer(device_, &info, nullptr, &read_back_), "creating the read-back buffer");
-  VkMemoryRequirements needs;
-  api_->vkGetBufferMemoryRequirements(device_, read_back_, &needs);
-  read_back_memory_ = allocate(needs,
-                               VK_MEMORY_PROPERTY_HOST_VISIBLE_BIT | VK_MEMORY_PROPERTY_HOST_COHERENT_BIT,
-                               VK_MEMORY_PROPERTY_HOST_CACHED_BIT, "the read-back buffer");
-  check(api_->vkBindBufferMemory(device_, read_back_, read_back_memory_, 0),
-        "binding the read-back buffer");
-  check(api_->vkMapMemory(device_, read_back_memory_, 0, VK_WHOLE_SIZE, 0, &read_back_map_),
-        "mapping the read-back buffer");
-  read_back_bytes_ = bytes;
+  grow(read_back_, bytes, VK_BUFFER_USAGE_TRANSFER_DST_BIT, "the read-back buffer");
 }
 
 void VulkanDevice::copy_to_host(VkCommandBuffer cmd, const VulkanBuffer& buffer, std::size_t bytes,
                                 std::size_t offset) {
-  if (offset + bytes > read_back_bytes_)
+  if (offset + bytes > read_back_.bytes)
     throw std::logic_error("VulkanDevice::copy_to_host: read-back area too small");
   barrier(cmd);
   VkBufferCopy region{0, offset, bytes};
-  api_->vkCmdCopyBuffer(cmd, buffer.buffer, read_back_, 1, &region);
+  api_->vkCmdCopyBuffer(cmd, buffer.buffer, read_back_.buffer, 1, &region);
   VkMemoryBarrier host{};
   host.sType = VK_STRUCTURE_TYPE_MEMORY_BARRIER;
   host.srcAccessMask = VK_ACCESS_TRANSFER_WRITE_BIT;
@@ -753,7 +736,7 @@ void VulkanDevice::copy_to_host(VkCommandBuffer cmd, const VulkanBuffer& buffer,
                              &host, 0, nullptr, 0, nullptr);
 }
 
-const void* VulkanDevice::read_back() const { return read_back_map_; }
+const void* VulkanDevice::read_back() const { return read_back_.map; }
 
 void VulkanDevice::submit_and_wait(VkCommandBuffer cmd) {
   check(api_->vkEndCommandBuffer(cmd), "recording a command buffer");

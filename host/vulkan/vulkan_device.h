@@ -113,7 +113,6 @@ class VulkanDevice {
                             VkMemoryPropertyFlags preferred) const;
   VkDeviceMemory allocate(VkMemoryRequirements needs, VkMemoryPropertyFlags wanted,
                           VkMemoryPropertyFlags preferred, const char* what);
-  void ensure_staging(std::size_t bytes);
   void check(VkResult result, const std::string& what) const;
 
   std::shared_ptr<VulkanApi> api_;
@@ -133,15 +132,19 @@ class VulkanDevice {
   VkDescriptorPool descriptor_pool_ = VK_NULL_HANDLE;
   std::vector<std::pair<VkBuffer, VkDeviceMemory>> buffers_;   // all buffers made here
   std::vector<VulkanKernel> kernels_;                          // all pipelines made here
-  // Host-visible buffers: staging for upload/download, and the read-back area.
-  VkBuffer staging_ = VK_NULL_HANDLE;
-  VkDeviceMemory staging_memory_ = VK_NULL_HANDLE;
-  void* staging_map_ = nullptr;
-  std::size_t staging_bytes_ = 0;
-  VkBuffer read_back_ = VK_NULL_HANDLE;
-  VkDeviceMemory read_back_memory_ = VK_NULL_HANDLE;
-  void* read_back_map_ = nullptr;
-  std::size_t read_back_bytes_ = 0;
+  // Host-visible buffers, mapped for their lifetime: staging for upload/download, and the
+  // read-back area.
+  struct HostBuffer {
+    VkBuffer buffer = VK_NULL_HANDLE;
+    VkDeviceMemory memory = VK_NULL_HANDLE;
+    void* map = nullptr;
+    std::size_t bytes = 0;
+  };
+  // Makes `host` at least `bytes` long (a new buffer if it is shorter; its contents go).
+  void grow(HostBuffer& host, std::size_t bytes, VkBufferUsageFlags usage, const char* what);
+  void destroy(HostBuffer& host);
+  HostBuffer staging_;
+  HostBuffer read_back_;
 };
 
 // The name of a VkResult ("VK_ERROR_OUT_OF_DEVICE_MEMORY"), for messages.

@@ -31,9 +31,7 @@ VulkanEnsemble::VulkanEnsemble(const Model& model, std::vector<int> estimated,
       nodes_(model.node_count()),
       elements_(model.element_count()) {
   check_ensemble_arguments(model, estimated_, observed_, S_, "VulkanEnsemble");
-  tolerance_ = options.precision == Precision::single
-                   ? std::max(model.solver.cg_tolerance, kSingleTolerance)
-                   : model.solver.cg_tolerance;
+  tolerance_ = device_cg_tolerance(model, options.precision);
 
   // Check the memory before asking for it, to say how much is needed.
   const std::size_t dof = 3 * static_cast<std::size_t>(nodes_) * S_;

@@ -11,7 +11,7 @@
 // two host waits per step; predicted_observations() then reads what the step gathered.
 //
 // Arithmetic and tolerances as OpenClEnsemble: float32 by default, the CG tolerance raised
-// to kSingleTolerance; --precision double needs shaderFloat64.
+// to kSingleCgTolerance; --precision double needs shaderFloat64.
 #pragma once
 
 #include <Eigen/Core>
@@ -25,8 +25,6 @@ namespace sigmafem {
 
 class VulkanEnsemble : public DeviceEnsemble {
  public:
-  // The CG tolerance floor in single precision (as OpenClEnsemble::kSingleTolerance).
-  static constexpr double kSingleTolerance = 1e-6;
 
   // `estimated`: indices into model.ligaments whose log-stiffness the parameters are;
   // `observed`: node indices. Throws DeviceError (no device, shader failure, too little memory).

@@ -9,7 +9,8 @@
 // to 1e-10 m. In single precision (float32, unit roundoff 6e-8) the positions of an organ
 // some 0.3 m from the origin are held to about 2e-8 m and each element's edge vectors to
 // a relative 1e-6 (1 cm edges), and the solve stops at a relative residual of 1e-6
-// (OpenClEnsemble::kSingleTolerance); each tolerance below is stated next to its check.
+// (kSingleCgTolerance, host/ensemble/ensemble_tables.h); each tolerance below is stated next
+// to its check.
 #include <gtest/gtest.h>
 
 #include <cmath>
