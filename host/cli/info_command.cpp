@@ -36,6 +36,12 @@ Action add_info_command(CLI::App& app) {
       std::cout << "  ligament " << ligament.name << " " << ligament.stiffness << " N/m: ";
       print_nodes(std::cout, ligament.nodes);
     }
+    for (const Ligament& region : s.candidate_regions) {
+      std::cout << "  candidate region " << region.name << " (extra_ligament:" << region.name << "): ";
+      print_nodes(std::cout, region.nodes);
+    }
+    for (const EffectValue& effect : s.effects)
+      std::cout << "  declared effect " << format_effect_assignment(effect) << "\n";
     std::cout << "  control " << s.control.stiffness << " N/m: ";
     print_nodes(std::cout, s.control.nodes);
     for (const Event& event : s.events)

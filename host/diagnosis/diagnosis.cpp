@@ -6,7 +6,6 @@
 
 #include "host/common/input_error.h"
 #include "host/ensemble/effect_ensemble.h"
-#include "host/ensemble/make_ensemble.h"
 #include "host/model/effects.h"
 #include "host/model/model.h"
 #include "host/scenario/estimation_options.h"
@@ -33,6 +32,32 @@ std::string describe_estimate(const EffectEstimate& e) {
 }
 
 }  // namespace
+
+std::vector<std::string> candidate_library(const Scenario& scenario, const std::vector<std::string>& names) {
+  std::vector<std::string> asked = names;
+  if (asked.empty())
+    for (const EffectDefinition& definition : effect_catalogue())
+      if (definition.candidate) asked.push_back(definition.name);
+  std::vector<std::string> library;
+  for (const std::string& name : asked) {
+    const EffectDefinition* definition = find_effect(name);
+    if (!definition && effect_region(name).empty()) {
+      // A family placed at regions, named alone: one candidate per candidate region.
+      for (const EffectDefinition& family : effect_catalogue())
+        if (family.name == name && family.regional && family.candidate) definition = &family;
+      if (definition) {
+        for (const Ligament& region : scenario.candidate_regions) library.push_back(name + ":" + region.name);
+        continue;
+      }
+    }
+    if (!definition || !definition->candidate)
+      throw InputError("--candidates " + name + ": not in the candidate library (" + effect_names(true) + ")");
+    if (definition->regional && !scenario.effect_region_problem(name).empty())
+      throw InputError("--candidates " + name + ": " + scenario.effect_region_problem(name));
+    library.push_back(name);
+  }
+  return library;
+}
 
 const char* to_string(DiagnosisOutcome outcome) {
   switch (outcome) {
@@ -81,15 +106,15 @@ ModelFit fit_model(const Scenario& scenario, const ObservationTable& data,
   fit.parameter_count = p;
 
   const int sigma_count = sigma_point_count(roukf.sigma_points, p);
-  EffectEnsemble ensemble(make_ensemble(options.backend, make_model(scenario), spec.estimate,
-                                        scenario.observations.nodes, sigma_count, options.device),
-                          effects);
+  const std::unique_ptr<EffectEnsemble> ensemble =
+      EffectEnsemble::make(options.backend, make_model(scenario), spec.estimate, scenario.observations.nodes,
+                           sigma_count, options.device, effects);
   // A camera offset the scenario declares: the positions are the data minus the offset.
   Eigen::MatrixXd points = data.points;
   const Eigen::Vector3d offset = camera_offset(scenario.effects);
   for (Eigen::Index c = 0; c + 2 < points.cols(); c += 3) points.middleCols(c, 3).rowwise() -= offset.transpose();
 
-  fit.run = run_estimation(ensemble, estimation, data.times, data.so, points, {});
+  fit.run = run_estimation(*ensemble, estimation, data.times, data.so, points, {});
   fit.series = innovation_series(fit.run);
   ResidualDiagnosticsOptions residual = options.residual;
   if (residual.burn_in_steps < 0)
@@ -176,15 +201,7 @@ ModelFit fit_model(const Scenario& scenario, const ObservationTable& data,
 
 Diagnosis diagnose(const Scenario& scenario, const ObservationTable& data,
                    const std::optional<TruthTable>& truth, const DiagnoseOptions& options) {
-  std::vector<std::string> library = options.candidates;
-  if (library.empty())
-    for (const EffectDefinition& definition : effect_catalogue())
-      if (definition.candidate) library.push_back(definition.name);
-  for (const std::string& name : library) {
-    const EffectDefinition* definition = find_effect(name);
-    if (!definition || !definition->candidate)
-      throw InputError("--candidates " + name + ": not in the candidate library (" + effect_names(true) + ")");
-  }
+  const std::vector<std::string> library = candidate_library(scenario, options.candidates);
   auto log_fit = [&](const ModelFit& fit) {
     if (!options.log) return;
     std::string name = "declared model";

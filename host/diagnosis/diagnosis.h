@@ -133,6 +133,12 @@ ModelFit fit_model(const Scenario& scenario, const ObservationTable& data,
                    const DiagnoseOptions& options, const Eigen::VectorXd& start = {},
                    const Eigen::VectorXd& start_std = {});
 
+// The candidates `names` stand for (empty: every candidate of the library), a regional
+// family (extra_ligament) once per candidate region of the scenario (none when it declares no
+// candidate_regions). Throws InputError for a name outside the library or a region the
+// scenario lacks.
+std::vector<std::string> candidate_library(const Scenario& scenario, const std::vector<std::string>& names);
+
 // The rounds above. Throws InputError for a scenario without a filter block, an unknown
 // candidate, or data that does not fit the scenario.
 Diagnosis diagnose(const Scenario& scenario, const ObservationTable& data,

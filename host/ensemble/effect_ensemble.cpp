@@ -2,9 +2,11 @@
 
 #include <algorithm>
 #include <cmath>
+#include <stdexcept>
 
 #include "host/common/input_error.h"
 #include "host/ensemble/cpu_ensemble.h"
+#include "host/ensemble/make_ensemble.h"
 #include "host/model/effects.h"
 
 namespace sigmafem {
@@ -12,19 +14,36 @@ namespace sigmafem {
 EffectEnsemble::EffectEnsemble(std::unique_ptr<Ensemble> inner, const std::vector<std::string>& effects)
     : inner_(std::move(inner)) {
   cpu_ = dynamic_cast<CpuEnsemble*>(inner_.get());
+  declared_count_ = inner_->parameter_count();
   for (const std::string& name : effects) {
     const EffectDefinition* definition = find_effect(name);
     if (!definition || !definition->candidate)
       throw InputError("effect " + name + ": not in the candidate library (" + effect_names(true) + ")");
-    if (std::find(effects_.begin(), effects_.end(), definition) != effects_.end())
-      throw InputError("effect " + name + ": listed twice");
+    if (std::count(effects.begin(), effects.end(), name) > 1) throw InputError("effect " + name + ": listed twice");
     if (definition->side == EffectSide::physics && !cpu_)
       throw InputError("effect " + name + ": estimating a physics effect needs the cpu back end "
                        "(the device kernels take only stiffnesses for now); run with --backend cpu");
     effects_.push_back(definition);
     effect_parameter_count_ += static_cast<int>(definition->parameters.size());
+    if (definition->side == EffectSide::ligament) --declared_count_;
   }
+  if (declared_count_ < 0)
+    throw std::invalid_argument("EffectEnsemble: the inner ensemble lacks the extra ligaments' parameters");
   camera_offsets_ = Eigen::MatrixXd::Zero(3, sigma_count());
+}
+
+std::unique_ptr<EffectEnsemble> EffectEnsemble::make(const std::string& backend, Model model,
+                                                     std::vector<int> estimated, const std::vector<int>& observed,
+                                                     int sigma_count, const DeviceOptions& options,
+                                                     const std::vector<std::string>& effects) {
+  for (const std::string& name : effects) {
+    const EffectDefinition* definition = find_effect(name);
+    // The stiffness is a placeholder: set_parameters gives every sigma point its own.
+    if (definition && definition->side == EffectSide::ligament)
+      estimated.push_back(add_extra_ligament(model, name, 0.0));
+  }
+  return std::make_unique<EffectEnsemble>(make_ensemble(backend, model, estimated, observed, sigma_count, options),
+                                          effects);
 }
 
 std::vector<double> EffectEnsemble::effect_value(const EffectDefinition& definition,
@@ -52,8 +71,10 @@ void EffectEnsemble::effect_estimate(const EffectDefinition& definition, const E
 }
 
 void EffectEnsemble::set_parameters(const Eigen::MatrixXd& theta) {
-  const int p0 = inner_->parameter_count(), S = sigma_count();
-  inner_->set_parameters(theta.topRows(p0));
+  const int p0 = declared_count_, S = sigma_count();
+  inner_theta_.resize(inner_->parameter_count(), S);
+  inner_theta_.topRows(p0) = theta.topRows(p0);
+  int inner_row = p0;
   std::vector<PhysicsEffects> physics(static_cast<std::size_t>(S));
   camera_offsets_.setZero(3, S);
   int row = p0;
@@ -61,12 +82,19 @@ void EffectEnsemble::set_parameters(const Eigen::MatrixXd& theta) {
     const int k = static_cast<int>(definition->parameters.size());
     for (int s = 0; s < S; ++s) {
       const std::vector<double> v = effect_value(*definition, theta.block(row, s, k, 1));
-      if (definition->name == "gravity") physics[s].gravity = Eigen::Vector3d(v[0], v[1], v[2]);
-      else if (definition->name == "young_scale") physics[s].young_scale = v[0];
-      else if (definition->name == "camera_offset") camera_offsets_.col(s) = Eigen::Vector3d(v[0], v[1], v[2]);
+      const std::string& name = definition->name;
+      if (name == "gravity") physics[s].gravity = Eigen::Vector3d(v[0], v[1], v[2]);
+      else if (name == "young_scale") physics[s].young_scale = v[0];
+      else if (name == "damping_scale") physics[s].damping_mass_scale = v[0], physics[s].damping_stiffness_scale = v[1];
+      else if (name == "ligament_law") physics[s].ligament_d0 = v[0];
+      else if (name == "time_lag") physics[s].time_lag = v[0];
+      else if (name == "extra_ligament") inner_theta_(inner_row, s) = std::log(v[0]);
+      else if (name == "camera_offset") camera_offsets_.col(s) = Eigen::Vector3d(v[0], v[1], v[2]);
     }
+    if (definition->side == EffectSide::ligament) ++inner_row;
     row += k;
   }
+  inner_->set_parameters(inner_theta_);
   if (cpu_) cpu_->set_physics_effects(physics);
 }
 

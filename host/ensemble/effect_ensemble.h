@@ -2,12 +2,15 @@
 // followed by the parameters of candidate effects (host/scenario/effect_catalogue.h), so that
 // the ROUKF estimates the effects as extra sigma-point dimensions with no change to the filter.
 //
-// Rows of theta: [inner parameters (p0); effect coordinates], the coordinate of an effect
-// parameter being (u - prior_mean) / prior_std with u = log(value) or value (its transform):
-// prior N(0, 1) for every effect coordinate.
-//   physics effects (gravity, young_scale): per sigma point through
-//     CpuEnsemble::set_physics_effects; another back end is refused with an InputError
-//     (its kernels take only stiffnesses for now);
+// Rows of theta: [the declared estimated ligaments' log-stiffnesses (p0); effect
+// coordinates], the coordinate of an effect parameter being (u - prior_mean) / prior_std with
+// u = log(value) or value (its transform): prior N(0, 1) for every effect coordinate.
+//   physics effects (gravity, young_scale, ligament_law, time_lag, damping_scale): per sigma
+//     point through CpuEnsemble::set_physics_effects; another back end is refused with an
+//     InputError (its kernels take only stiffnesses for now);
+//   ligament effects (extra_ligament:REGION): one more estimated ligament of the inner
+//     ensemble (make() appends it to the model), its log-stiffness mapped from the
+//     coordinate: any back end;
 //   observation effects (camera_offset): added to the inner ensemble's predicted
 //     observations, per sigma point, on any back end.
 #pragma once
@@ -18,6 +21,8 @@
 #include <vector>
 
 #include "filter/ensemble.h"
+#include "host/common/device_error.h"
+#include "host/model/model.h"
 #include "host/scenario/effect_catalogue.h"
 
 namespace sigmafem {
@@ -26,12 +31,20 @@ class CpuEnsemble;
 
 class EffectEnsemble : public Ensemble {
  public:
-  // `effects`: names of candidate effects, each at most once. Throws InputError for an
-  // unknown name, one that is not a candidate, or a physics effect on a non-CPU back end.
+  // `effects`: names of candidate effects, each at most once. `inner` estimates the declared
+  // ligaments, then one ligament per ligament effect, in the order of `effects`. Throws
+  // InputError for an unknown name, one that is not a candidate, or a physics effect on a
+  // non-CPU back end.
   EffectEnsemble(std::unique_ptr<Ensemble> inner, const std::vector<std::string>& effects);
 
+  // The ensemble of `model` on `backend` (make_ensemble) with `effects` estimated: the
+  // ligament of every ligament effect is appended to the model and to `estimated` first.
+  static std::unique_ptr<EffectEnsemble> make(const std::string& backend, Model model, std::vector<int> estimated,
+                                              const std::vector<int>& observed, int sigma_count,
+                                              const DeviceOptions& options, const std::vector<std::string>& effects);
+
   int sigma_count() const override { return inner_->sigma_count(); }
-  int parameter_count() const override { return inner_->parameter_count() + effect_parameter_count_; }
+  int parameter_count() const override { return declared_count_ + effect_parameter_count_; }
   int observation_count() const override { return inner_->observation_count(); }
   void set_parameters(const Eigen::MatrixXd& theta) override;
   StepReport advance(const Eigen::Vector3d& so_position) override;
@@ -52,7 +65,9 @@ class EffectEnsemble : public Ensemble {
   std::unique_ptr<Ensemble> inner_;
   CpuEnsemble* cpu_ = nullptr;                     // inner_ as the CPU back end, if it is
   std::vector<const EffectDefinition*> effects_;
+  int declared_count_ = 0;                         // p0: the declared estimated ligaments
   int effect_parameter_count_ = 0;
+  Eigen::MatrixXd inner_theta_;                    // the inner ensemble's parameters
   Eigen::MatrixXd camera_offsets_;                 // 3 x S
 };
 

@@ -71,7 +71,7 @@ GenerateResult generate(const Scenario& scenario, const GenerateOptions& options
     truth.steps.push_back(k);
     truth.times.push_back(t);
     for (std::size_t l = 0; l < scenario.ligaments.size(); ++l)
-      truth.stiffness(k, static_cast<Eigen::Index>(l)) = simulation.ligament_stiffness()[l];
+      truth.stiffness(k, static_cast<Eigen::Index>(l)) = simulation.ligament_stiffness()[l];   // declared ones
     for (int i = 0; i < model.node_count(); ++i)
       result.max_displacement =
           std::max(result.max_displacement,
@@ -81,13 +81,20 @@ GenerateResult generate(const Scenario& scenario, const GenerateOptions& options
   std::unique_ptr<VtkSeries> vtk;
   if (vtk_every > 0) vtk = std::make_unique<VtkSeries>(model, observed, options.out_dir, scenario.name);
 
-  simulation.set_ligament_stiffness(scenario.ligament_stiffness_at(0.0));
+  // The scenario's ligaments (events applied), then any extra ligament of an effect at the
+  // model's stiffness.
+  auto stiffness_at = [&](double t) {
+    std::vector<double> k = scenario.ligament_stiffness_at(t);
+    for (std::size_t l = k.size(); l < model.ligaments.size(); ++l) k.push_back(model.ligaments[l].stiffness);
+    return k;
+  };
+  simulation.set_ligament_stiffness(stiffness_at(0.0));
   record(0);
   if (vtk) vtk->write_frame(0.0, positions);
   Progress progress("generate " + scenario.name + ": step", steps, options.progress);
   for (int k = 1; k <= steps; ++k) {
     const double t = k * dt;
-    simulation.set_ligament_stiffness(scenario.ligament_stiffness_at(t));
+    simulation.set_ligament_stiffness(stiffness_at(t));
     const CgResult cg = simulation.step(scenario.control.trajectory.position(t, scenario.control.start));
     result.cg_iterations += cg.iterations;
     result.max_cg_iterations = std::max(result.max_cg_iterations, cg.iterations);

@@ -2,6 +2,8 @@
 
 #include <stdexcept>
 
+#include "host/common/input_error.h"
+
 namespace sigmafem {
 
 void apply_effects(const std::vector<EffectValue>& effects, Model& model) {
@@ -9,16 +11,26 @@ void apply_effects(const std::vector<EffectValue>& effects, Model& model) {
     const EffectDefinition* definition = find_effect(effect.name);
     if (!definition || !effect_value_problem(*definition, effect.value).empty())
       throw std::invalid_argument("apply_effects: invalid effect " + format_effect_assignment(effect));
-    if (effect.name == "gravity") {
+    const std::string& family = definition->name;
+    if (family == "gravity") {
       model.gravity += Eigen::Vector3d(effect.value[0], effect.value[1], effect.value[2]);
-    } else if (effect.name == "young_scale") {
+    } else if (family == "young_scale") {
       // Linear elasticity: the Lame terms, hence K_e, are proportional to E.
       model.material.young_modulus *= effect.value[0];
       for (ElementRest& element : model.elements) {
         element.vlambda *= effect.value[0];
         element.vmu *= effect.value[0];
       }
-    } else if (effect.name == "inclusion") {
+    } else if (family == "damping_scale") {
+      model.damping.rayleigh_mass *= effect.value[0];
+      model.damping.rayleigh_stiffness *= effect.value[1];
+    } else if (family == "ligament_law") {
+      model.ligament_d0 = effect.value[0];
+    } else if (family == "time_lag") {
+      model.so_lag += effect.value[0];
+    } else if (family == "extra_ligament") {
+      add_extra_ligament(model, effect.name, effect.value[0]);
+    } else if (family == "inclusion") {
       const Eigen::Vector3d centre(effect.value[0], effect.value[1], effect.value[2]);
       for (ElementRest& element : model.elements) {
         Eigen::Vector3d centroid = Eigen::Vector3d::Zero();
@@ -30,6 +42,20 @@ void apply_effects(const std::vector<EffectValue>& effects, Model& model) {
       }
     }
   }
+}
+
+int add_extra_ligament(Model& model, const std::string& effect_name, double stiffness) {
+  const std::string region = effect_region(effect_name);
+  std::string names;
+  for (const SpringSet& candidate : model.candidate_regions) {
+    if (candidate.name == region) {
+      model.ligaments.push_back({effect_name, candidate.nodes, stiffness});
+      return static_cast<int>(model.ligaments.size()) - 1;
+    }
+    names += (names.empty() ? "" : ", ") + candidate.name;
+  }
+  throw InputError("effect " + effect_name + ": no candidate region \"" + region + "\" (candidate_regions: " +
+                   (names.empty() ? "none declared" : names) + ")");
 }
 
 Eigen::Vector3d camera_offset(const std::vector<EffectValue>& effects) {

@@ -7,6 +7,7 @@
 
 #include <Eigen/Core>
 #include <array>
+#include <limits>
 #include <string>
 #include <vector>
 
@@ -41,6 +42,14 @@ struct Model {
   double dt = 0.01;
   SolverSpec solver;
   std::vector<SpringSet> ligaments;     // each node tied to its rest position
+  // The ligament law: f = -k u (1 + |u|^2 / d0^2) per node, u its displacement; infinite d0
+  // (the default): linear. The ligament_law effect (host/model/effects.h) sets it.
+  double ligament_d0 = std::numeric_limits<double>::infinity();
+  // The organ is driven by the SO as it was so_lag seconds earlier (the time_lag effect: the
+  // observations, stamped with the SO's time, show the organ late). 0: no lag.
+  double so_lag = 0.0;
+  // Surface regions where an unmodelled ligament may be (diagnose's extra_ligament:NAME).
+  std::vector<SpringSet> candidate_regions;
   SpringSet control;                    // each node tied to so(t) + rest - so(0)
   Eigen::Vector3d control_start = Eigen::Vector3d::Zero();   // so(0)
 

@@ -1,6 +1,7 @@
 #include "host/reference/reference_simulation.h"
 
 #include <Eigen/SparseCholesky>
+#include <cmath>
 #include <stdexcept>
 #include <string>
 
@@ -17,10 +18,18 @@ ReferenceSimulation::ReferenceSimulation(Model model) : model_(std::move(model))
   v_ = Eigen::VectorXd::Zero(3 * n);
   dv_ = Eigen::VectorXd::Zero(3 * n);
   base_gravity_ = model_.gravity;
+  base_damping_ = model_.damping;
+  base_d0_ = model_.ligament_d0;
+  base_so_lag_ = model_.so_lag;
+  so_history_.push_back(model_.control_start);
 }
 
 void ReferenceSimulation::set_physics_effects(const PhysicsEffects& effects) {
   model_.gravity = base_gravity_ + effects.gravity;
+  model_.damping.rayleigh_mass = effects.damping_mass_scale * base_damping_.rayleigh_mass;
+  model_.damping.rayleigh_stiffness = effects.damping_stiffness_scale * base_damping_.rayleigh_stiffness;
+  model_.ligament_d0 = std::isfinite(effects.ligament_d0) ? effects.ligament_d0 : base_d0_;
+  model_.so_lag = base_so_lag_ + effects.time_lag;
   if (effects.young_scale == young_scale_) return;
   if (base_lame_.empty())
     for (const ElementRest& element : model_.elements) base_lame_.emplace_back(element.vlambda, element.vmu);
@@ -48,11 +57,21 @@ void ReferenceSimulation::set_state(const Eigen::VectorXd& positions,
   v_ = velocities;
 }
 
+namespace {
+// The nonlinear ligament law's factor (1 + |u|^2/d0^2) on k u, and its tangent's along u,
+// (1 + 3 |u|^2/d0^2): the largest eigenvalue, so that the implicit step stays stable. Both
+// 1 for the linear law (infinite d0).
+double law_factor(const Eigen::Vector3d& u, double d0) { return 1.0 + u.squaredNorm() / (d0 * d0); }
+double law_tangent_factor(const Eigen::Vector3d& u, double d0) { return 1.0 + 3.0 * u.squaredNorm() / (d0 * d0); }
+}  // namespace
+
 Eigen::VectorXd ReferenceSimulation::spring_stiffness() const {
   Eigen::VectorXd k = Eigen::VectorXd::Zero(model_.node_count());
   for (std::size_t l = 0; l < model_.ligaments.size(); ++l) {
     const auto& nodes = model_.ligaments[l].nodes;
-    for (int node : nodes) k[node] += ligament_stiffness_[l] / static_cast<double>(nodes.size());
+    for (int node : nodes)
+      k[node] += ligament_stiffness_[l] / static_cast<double>(nodes.size()) *
+                 law_tangent_factor(x_.segment<3>(3 * node) - model_.rest_positions[node], model_.ligament_d0);
   }
   const auto& control = model_.control.nodes;
   for (int node : control) k[node] += model_.control.stiffness / static_cast<double>(control.size());
@@ -67,8 +86,10 @@ Eigen::VectorXd ReferenceSimulation::forces(const Eigen::VectorXd& x,
   for (std::size_t l = 0; l < model_.ligaments.size(); ++l) {
     const auto& nodes = model_.ligaments[l].nodes;
     const double k = ligament_stiffness_[l] / static_cast<double>(nodes.size());
-    for (int node : nodes)
-      f.segment<3>(3 * node) -= k * (x.segment<3>(3 * node) - model_.rest_positions[node]);
+    for (int node : nodes) {
+      const Eigen::Vector3d u = x.segment<3>(3 * node) - model_.rest_positions[node];
+      f.segment<3>(3 * node) -= k * law_factor(u, model_.ligament_d0) * u;
+    }
   }
   const auto& control = model_.control.nodes;
   if (!control.empty()) {
@@ -85,11 +106,21 @@ Eigen::VectorXd ReferenceSimulation::forces(const Eigen::VectorXd& x,
   return f;
 }
 
+Eigen::Vector3d ReferenceSimulation::lagged_so(const Eigen::Vector3d& so_position) {
+  so_history_.push_back(so_position);
+  if (model_.so_lag == 0.0) return so_position;
+  const double at = static_cast<double>(so_history_.size() - 1) - model_.so_lag / model_.dt;
+  if (at <= 0.0) return so_history_.front();
+  const std::size_t i = static_cast<std::size_t>(at);
+  const double a = at - static_cast<double>(i);
+  return i + 1 < so_history_.size() ? ((1.0 - a) * so_history_[i] + a * so_history_[i + 1]).eval() : so_history_[i];
+}
+
 CgResult ReferenceSimulation::step(const Eigen::Vector3d& so_position) {
   element_frames(model_, x_, frames_);
   const Eigen::VectorXd springs = spring_stiffness();
   const ImplicitEulerSystem system(model_, frames_, springs);
-  const Eigen::VectorXd b = system.right_hand_side(forces(x_, frames_, so_position), v_);
+  const Eigen::VectorXd b = system.right_hand_side(forces(x_, frames_, lagged_so(so_position)), v_);
 
   CgResult result;
   if (solver_ == LinearSolver::conjugate_gradient) {

@@ -1,8 +1,9 @@
 // ReferenceSimulation: one organ simulated on the CPU in double precision, step by step.
 // This is the oracle every device back end is tested against (ARCHITECTURE.md). One step:
 //   1. element frames at x_n (rotations),
-//   2. forces f(x_n): elastic, ligament springs to rest, control spring to the SO target at
-//      the END of the step (so(t_{n+1}); sigmafem's convention), gravity,
+//   2. forces f(x_n): elastic, ligament springs to rest (linear, or the law of
+//      Model::ligament_d0), control spring to the SO target at the END of the step
+//      (so(t_{n+1}); sigmafem's convention; so(t_{n+1} - so_lag) with a lag), gravity,
 //   3. solve (M + h B + h^2 K) dv = h (f - B v - h K v) by Jacobi-preconditioned CG
 //      warm-started from the last dv (or by a sparse direct solve, to check CG),
 //   4. v += dv, x += h v.
@@ -46,7 +47,8 @@ class ReferenceSimulation {
   void set_state(const Eigen::VectorXd& positions, const Eigen::VectorXd& velocities);
   Eigen::Vector3d node_position(int node) const { return x_.segment<3>(3 * node); }
 
-  // The spring stiffness on each node (ligaments and control), N/m.
+  // The spring stiffness on each node (ligaments and control), N/m: with a nonlinear
+  // ligament law, its tangent along the displacement at the current positions.
   Eigen::VectorXd spring_stiffness() const;
   // All forces at positions x with the SO at so_position, for the frames of x.
   Eigen::VectorXd forces(const Eigen::VectorXd& x, const std::vector<Frame>& frames,
@@ -60,9 +62,16 @@ class ReferenceSimulation {
   Eigen::VectorXd x_, v_;
   Eigen::VectorXd dv_;                 // last velocity change: the CG warm start
   std::vector<Frame> frames_;
+  // The SO target of the step that ends at step count `steps` + 1, `so_position` given:
+  // so(t - lag) interpolated in the SO positions of the steps made (so(0) before them).
+  Eigen::Vector3d lagged_so(const Eigen::Vector3d& so_position);
+
   Eigen::Vector3d base_gravity_;
   std::vector<Eigen::Vector2d> base_lame_;   // per element: vlambda, vmu of the model
   double young_scale_ = 1.0;
+  Damping base_damping_;
+  double base_d0_ = 0.0, base_so_lag_ = 0.0;
+  std::vector<Eigen::Vector3d> so_history_;  // so at the end of each step made; [0]: so(0)
 };
 
 }  // namespace sigmafem

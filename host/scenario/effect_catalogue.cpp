@@ -1,5 +1,6 @@
 #include "host/scenario/effect_catalogue.h"
 
+#include <algorithm>
 #include <cmath>
 #include <cstdlib>
 #include <sstream>
@@ -14,23 +15,50 @@ const std::vector<EffectDefinition>& effect_catalogue() {
   // up to ~3), narrow enough that the first sigma points stay physical.
   static const std::vector<EffectDefinition> catalogue = {
       {"gravity", "gravity the model lacks (a vector: the patient may lie in any orientation)",
-       EffectSide::physics, true, "gx,gy,gz (m/s^2, added to the scenario's gravity)", 3,
+       EffectSide::physics, true, false, "gx,gy,gz (m/s^2, added to the scenario's gravity)", 3,
        {{"gx", "m/s^2", false, 0.0, 2.0}, {"gy", "m/s^2", false, 0.0, 2.0}, {"gz", "m/s^2", false, 0.0, 2.0}}},
-      {"young_scale", "a global scale of Young's modulus", EffectSide::physics, true,
+      {"young_scale", "a global scale of Young's modulus", EffectSide::physics, true, false,
        "s (> 0, multiplies material.young_modulus)", 1, {{"scale", "", true, 0.0, 0.5}}},
       {"camera_offset", "a rigid translation of the observation frame (camera registration error)",
-       EffectSide::observation, true, "tx,ty,tz (m, added to every observed position)", 3,
+       EffectSide::observation, true, false, "tx,ty,tz (m, added to every observed position)", 3,
        {{"tx", "m", false, 0.0, 5e-3}, {"ty", "m", false, 0.0, 5e-3}, {"tz", "m", false, 0.0, 5e-3}}},
+      // A ligament law that stiffens with stretch, d0 shared by the ligaments; d0 = 1 cm a
+      // priori, within a factor of e (1 std).
+      {"ligament_law", "a nonlinear ligament law: force = k d (1 + (d/d0)^2), d the node's displacement",
+       EffectSide::physics, true, false, "d0 (m, > 0, shared by every ligament)", 1,
+       {{"d0", "m", true, std::log(0.01), 1.0}}},
+      // A ligament the scenario does not declare, at one of its candidate_regions; 100 N/m a
+      // priori, within a factor of e^1.5 (1 std): from barely there to as stiff as the others.
+      {"extra_ligament", "an unmodelled ligament at one of the scenario's candidate_regions",
+       EffectSide::ligament, true, true, "k (N/m, >= 0; named extra_ligament:REGION)", 1,
+       {{"k", "N/m", true, std::log(100.0), 1.5}}},
+      // The tracker's latency: the organ seen at t is the one driven by the SO up to t - tau.
+      // 50 ms a priori, within a factor of e.
+      {"time_lag", "the observations lag the SO positions by tau (the tracker's latency)",
+       EffectSide::physics, true, false, "tau (s, >= 0)", 1, {{"tau", "s", true, std::log(0.05), 1.0}}},
+      // Factors on the two Rayleigh coefficients (a zero coefficient stays zero); 1 a priori,
+      // within a factor of e.
+      {"damping_scale", "a mismatch of the Rayleigh damping: factors on its mass and stiffness coefficients",
+       EffectSide::physics, true, false, "am,ak (> 0, multiply damping.rayleigh_mass and damping.rayleigh_stiffness)", 2,
+       {{"am", "", true, 0.0, 1.0}, {"ak", "", true, 0.0, 1.0}}},
       {"inclusion", "a stiffer (or softer) sphere inside the organ: outside the candidate library",
-       EffectSide::physics, false, "x,y,z,radius,factor (m, m, > 0: multiplies Young's modulus of the elements whose centroid is inside)",
+       EffectSide::physics, false, false, "x,y,z,radius,factor (m, m, > 0: multiplies Young's modulus of the elements whose centroid is inside)",
        5, {}},
   };
   return catalogue;
 }
 
+std::string effect_family(const std::string& name) { return name.substr(0, name.find(':')); }
+
+std::string effect_region(const std::string& name) {
+  const std::size_t colon = name.find(':');
+  return colon == std::string::npos ? "" : name.substr(colon + 1);
+}
+
 const EffectDefinition* find_effect(const std::string& name) {
+  const std::string family = effect_family(name);
   for (const EffectDefinition& definition : effect_catalogue())
-    if (definition.name == name) return &definition;
+    if (definition.name == family && definition.regional == !effect_region(name).empty()) return &definition;
   return nullptr;
 }
 
@@ -48,8 +76,11 @@ std::string effect_value_problem(const EffectDefinition& definition, const std::
            std::to_string(value.size());
   for (double x : value)
     if (!std::isfinite(x)) return "every number must be finite";
-  if (definition.name == "young_scale" && !(value[0] > 0.0))
-    return "the scale must be > 0 (" + definition.value_syntax + ")";
+  if ((definition.name == "young_scale" || definition.name == "ligament_law" || definition.name == "damping_scale") &&
+      !(*std::min_element(value.begin(), value.end()) > 0.0))
+    return "must be > 0 (" + definition.value_syntax + ")";
+  if ((definition.name == "time_lag" || definition.name == "extra_ligament") && !(value[0] >= 0.0))
+    return "must be >= 0 (" + definition.value_syntax + ")";
   if (definition.name == "inclusion" && !(value[3] > 0.0 && value[4] > 0.0))
     return "radius and factor must be > 0 (" + definition.value_syntax + ")";
   return "";
@@ -65,7 +96,8 @@ EffectValue parse_effect_assignment(const std::string& text, const std::string& 
   effect.name = text.substr(0, equals);
   const EffectDefinition* definition = find_effect(effect.name);
   if (!definition)
-    throw InputError(where + "unknown effect \"" + effect.name + "\" (known: " + effect_names() + ")");
+    throw InputError(where + "unknown effect \"" + effect.name + "\" (known: " + effect_names() +
+                     "; extra_ligament is named extra_ligament:REGION)");
   std::stringstream fields(text.substr(equals + 1));
   std::string field;
   while (std::getline(fields, field, ',')) {

@@ -16,9 +16,11 @@
 
 namespace sigmafem {
 
-// Where an effect acts: in the simulated physics (needs the CPU ensemble for per-sigma
-// values) or in the observation operator (any back end).
-enum class EffectSide { physics, observation };
+// Where an effect acts, which decides the back ends that can estimate it per sigma point:
+//   physics      in the simulated physics, set per simulation (the CPU ensemble only);
+//   ligament     an extra spring set, estimated as one more ligament (any back end);
+//   observation  in the observation operator (any back end).
+enum class EffectSide { physics, ligament, observation };
 
 // One estimated parameter. In the filter its coordinate is (u - prior_mean) / prior_std with
 // u = log(value) (log) or value (identity), so that every effect coordinate has prior N(0, 1).
@@ -37,21 +39,29 @@ struct EffectDefinition {
   // In `diagnose`'s candidate library. False for effects that can be injected into data but
   // that the library does not hold (the out-of-library test's stiff inclusion).
   bool candidate = true;
+  bool regional = false;                   // placed at a region: named FAMILY:REGION
   std::string value_syntax;                // e.g. "gx,gy,gz (m/s^2)"
   int value_count = 0;                     // numbers in a value
   // Candidates: the estimated parameters, one per number of the value, same order.
   std::vector<EffectParameter> parameters;
 };
 
-// An effect with its value (natural units), as declared, injected or discovered.
+// An effect with its value (natural units), as declared, injected or discovered. The name is
+// the effect's, or for a family placed at a region, FAMILY:REGION (extra_ligament:left, the
+// region one of the scenario's candidate_regions).
 struct EffectValue {
   std::string name;
   std::vector<double> value;
 };
 
+// The effect part of a name ("extra_ligament" of "extra_ligament:left") and the region part
+// ("left"; "" when there is none).
+std::string effect_family(const std::string& name);
+std::string effect_region(const std::string& name);
+
 // Every effect this build knows, candidates first.
 const std::vector<EffectDefinition>& effect_catalogue();
-// The effect called `name`, or nullptr.
+// The effect called `name` (FAMILY:REGION: the family's), or nullptr.
 const EffectDefinition* find_effect(const std::string& name);
 // "gravity, young_scale, ...": the names, for messages.
 std::string effect_names(bool candidates_only = false);

@@ -18,6 +18,21 @@ int Scenario::ligament_index(const std::string& ligament_name) const {
   return -1;
 }
 
+int Scenario::candidate_region_index(const std::string& region_name) const {
+  for (size_t i = 0; i < candidate_regions.size(); ++i)
+    if (candidate_regions[i].name == region_name) return static_cast<int>(i);
+  return -1;
+}
+
+std::string Scenario::effect_region_problem(const std::string& effect_name) const {
+  const std::string region = effect_region(effect_name);
+  if (candidate_region_index(region) >= 0) return "";
+  std::string names;
+  for (const Ligament& r : candidate_regions) names += (names.empty() ? "" : ", ") + r.name;
+  return "no candidate region \"" + region + "\" in scenario " + name +
+         " (candidate_regions: " + (names.empty() ? "none declared" : names) + ")";
+}
+
 std::vector<double> Scenario::ligament_stiffness_at(double t) const {
   std::vector<double> stiffness;
   stiffness.reserve(ligaments.size());

@@ -127,6 +127,9 @@ struct Scenario {
   TimeSpec time;
   SolverSpec solver;
   std::vector<Ligament> ligaments;
+  // Surface regions where `diagnose` tries an unmodelled ligament (extra_ligament:NAME); the
+  // stiffness field is unused.
+  std::vector<Ligament> candidate_regions;
   Control control;
   std::vector<Event> events;        // sorted by time
   Observations observations;
@@ -138,6 +141,11 @@ struct Scenario {
 
   // Index of the ligament called `name`, or -1.
   int ligament_index(const std::string& name) const;
+  // Index of the candidate region called `name`, or -1.
+  int candidate_region_index(const std::string& name) const;
+  // "" when the region of a regional effect (FAMILY:REGION) is one of candidate_regions,
+  // else what is wrong, naming the regions there are.
+  std::string effect_region_problem(const std::string& effect_name) const;
   // Stiffness of every ligament in effect at time t: events with time <= t + 1e-9 applied,
   // in time order (the slack absorbs rounding when t is computed as step * dt).
   std::vector<double> ligament_stiffness_at(double t) const;

@@ -540,6 +540,25 @@ void read_ligaments(const Checker& c, const json& root, Scenario& s) {
   }
 }
 
+// candidate_regions: [{"name", "nodes" | "select"}], the regions of extra_ligament:NAME.
+void read_candidate_regions(const Checker& c, const json& root, Scenario& s) {
+  if (!root.contains("candidate_regions")) return;
+  const json& regions = c.array(root.at("candidate_regions"), "candidate_regions");
+  for (size_t i = 0; i < regions.size(); ++i) {
+    const std::string path = element("candidate_regions", i);
+    c.check_object(regions[i], path, {"name", "nodes", "select"}, {"name"});
+    Ligament region;
+    region.name = c.string(regions[i].at("name"), child(path, "name"));
+    c.require(valid_name(region.name) && region.name.find(':') == std::string::npos, child(path, "name"),
+              "not a usable name: it must be non-empty, without colons, commas, quotes, control "
+              "characters or edge spaces");
+    for (const Ligament& other : s.candidate_regions)
+      c.require(other.name != region.name, child(path, "name"), "duplicate region name; names must be unique");
+    region.nodes = node_set(c, regions[i], path, s.mesh);
+    s.candidate_regions.push_back(std::move(region));
+  }
+}
+
 Trajectory read_trajectory(const Checker& c, const json& value, const std::string& path,
                            const std::string& scenario_path) {
   c.check_object(value, path, {"type", "velocity", "times", "positions", "file"}, {"type"});
@@ -740,6 +759,7 @@ void read_effects(const Checker& c, const json& root, Scenario& s) {
     }
     const std::string problem = effect_value_problem(*definition, effect.value);
     c.require(problem.empty(), child(path, "value"), effect.name + " " + problem);
+    if (definition->regional) c.require(s.effect_region_problem(effect.name).empty(), child(path, "name"), s.effect_region_problem(effect.name));
     s.effects.push_back(std::move(effect));
   }
 }
@@ -773,8 +793,8 @@ Scenario load_scenario(const std::string& path) {
             "this program reads " + in_quotes(kFormat) + ", found " + in_quotes(s.format));
   c.check_object(root, "",
                  {"format", "name", "description", "mesh", "material", "damping", "gravity", "time",
-                  "solver", "ligaments", "control", "events", "observations", "filter", "output",
-                  "effects"},
+                  "solver", "ligaments", "candidate_regions", "control", "events", "observations",
+                  "filter", "output", "effects"},
                  {"format", "mesh", "material", "time", "control"});
 
   s.name =
@@ -785,6 +805,7 @@ Scenario load_scenario(const std::string& path) {
   read_mesh_section(c, root, path, s);
   read_physics(c, root, s);
   read_ligaments(c, root, s);
+  read_candidate_regions(c, root, s);
   read_control(c, root, path, s);
   read_events(c, root, s);
   read_observations(c, root, s);

@@ -1,0 +1,119 @@
+// EffectEnsemble: candidate effects as extra sigma-point dimensions. An extra ligament is one
+// more estimated ligament of the inner ensemble, on any back end; a camera offset moves the
+// predicted observations; the physics effects the device kernels lack are refused there with
+// a message.
+#include "host/ensemble/effect_ensemble.h"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+
+#include "host/common/input_error.h"
+#include "host/ensemble/cpu_ensemble.h"
+#include "host/ensemble/make_ensemble.h"
+#include "host/model/effects.h"
+#include "host/opencl/opencl_device.h"
+#include "host/scenario/scenario.h"
+
+namespace sigmafem {
+namespace {
+
+class EffectEnsembleTest : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    scenario_ = load_scenario(std::string(SIGMAFEM_SOURCE_DIR) + "/scenarios/box_diagnose.json");
+    model_ = make_model(scenario_);
+    // Rows: the 3 declared ligaments' log-stiffness, extra_ligament:bottom's coordinate, the
+    // camera offset's three; a different value per sigma point.
+    theta_.resize(7, kSigma);
+    for (int s = 0; s < kSigma; ++s) {
+      for (int j = 0; j < 3; ++j)
+        theta_(j, s) = std::log(model_.ligaments[static_cast<std::size_t>(j)].stiffness) + 0.3 * std::sin(s + j);
+      theta_(3, s) = 0.5 * std::cos(s);
+      for (int j = 0; j < 3; ++j) theta_(4 + j, s) = 0.2 * (s - j);
+    }
+  }
+  Eigen::Vector3d so(int step) const {
+    return scenario_.control.trajectory.position(step * scenario_.time.dt, scenario_.control.start);
+  }
+  static constexpr int kSigma = 3;
+  const std::vector<std::string> effects_ = {"extra_ligament:bottom", "camera_offset"};
+  Scenario scenario_;
+  Model model_;
+  Eigen::MatrixXd theta_;
+};
+
+TEST_F(EffectEnsembleTest, AnExtraLigamentIsOneMoreEstimatedLigament) {
+  auto ensemble = EffectEnsemble::make("cpu", model_, scenario_.filter->estimate, scenario_.observations.nodes,
+                                       kSigma, {}, effects_);
+  ASSERT_EQ(ensemble->parameter_count(), 7);
+  ensemble->set_parameters(theta_);
+  // By hand: the model with the ligament appended, its log-stiffness prior_mean + prior_std c.
+  Model model = model_;
+  std::vector<int> estimated = scenario_.filter->estimate;
+  estimated.push_back(add_extra_ligament(model, "extra_ligament:bottom", 0.0));
+  CpuEnsemble by_hand(model, estimated, scenario_.observations.nodes, kSigma);
+  const EffectParameter& k = find_effect("extra_ligament:bottom")->parameters[0];
+  Eigen::MatrixXd inner(4, kSigma);
+  inner.topRows(3) = theta_.topRows(3);
+  inner.row(3) = (k.prior_mean + k.prior_std * theta_.row(3).array()).matrix();
+  by_hand.set_parameters(inner);
+  for (int n = 1; n <= 20; ++n) {
+    ensemble->advance(so(n));
+    by_hand.advance(so(n));
+  }
+  Eigen::MatrixXd y, y_by_hand;
+  ensemble->predicted_observations(y);
+  by_hand.predicted_observations(y_by_hand);
+  for (int s = 0; s < kSigma; ++s)
+    for (Eigen::Index r = 0; r < y.rows(); ++r) {
+      const EffectParameter& t = find_effect("camera_offset")->parameters[static_cast<std::size_t>(r % 3)];
+      const double offset = t.prior_mean + t.prior_std * theta_(4 + r % 3, s);
+      EXPECT_EQ(y(r, s), y_by_hand(r, s) + offset) << "row " << r << " sigma point " << s;
+    }
+}
+
+TEST_F(EffectEnsembleTest, AnExtraLigamentRunsOnOpenClAsOnTheCpu) {
+  const auto devices = list_opencl_devices();
+  if (devices.empty()) GTEST_SKIP() << "no OpenCL platform on this machine";
+  if (!devices[0].has_fp64) GTEST_SKIP() << "OpenCL device 0 has no fp64";
+  DeviceOptions options;
+  options.precision = Precision::double_precision;
+  auto cpu = EffectEnsemble::make("cpu", model_, scenario_.filter->estimate, scenario_.observations.nodes, kSigma,
+                                  {}, effects_);
+  auto opencl = EffectEnsemble::make("opencl", model_, scenario_.filter->estimate, scenario_.observations.nodes,
+                                     kSigma, options, effects_);
+  cpu->set_parameters(theta_);
+  opencl->set_parameters(theta_);
+  Eigen::MatrixXd y_cpu, y_opencl;
+  for (int n = 1; n <= 50; ++n) {
+    cpu->advance(so(n));
+    opencl->advance(so(n));
+  }
+  cpu->predicted_observations(y_cpu);
+  opencl->predicted_observations(y_opencl);
+  // float64 kernels against the float64 reference: the conformance suite's trajectory
+  // tolerance (1e-9 m).
+  EXPECT_LT((y_cpu - y_opencl).lpNorm<Eigen::Infinity>(), 1e-9);
+}
+
+TEST_F(EffectEnsembleTest, DeviceBackEndsRefuseThePhysicsTheirKernelsLack) {
+  if (list_opencl_devices().empty()) GTEST_SKIP() << "no OpenCL platform on this machine";
+  for (const char* effect : {"time_lag", "damping_scale", "gravity"}) {
+    try {
+      EffectEnsemble::make("opencl", model_, scenario_.filter->estimate, scenario_.observations.nodes, kSigma, {},
+                           {effect});
+      ADD_FAILURE() << effect << " was accepted on OpenCL";
+    } catch (const InputError& e) {
+      EXPECT_NE(std::string(e.what()).find("--backend cpu"), std::string::npos) << e.what();
+    }
+  }
+  // A model with a declared ligament law or time lag: the kernels would ignore it.
+  Model model = model_;
+  apply_effects({{"ligament_law", {0.01}}}, model);
+  EXPECT_THROW(make_ensemble("opencl", model, scenario_.filter->estimate, scenario_.observations.nodes, kSigma, {}),
+               InputError);
+}
+
+}  // namespace
+}  // namespace sigmafem
