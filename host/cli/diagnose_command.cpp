@@ -37,7 +37,9 @@ Action add_diagnose_command(CLI::App& app) {
       ->required();
   sub->add_option("--out", options->out_dir, "Output folder (created if missing)")->required();
   sub->add_option("--candidates", options->candidates,
-                  "Comma-separated candidate effects to try (default: all: " + effect_names(true) + ")");
+                  "Comma-separated candidate effects to try (default: all: " + effect_names(true) +
+                      "; extra_ligament alone: one candidate per candidate region of the scenario, "
+                      "extra_ligament:REGION: that region)");
   sub->add_option("--max-rounds", options->max_rounds, "Effects added at most")
       ->check(CLI::Range(1, 10))
       ->capture_default_str();

@@ -2,6 +2,7 @@
 #include <iostream>
 #include <memory>
 
+#include "host/common/input_error.h"
 #include "host/cli/backend_options.h"
 #include "host/cli/commands.h"
 #include "host/cli/report.h"
@@ -36,7 +37,8 @@ Action add_generate_command(CLI::App& app) {
       ->check(CLI::NonNegativeNumber);
   sub->add_option("--inject", options->inject,
                   "Put an effect into the data without declaring it in the scenario, NAME=VALUE "
-                  "(repeatable), e.g. gravity=0,-9.81,0, young_scale=1.5, camera_offset=0.5e-3,0,0; "
+                  "(repeatable), e.g. gravity=0,-9.81,0, young_scale=1.5, camera_offset=0.5e-3,0,0, "
+                  "extra_ligament:REGION=150 (REGION one of the scenario's candidate_regions); "
                   "effects: " + effect_names() + ". Recorded in truth.json")
       ->expected(1)
       ->multi_option_policy(CLI::MultiOptionPolicy::TakeAll);
@@ -44,8 +46,12 @@ Action add_generate_command(CLI::App& app) {
   sub->add_flag("--quiet", options->quiet, "No progress line and no summary");
   return [options]() {
     Scenario scenario = load_scenario(options->scenario);
-    for (const std::string& text : options->inject)
+    for (const std::string& text : options->inject) {
       options->generate.inject.push_back(parse_effect_assignment(text, "--inject"));
+      const std::string& name = options->generate.inject.back().name;
+      if (!effect_region(name).empty() && !scenario.effect_region_problem(name).empty())
+        throw InputError("--inject " + text + ": " + scenario.effect_region_problem(name));
+    }
     options->generate.backend = options->backend.backend;
     options->generate.device = options->backend.device_options();
     if (options->noise_std >= 0.0) scenario.observations.noise_std = options->noise_std;

@@ -138,6 +138,55 @@ TEST_F(CliTest, RejectsMissingScenarioFile) {
   EXPECT_FALSE(fs::exists(dir_ / "out"));
 }
 
+TEST_F(CliTest, RejectsAnExtraLigamentAtARegionTheScenarioLacks) {
+  expect_rejected(
+      [](json& s) {
+        s["candidate_regions"] = {{{"name", "bottom"}, {"select", {{"near", {0.15, 0.075, 0.0}}, {"radius", 0.05}}}}};
+        s["effects"] = {{{"name", "extra_ligament:top"}, {"value", 50.0}}};
+      },
+      "effects[0].name");
+  // The same through --inject: the message names the option and the regions there are.
+  json scenario = box_;
+  scenario["candidate_regions"] = {{{"name", "bottom"}, {"select", {{"near", {0.15, 0.075, 0.0}}, {"radius", 0.05}}}}};
+  std::ofstream(dir_ / "regions.json") << scenario.dump(2);
+  const CommandRun run = run_sigmafem("generate " + (dir_ / "regions.json").string() + " --out " +
+                                      (dir_ / "out").string() + " --inject extra_ligament:top=50 --quiet");
+  EXPECT_EQ(run.exit_code, 2) << run.output;
+  EXPECT_NE(run.output.find("--inject extra_ligament:top=50: no candidate region \"top\""), std::string::npos)
+      << run.output;
+  EXPECT_NE(run.output.find("candidate_regions: bottom"), std::string::npos) << run.output;
+  EXPECT_FALSE(fs::exists(dir_ / "out"));
+}
+
+TEST_F(CliTest, DiagnoseFindsAnInjectedEffectAndWritesItsReport) {
+  // A short run (60 steps of box_diagnose) and two candidates: the command's files, not the
+  // method's accuracy (tests/diagnosis).
+  const fs::path scenarios = fs::path(SIGMAFEM_SOURCE_DIR) / "scenarios";
+  std::ifstream in(scenarios / "box_diagnose.json");
+  json scenario = json::parse(in);
+  scenario["time"]["steps"] = 60;
+  scenario["mesh"]["file"] = (scenarios / "box_coarse.msh").string();
+  std::ofstream(dir_ / "short.json") << scenario.dump(2);
+  const std::string data = (dir_ / "data").string(), out = (dir_ / "diagnose").string();
+  const CommandRun generated = run_sigmafem("generate " + (dir_ / "short.json").string() + " --out " + data +
+                                            " --inject camera_offset=2e-3,0,0 --quiet");
+  ASSERT_EQ(generated.exit_code, 0) << generated.output;
+  const CommandRun run = run_sigmafem("diagnose " + (dir_ / "short.json").string() + " --data " + data +
+                                      " --out " + out + " --candidates camera_offset,time_lag --quiet");
+  ASSERT_EQ(run.exit_code, 0) << run.output;
+  for (const char* file : {"report.md", "report.json", "residual_before.png", "residual_after.png", "scenario.json"})
+    EXPECT_TRUE(fs::exists(fs::path(out) / file)) << file;
+  std::ifstream report_file(fs::path(out) / "report.json");
+  const json report = json::parse(report_file);
+  EXPECT_EQ(report["outcome"], "explained") << report["conclusion"];
+  ASSERT_EQ(report["discovered_effects"].size(), 1u);
+  EXPECT_EQ(report["discovered_effects"][0]["name"], "camera_offset");
+  // The scenario it writes declares the effect and loads.
+  const CommandRun info = run_sigmafem("info " + (fs::path(out) / "scenario.json").string());
+  EXPECT_EQ(info.exit_code, 0) << info.output;
+  EXPECT_NE(info.output.find("declared effect camera_offset=0.00"), std::string::npos) << info.output;
+}
+
 TEST_F(CliTest, RejectsBadOptions) {
   const CommandRun run = run_sigmafem("generate");
   EXPECT_NE(run.exit_code, 0) << run.output;
