@@ -5,7 +5,7 @@
 #include <CLI/CLI.hpp>
 #include <string>
 
-#include "host/common/device_error.h"
+#include "host/common/device_options.h"
 
 namespace sigmafem::cli {
 

@@ -5,7 +5,7 @@
 #include <nlohmann/json.hpp>
 #include <string>
 
-#include "host/common/device_error.h"
+#include "host/common/device_options.h"
 #include "host/scenario/scenario.h"
 
 namespace sigmafem::cli {

@@ -34,7 +34,7 @@
 
 #include "filter/estimation.h"
 #include "filter/residual_diagnostics.h"
-#include "host/common/device_error.h"
+#include "host/common/device_options.h"
 #include "host/data/observation_table.h"
 #include "host/data/truth_table.h"
 #include "host/scenario/effect_catalogue.h"

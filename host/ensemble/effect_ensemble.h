@@ -21,7 +21,7 @@
 #include <vector>
 
 #include "filter/ensemble.h"
-#include "host/common/device_error.h"
+#include "host/common/device_options.h"
 #include "host/model/model.h"
 #include "host/scenario/effect_catalogue.h"
 

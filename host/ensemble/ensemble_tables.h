@@ -13,7 +13,7 @@
 #include <vector>
 
 #include "filter/ensemble.h"
-#include "host/common/device_error.h"
+#include "host/common/device_options.h"
 #include "host/model/model.h"
 
 namespace sigmafem {

@@ -8,6 +8,7 @@
 
 #include "filter/ensemble.h"
 #include "host/common/device_error.h"
+#include "host/common/device_options.h"
 #include "host/model/model.h"
 
 namespace sigmafem {

@@ -17,7 +17,7 @@
 #include <iosfwd>
 #include <string>
 
-#include "host/common/device_error.h"
+#include "host/common/device_options.h"
 #include "host/scenario/effect_catalogue.h"
 #include "host/scenario/scenario.h"
 

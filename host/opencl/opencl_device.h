@@ -15,6 +15,7 @@
 #include <vector>
 
 #include "host/common/device_error.h"
+#include "host/common/device_options.h"
 
 namespace sigmafem {
 

@@ -53,16 +53,20 @@ OpenClEnsemble::OpenClEnsemble(const Model& model, std::vector<int> estimated,
   EnsembleTables tables = make_ensemble_tables(model, S_);
   ligament_k_ = std::move(tables.ligament_k);
 
+  // The CPU form or the GPU form of the kernels (DeviceOptions::kernel_form): the device's
+  // type decides unless a test forces one.
+  const bool cpu_form = options.kernel_form == KernelForm::automatic ? info.type == "cpu"
+                                                                     : options.kernel_form == KernelForm::cpu;
   // Element kernels: on a CPU device one work-item takes an element for all S sigma points,
   // so the compiler vectorises over them; elsewhere one work-item per (element, sigma).
-  sigma_block_ = info.type == "cpu" ? S_ : 1;
+  sigma_block_ = cpu_form ? S_ : 1;
   // On a CPU the element product goes in contiguous chunks of elements, one per compute unit,
   // each adding into its own copy of K d (element_product.cl), instead of element outputs.
-  element_chunks_ = info.type == "cpu" ? static_cast<int>(std::max(1u, info.compute_units)) : 0;
+  element_chunks_ = cpu_form ? static_cast<int>(std::max(1u, info.compute_units)) : 0;
   // The CG kernels (conjugate_gradient.cl): on a GPU a work-group of 64 per sigma point; on
   // a CPU a work-item per block of sigma points, the blocks shared out over the compute
   // units (and dividing S, so that the kernels' loops over a block have a fixed length).
-  cg_per_group_ = info.type != "cpu";
+  cg_per_group_ = !cpu_form;
   // The whole solve in one launch (cg_solve, CPU only) where an iteration's work is small
   // against two launches (several microseconds each on PoCL): up to kWholeSolveWork
   // element-sigma pairs. Measured on PoCL, 2 cores (bench/RESULTS.md): the liver filter step

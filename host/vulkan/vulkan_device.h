@@ -18,6 +18,7 @@
 #include <vector>
 
 #include "host/common/device_error.h"
+#include "host/common/device_options.h"
 
 namespace sigmafem {
 

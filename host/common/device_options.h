@@ -1,0 +1,29 @@
+// DeviceOptions: how a device back end runs (`--device N --precision single|double`, and
+// the choices tests and benchmarks force: the CG launch and the kernels' form).
+#pragma once
+
+namespace sigmafem {
+
+// The arithmetic of a device ensemble: float32 by default; float64 where the device has it.
+enum class Precision { single, double_precision };
+
+// How a device back end runs its CG solve: a few launches per iteration (products over all
+// sigma points at once, on every core), the whole solve in one launch (no launch cost per
+// iteration, one core), or the back end's choice by mesh size and S.
+enum class SolveLaunch { automatic, per_iteration, whole_solve };
+
+// Which device and precision a device back end uses (`--device N --precision single|double`).
+// The form of the OpenCL kernels (host/opencl/opencl_ensemble.cpp): the CPU form (element
+// chunks, blocks of sigma points per work-item), the GPU form (a work-item per element and
+// sigma point, a work-group per sigma point in CG), or the one for the device's type. Forcing
+// the GPU form on PoCL lets the tests run it where there is no GPU.
+enum class KernelForm { automatic, cpu, gpu };
+
+struct DeviceOptions {
+  int device = 0;                   // index in `sigmafem devices`' list for the back end
+  Precision precision = Precision::single;
+  SolveLaunch solve_launch = SolveLaunch::automatic;
+  KernelForm kernel_form = KernelForm::automatic;   // OpenCL only
+};
+
+}  // namespace sigmafem
