@@ -37,7 +37,10 @@ Action add_info_command(CLI::App& app) {
       print_nodes(std::cout, ligament.nodes);
     }
     for (const Ligament& region : s.candidate_regions) {
-      std::cout << "  candidate region " << region.name << " (extra_ligament:" << region.name << "): ";
+      Eigen::Vector3d centre = Eigen::Vector3d::Zero();
+      for (int node : region.nodes) centre += s.mesh.nodes[static_cast<std::size_t>(node)] / region.nodes.size();
+      std::cout << "  candidate region " << region.name << " (extra_ligament:" << region.name << ") around ("
+                << centre.x() << ", " << centre.y() << ", " << centre.z() << ") m: ";
       print_nodes(std::cout, region.nodes);
     }
     for (const EffectValue& effect : s.effects)

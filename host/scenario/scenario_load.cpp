@@ -18,6 +18,7 @@
 
 #include "host/common/input_error.h"
 #include "host/scenario/scenario.h"
+#include "host/scenario/surface_regions.h"
 
 namespace sigmafem {
 
@@ -540,23 +541,36 @@ void read_ligaments(const Checker& c, const json& root, Scenario& s) {
   }
 }
 
-// candidate_regions: [{"name", "nodes" | "select"}], the regions of extra_ligament:NAME.
+// candidate_regions, the regions of extra_ligament:NAME: a list [{"name", "nodes" | "select"}],
+// or {"automatic": N} for N surface patches; left out: kAutomaticRegionCount patches. Read
+// after the ligaments and the control, whose nodes the patches leave out.
 void read_candidate_regions(const Checker& c, const json& root, Scenario& s) {
-  if (!root.contains("candidate_regions")) return;
-  const json& regions = c.array(root.at("candidate_regions"), "candidate_regions");
-  for (size_t i = 0; i < regions.size(); ++i) {
-    const std::string path = element("candidate_regions", i);
-    c.check_object(regions[i], path, {"name", "nodes", "select"}, {"name"});
-    Ligament region;
-    region.name = c.string(regions[i].at("name"), child(path, "name"));
-    c.require(valid_name(region.name) && region.name.find(':') == std::string::npos, child(path, "name"),
-              "not a usable name: it must be non-empty, without colons, commas, quotes, control "
-              "characters or edge spaces");
-    for (const Ligament& other : s.candidate_regions)
-      c.require(other.name != region.name, child(path, "name"), "duplicate region name; names must be unique");
-    region.nodes = node_set(c, regions[i], path, s.mesh);
-    s.candidate_regions.push_back(std::move(region));
+  int automatic = kAutomaticRegionCount;
+  if (root.contains("candidate_regions") && root.at("candidate_regions").is_object()) {
+    const json& object = root.at("candidate_regions");
+    c.check_object(object, "candidate_regions", {"automatic"}, {"automatic"});
+    automatic = c.integer(object.at("automatic"), "candidate_regions.automatic");
+    c.require(automatic >= 0 && automatic <= 64, "candidate_regions.automatic", "must be an integer from 0 to 64");
+  } else if (root.contains("candidate_regions")) {
+    const json& regions = c.array(root.at("candidate_regions"), "candidate_regions");
+    for (size_t i = 0; i < regions.size(); ++i) {
+      const std::string path = element("candidate_regions", i);
+      c.check_object(regions[i], path, {"name", "nodes", "select"}, {"name"});
+      Ligament region;
+      region.name = c.string(regions[i].at("name"), child(path, "name"));
+      c.require(valid_name(region.name) && region.name.find(':') == std::string::npos, child(path, "name"),
+                "not a usable name: it must be non-empty, without colons, commas, quotes, control "
+                "characters or edge spaces");
+      c.require(s.candidate_region_index(region.name) < 0, child(path, "name"),
+                "duplicate region name; names must be unique");
+      region.nodes = node_set(c, regions[i], path, s.mesh);
+      s.candidate_regions.push_back(std::move(region));
+    }
+    return;
   }
+  std::vector<int> held = s.control.nodes;
+  for (const Ligament& ligament : s.ligaments) held.insert(held.end(), ligament.nodes.begin(), ligament.nodes.end());
+  s.candidate_regions = automatic_surface_regions(s.mesh, automatic, held);
 }
 
 Trajectory read_trajectory(const Checker& c, const json& value, const std::string& path,
@@ -805,8 +819,8 @@ Scenario load_scenario(const std::string& path) {
   read_mesh_section(c, root, path, s);
   read_physics(c, root, s);
   read_ligaments(c, root, s);
-  read_candidate_regions(c, root, s);
   read_control(c, root, path, s);
+  read_candidate_regions(c, root, s);
   read_events(c, root, s);
   read_observations(c, root, s);
   read_filter(c, root, s);
