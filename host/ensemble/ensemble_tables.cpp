@@ -107,12 +107,16 @@ std::vector<double> step_constants(const Model& m, const Eigen::Vector3d& so_pos
   return c;
 }
 
-RecenteringInputs pack_recentering(const Recentering& r, int p, int S, const char* who) {
-  if (r.directions.rows() != p || r.directions.cols() != S || r.correction.size() != p ||
-      r.factor.rows() != p || r.factor.cols() != p)
+RecenteringInputs pack_recentering(const Recentering& r, int S, const char* who) {
+  const int p = static_cast<int>(r.directions.rows());
+  if (r.directions.cols() != S || r.correction.size() != p || r.factor.rows() != p || r.factor.cols() != p)
     throw std::invalid_argument(std::string(who) + "::recenter: sizes do not match the ensemble");
+  if (p > kDeviceMaxParameters)
+    throw std::invalid_argument(std::string(who) + "::recenter: at most " + std::to_string(kDeviceMaxParameters) +
+                                " filter parameters on a device, got " + std::to_string(p));
   const Eigen::MatrixXd weights = r.factor * r.directions;   // W = C I
   RecenteringInputs in;
+  in.p = static_cast<std::uint32_t>(p);
   in.scalars.assign(1 + kDeviceMaxParameters, 0.0);
   in.directions.resize(static_cast<std::size_t>(p) * S);
   in.weights.resize(static_cast<std::size_t>(p) * S);

@@ -10,6 +10,7 @@
 #include <Eigen/Core>
 #include <cstddef>
 #include <string>
+#include <cstdint>
 #include <vector>
 
 #include "filter/ensemble.h"
@@ -65,12 +66,15 @@ std::vector<double> step_constants(const Model& model, const Eigen::Vector3d& so
                                    double cg_tolerance);
 
 // The re-centring inputs, packed as the recenter kernels read them: scalars[1 + max p]
-// (alpha, the correction), directions and weights W = C I, each [j S + s].
+// (alpha, the correction), directions and weights W = C I, each [j S + s]. p is the filter's
+// parameter count, which may exceed the ensemble's own (EffectEnsemble adds effect
+// parameters): re-sampling the states does not depend on what the parameters are. Throws
+// std::invalid_argument when the sizes disagree or p exceeds kDeviceMaxParameters.
 struct RecenteringInputs {
+  std::uint32_t p = 0;
   std::vector<double> scalars, directions, weights;
 };
-RecenteringInputs pack_recentering(const Recentering& r, int parameter_count, int sigma_count,
-                                   const char* who);
+RecenteringInputs pack_recentering(const Recentering& r, int sigma_count, const char* who);
 
 // Device memory of an ensemble, in bytes, for `real_size`-byte reals.
 struct EnsembleMemory {

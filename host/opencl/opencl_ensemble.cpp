@@ -367,8 +367,9 @@ void OpenClEnsemble::predicted_observations(Eigen::MatrixXd& y) const {
 }
 
 void OpenClEnsemble::recenter(const Recentering& r) {
-  const RecenteringInputs in = pack_recentering(r, parameter_count(), S_, "OpenClEnsemble");
+  const RecenteringInputs in = pack_recentering(r, S_, "OpenClEnsemble");
   try {
+    k_recenter_.setArg(2, static_cast<cl_uint>(in.p));
     write(recenter_scalars_, in.scalars);
     write(directions_, in.directions);
     write(weights_, in.weights);

@@ -204,7 +204,7 @@ void VulkanEnsemble::dispatch_items(VkCommandBuffer cmd, const VulkanKernel& ker
   push.S = static_cast<std::uint32_t>(S_);
   push.count = count;
   push.max_iterations = model_.solver.cg_max_iterations;
-  push.p = static_cast<std::uint32_t>(estimated_.size());
+  push.p = recenter_parameters_;
   device_.dispatch(cmd, kernel, set, &push, groups_for(items));
   device_.barrier(cmd);
 }
@@ -328,7 +328,8 @@ void VulkanEnsemble::predicted_observations(Eigen::MatrixXd& y) const {
 }
 
 void VulkanEnsemble::recenter(const Recentering& r) {
-  const RecenteringInputs in = pack_recentering(r, parameter_count(), S_, "VulkanEnsemble");
+  const RecenteringInputs in = pack_recentering(r, S_, "VulkanEnsemble");
+  recenter_parameters_ = in.p;
   write(recenter_scalars_, in.scalars);
   write(directions_, in.directions);
   write(weights_, in.weights);

@@ -86,6 +86,7 @@ class VulkanEnsemble : public DeviceEnsemble {
   // The observations gathered at the end of the last advance(), until recenter() moves x.
   mutable std::vector<double> observations_cache_;
   mutable bool observations_current_ = false;
+  std::uint32_t recenter_parameters_ = 0;   // p of the last recenter(): the recenter shader's loop
 
   // Shared data.
   VulkanBuffer element_nodes_, element_rest_, incidence_offsets_, incidence_;

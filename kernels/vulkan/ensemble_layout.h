@@ -29,7 +29,7 @@ layout(push_constant) uniform SfPush {
   uint S;               /* sigma points */
   uint count;           /* elements, nodes, rows or observed nodes: the kernel's items */
   int max_iterations;   /* CG iteration cap (cg_iteration) */
-  uint p;               /* estimated parameters (recenter) */
+  uint p;               /* the filter's parameters (recenter) */
 } sf_push;
 
 /* Invocations per work-group of the element and node kernels (the host dispatches

@@ -18,6 +18,7 @@
 #include "temp_path.h"
 #include "host/common/input_error.h"
 #include "host/generator/generate.h"
+#include "host/opencl/opencl_device.h"
 #include "host/scenario/effect_catalogue.h"
 
 namespace sigmafem {
@@ -85,9 +86,10 @@ struct BoxData {
   std::optional<TruthTable> truth;
 };
 
-BoxData box_data(const std::vector<EffectValue>& inject, std::uint64_t seed = 1) {
+BoxData box_data(const std::vector<EffectValue>& inject, std::uint64_t seed = 1,
+                 const std::string& scenario = "box_diagnose") {
   BoxData box;
-  box.scenario = load_scenario(std::string(SIGMAFEM_SOURCE_DIR) + "/scenarios/box_diagnose.json");
+  box.scenario = load_scenario(std::string(SIGMAFEM_SOURCE_DIR) + "/scenarios/" + scenario + ".json");
   const fs::path dir = test::unique_temp_path("sigmafem_diagnosis_test");
   GenerateOptions options;
   options.out_dir = dir.string();
@@ -113,10 +115,12 @@ std::string describe(const Diagnosis& d) {
 }
 
 // Injects `effect`, runs diagnose with every candidate, and checks the three claims.
-void expect_found(const EffectValue& effect, const std::vector<std::string>& candidates = {}) {
-  const BoxData box = box_data({effect});
+void expect_found(const EffectValue& effect, const std::vector<std::string>& candidates = {},
+                  const std::string& scenario = "box_diagnose", const std::string& backend = "cpu") {
+  const BoxData box = box_data({effect}, 1, scenario);
   DiagnoseOptions options;
   options.candidates = candidates;
+  options.backend = backend;
   const Diagnosis d = diagnose(box.scenario, box.data, box.truth, options);
   ASSERT_EQ(d.outcome, DiagnosisOutcome::explained) << describe(d);
   ASSERT_EQ(d.after().estimates.size(), 1u) << describe(d);
@@ -195,6 +199,28 @@ TEST(DiagnoseBox, AStiffInclusionStaysUnexplained) {
   EXPECT_EQ(d.outcome, DiagnosisOutcome::unexplained) << describe(d);
   EXPECT_TRUE(d.discovered.empty()) << describe(d);
   EXPECT_NE(d.conclusion.find("unexplained"), std::string::npos) << d.conclusion;
+}
+
+// The liver (scenarios/liver_diagnose.json: 300 steps, its six automatic surface regions) on
+// the OpenCL back end, float32: the effects a device estimates (an extra ligament, a camera
+// offset) are found there as on the CPU. Each diagnose is about 9 filter runs of 1 s.
+bool opencl_missing() { return list_opencl_devices().empty(); }
+
+TEST(DiagnoseLiverOnOpenCl, FindsAnExtraLigamentAmongTheSurfaceRegions) {
+  if (opencl_missing()) GTEST_SKIP() << "no OpenCL platform on this machine";
+  expect_found({"extra_ligament:surface_5", {100.0}}, {}, "liver_diagnose", "opencl");
+}
+
+TEST(DiagnoseLiverOnOpenCl, CleanDataAddNothing) {
+  if (opencl_missing()) GTEST_SKIP() << "no OpenCL platform on this machine";
+  const BoxData liver = box_data({}, 1, "liver_diagnose");
+  DiagnoseOptions options;
+  options.backend = "opencl";
+  const Diagnosis d = diagnose(liver.scenario, liver.data, liver.truth, options);
+  EXPECT_EQ(d.outcome, DiagnosisOutcome::consistent) << describe(d);
+  EXPECT_EQ(d.fits.size(), 1u);
+  // The physics effects its kernels lack are left out, and said so.
+  EXPECT_EQ(d.left_out, (std::vector<std::string>{"gravity", "young_scale", "ligament_law", "time_lag", "damping_scale"}));
 }
 
 }  // namespace

@@ -73,7 +73,7 @@ TEST_F(EffectEnsembleTest, AnExtraLigamentIsOneMoreEstimatedLigament) {
     }
 }
 
-TEST_F(EffectEnsembleTest, AnExtraLigamentRunsOnOpenClAsOnTheCpu) {
+TEST_F(EffectEnsembleTest, AnExtraLigamentAndACameraOffsetRunOnOpenClAsOnTheCpu) {
   const auto devices = list_opencl_devices();
   if (devices.empty()) GTEST_SKIP() << "no OpenCL platform on this machine";
   if (!devices[0].has_fp64) GTEST_SKIP() << "OpenCL device 0 has no fp64";
@@ -90,11 +90,25 @@ TEST_F(EffectEnsembleTest, AnExtraLigamentRunsOnOpenClAsOnTheCpu) {
     cpu->advance(so(n));
     opencl->advance(so(n));
   }
+  // A re-sampling with the filter's 7 parameters, more than the inner ensemble's 4.
+  Recentering r;
+  r.alpha = 1.0 / kSigma;
+  r.directions = Eigen::MatrixXd::Zero(7, kSigma);
+  for (int j = 0; j < 7; ++j) r.directions(j, j % kSigma) = 1.0, r.directions(j, (j + 1) % kSigma) = -1.0;
+  r.correction = Eigen::VectorXd::LinSpaced(7, -0.2, 0.3);
+  r.factor = Eigen::MatrixXd::Identity(7, 7) * 0.5;
+  cpu->recenter(r);
+  opencl->recenter(r);
+  for (int n = 51; n <= 60; ++n) {
+    cpu->advance(so(n));
+    opencl->advance(so(n));
+  }
   cpu->predicted_observations(y_cpu);
   opencl->predicted_observations(y_opencl);
   // float64 kernels against the float64 reference: the conformance suite's trajectory
   // tolerance (1e-9 m).
   EXPECT_LT((y_cpu - y_opencl).lpNorm<Eigen::Infinity>(), 1e-9);
+  EXPECT_GT((y_cpu.col(0) - y_cpu.col(1)).norm(), 1e-6) << "the sigma points differ (the test would be empty)";
 }
 
 TEST_F(EffectEnsembleTest, DeviceBackEndsRefuseThePhysicsTheirKernelsLack) {
