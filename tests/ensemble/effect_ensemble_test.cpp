@@ -13,6 +13,7 @@
 #include "host/ensemble/make_ensemble.h"
 #include "host/model/effects.h"
 #include "host/opencl/opencl_device.h"
+#include "host/vulkan/vulkan_device.h"
 #include "host/scenario/scenario.h"
 
 namespace sigmafem {
@@ -73,15 +74,25 @@ TEST_F(EffectEnsembleTest, AnExtraLigamentIsOneMoreEstimatedLigament) {
     }
 }
 
-TEST_F(EffectEnsembleTest, AnExtraLigamentAndACameraOffsetRunOnOpenClAsOnTheCpu) {
-  const auto devices = list_opencl_devices();
-  if (devices.empty()) GTEST_SKIP() << "no OpenCL platform on this machine";
-  if (!devices[0].has_fp64) GTEST_SKIP() << "OpenCL device 0 has no fp64";
+// On each device back end in float64, against the CPU reference.
+class EffectEnsembleOnDevice : public EffectEnsembleTest, public ::testing::WithParamInterface<std::string> {};
+
+TEST_P(EffectEnsembleOnDevice, AnExtraLigamentAndACameraOffsetRunAsOnTheCpu) {
+  if (GetParam() == "opencl") {
+    const auto devices = list_opencl_devices();
+    if (devices.empty()) GTEST_SKIP() << "no OpenCL platform on this machine";
+    if (!devices[0].has_fp64) GTEST_SKIP() << "OpenCL device 0 has no fp64";
+  } else {
+    std::string why;
+    const auto devices = list_vulkan_devices(&why);
+    if (devices.empty()) GTEST_SKIP() << why;
+    if (!devices[0].has_fp64) GTEST_SKIP() << "Vulkan device 0 has no shaderFloat64";
+  }
   DeviceOptions options;
   options.precision = Precision::double_precision;
   auto cpu = EffectEnsemble::make("cpu", model_, scenario_.filter->estimate, scenario_.observations.nodes, kSigma,
                                   {}, effects_);
-  auto opencl = EffectEnsemble::make("opencl", model_, scenario_.filter->estimate, scenario_.observations.nodes,
+  auto opencl = EffectEnsemble::make(GetParam(), model_, scenario_.filter->estimate, scenario_.observations.nodes,
                                      kSigma, options, effects_);
   cpu->set_parameters(theta_);
   opencl->set_parameters(theta_);
@@ -110,6 +121,8 @@ TEST_F(EffectEnsembleTest, AnExtraLigamentAndACameraOffsetRunOnOpenClAsOnTheCpu)
   EXPECT_LT((y_cpu - y_opencl).lpNorm<Eigen::Infinity>(), 1e-9);
   EXPECT_GT((y_cpu.col(0) - y_cpu.col(1)).norm(), 1e-6) << "the sigma points differ (the test would be empty)";
 }
+
+INSTANTIATE_TEST_SUITE_P(Backends, EffectEnsembleOnDevice, ::testing::Values("opencl", "vulkan"));
 
 TEST_F(EffectEnsembleTest, DeviceBackEndsRefuseThePhysicsTheirKernelsLack) {
   if (list_opencl_devices().empty()) GTEST_SKIP() << "no OpenCL platform on this machine";
