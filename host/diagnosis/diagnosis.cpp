@@ -39,7 +39,7 @@ std::vector<std::string> candidate_library(const Scenario& scenario, const std::
   if (asked.empty())
     for (const EffectDefinition& definition : effect_catalogue()) {
       if (!definition.candidate) continue;
-      if (definition.side == EffectSide::physics && backend != "cpu") {
+      if (definition.cpu_only && backend != "cpu") {
         if (left_out) left_out->push_back(definition.name);
         continue;
       }

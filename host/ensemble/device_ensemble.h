@@ -9,6 +9,7 @@
 #include <vector>
 
 #include "filter/ensemble.h"
+#include "host/model/effects.h"
 
 namespace sigmafem {
 
@@ -26,6 +27,12 @@ class DeviceEnsemble : public Ensemble {
   virtual double cg_tolerance() const = 0;
   // "opencl single on <device>", for messages and reports.
   virtual std::string description() const = 0;
+
+  // Per sigma point s, physics effects on top of the model (diagnose's candidates: gravity,
+  // time_lag, ligament_law; one entry per sigma point), kept until changed. Throws InputError
+  // for young_scale or damping_scale other than 1 (the kernels share the element stiffness
+  // and the damping; check_device_physics_effects).
+  virtual void set_physics_effects(const std::vector<PhysicsEffects>& effects) = 0;
 };
 
 }  // namespace sigmafem

@@ -6,6 +6,7 @@
 
 #include "host/common/input_error.h"
 #include "host/ensemble/cpu_ensemble.h"
+#include "host/ensemble/device_ensemble.h"
 #include "host/ensemble/make_ensemble.h"
 #include "host/model/effects.h"
 
@@ -14,15 +15,19 @@ namespace sigmafem {
 EffectEnsemble::EffectEnsemble(std::unique_ptr<Ensemble> inner, const std::vector<std::string>& effects)
     : inner_(std::move(inner)) {
   cpu_ = dynamic_cast<CpuEnsemble*>(inner_.get());
+  device_ = dynamic_cast<DeviceEnsemble*>(inner_.get());
   declared_count_ = inner_->parameter_count();
   for (const std::string& name : effects) {
     const EffectDefinition* definition = find_effect(name);
     if (!definition || !definition->candidate)
       throw InputError("effect " + name + ": not in the candidate library (" + effect_names(true) + ")");
     if (std::count(effects.begin(), effects.end(), name) > 1) throw InputError("effect " + name + ": listed twice");
-    if (definition->side == EffectSide::physics && !cpu_)
-      throw InputError("effect " + name + ": estimating a physics effect needs the cpu back end "
-                       "(the device kernels take only stiffnesses for now); run with --backend cpu");
+    if (definition->side == EffectSide::physics && !cpu_ && !device_)
+      throw std::invalid_argument("EffectEnsemble: effect " + name + " needs a CPU or device ensemble");
+    if (definition->cpu_only && !cpu_)
+      throw InputError("effect " + name + ": estimating it per sigma point needs the cpu back end (the device "
+                       "kernels share the element stiffness and the damping between sigma points); run with "
+                       "--backend cpu");
     effects_.push_back(definition);
     effect_parameter_count_ += static_cast<int>(definition->parameters.size());
     if (definition->side == EffectSide::ligament) --declared_count_;
@@ -96,6 +101,7 @@ void EffectEnsemble::set_parameters(const Eigen::MatrixXd& theta) {
   }
   inner_->set_parameters(inner_theta_);
   if (cpu_) cpu_->set_physics_effects(physics);
+  if (device_) device_->set_physics_effects(physics);
 }
 
 StepReport EffectEnsemble::advance(const Eigen::Vector3d& so_position) { return inner_->advance(so_position); }

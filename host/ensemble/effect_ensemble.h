@@ -6,8 +6,9 @@
 // coordinates], the coordinate of an effect parameter being (u - prior_mean) / prior_std with
 // u = log(value) or value (its transform): prior N(0, 1) for every effect coordinate.
 //   physics effects (gravity, young_scale, ligament_law, time_lag, damping_scale): per sigma
-//     point through CpuEnsemble::set_physics_effects; another back end is refused with an
-//     InputError (its kernels take only stiffnesses for now);
+//     point through set_physics_effects of the CPU or the device ensemble; young_scale and
+//     damping_scale (cpu_only) on a device back end are refused with an InputError (its
+//     kernels share the element stiffness and the damping between sigma points);
 //   ligament effects (extra_ligament:REGION): one more estimated ligament of the inner
 //     ensemble (make() appends it to the model), its log-stiffness mapped from the
 //     coordinate: any back end;
@@ -28,6 +29,7 @@
 namespace sigmafem {
 
 class CpuEnsemble;
+class DeviceEnsemble;
 
 class EffectEnsemble : public Ensemble {
  public:
@@ -64,6 +66,7 @@ class EffectEnsemble : public Ensemble {
  private:
   std::unique_ptr<Ensemble> inner_;
   CpuEnsemble* cpu_ = nullptr;                     // inner_ as the CPU back end, if it is
+  DeviceEnsemble* device_ = nullptr;               // inner_ as a device back end, if it is
   std::vector<const EffectDefinition*> effects_;
   int declared_count_ = 0;                         // p0: the declared estimated ligaments
   int effect_parameter_count_ = 0;

@@ -14,6 +14,8 @@
 #include <vector>
 
 #include "filter/ensemble.h"
+#include "host/model/effects.h"
+#include "host/model/so_history.h"
 #include "host/common/device_options.h"
 #include "host/model/model.h"
 
@@ -61,9 +63,17 @@ void set_ligament_stiffness(const Model& model, const std::vector<int>& estimate
                             const Eigen::MatrixXd& theta, int sigma_count,
                             std::vector<double>& ligament_k);
 
-// The SF_STEP_CONSTANTS numbers of one step (kernels/shared/step_constants.h).
-std::vector<double> step_constants(const Model& model, const Eigen::Vector3d& so_position,
-                                   double cg_tolerance);
+// The constants of one step (kernels/shared/step_constants.h), SF_STEP_CONSTANTS +
+// SF_SIGMA_FORCE_COUNT S numbers: the shared ones, then per sigma point s its gravity, SO
+// target shift and the ligament law's 1/d0^2, from the model and physics[s] (gravity,
+// time_lag, ligament_d0). `history` holds the SO up to the end of this step.
+std::vector<double> step_constants(const Model& model, const std::vector<PhysicsEffects>& physics,
+                                   const SoHistory& history, double cg_tolerance);
+
+// The device kernels share the element stiffness and the damping between sigma points: an
+// InputError names an effect of `physics` that would need them per sigma point (young_scale,
+// damping_scale), or a count other than `sigma_count`.
+void check_device_physics_effects(const std::vector<PhysicsEffects>& physics, int sigma_count, const std::string& who);
 
 // The re-centring inputs, packed as the recenter kernels read them: scalars[1 + max p]
 // (alpha, the correction), directions and weights W = C I, each [j S + s]. p is the filter's

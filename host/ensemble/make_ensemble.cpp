@@ -1,7 +1,5 @@
 #include "host/ensemble/make_ensemble.h"
 
-#include <cmath>
-
 #include "host/common/input_error.h"
 #include "host/ensemble/cpu_ensemble.h"
 #include "host/opencl/opencl_ensemble.h"
@@ -16,11 +14,6 @@ std::unique_ptr<Ensemble> make_ensemble(const std::string& backend, const Model&
                                         const std::vector<int>& observed, int sigma_count,
                                         const DeviceOptions& options) {
   if (backend == "cpu") return std::make_unique<CpuEnsemble>(model, estimated, observed, sigma_count);
-  // The device kernels have the linear ligament law and no SO history.
-  if ((backend == "opencl" || backend == "vulkan") && (std::isfinite(model.ligament_d0) || model.so_lag != 0.0))
-    throw InputError("--backend " + backend + ": the model has the effect " +
-                     (std::isfinite(model.ligament_d0) ? "ligament_law" : "time_lag") +
-                     ", which only the cpu back end simulates for now; run with --backend cpu");
   if (backend == "opencl")
     return std::make_unique<OpenClEnsemble>(model, estimated, observed, sigma_count, options);
   if (backend == "vulkan")

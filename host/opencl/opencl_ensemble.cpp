@@ -34,6 +34,8 @@ OpenClEnsemble::OpenClEnsemble(const Model& model, std::vector<int> estimated,
                                const DeviceOptions& options)
     : device_(options.device, options.precision),
       model_(model),
+      physics_(static_cast<std::size_t>(std::max(sigma_count, 0))),
+      so_history_(model.control_start, model.dt),
       estimated_(std::move(estimated)),
       observed_(std::move(observed)),
       S_(sigma_count),
@@ -98,7 +100,7 @@ OpenClEnsemble::OpenClEnsemble(const Model& model, std::vector<int> estimated,
     rest_positions_ = make_buffer(tables.rest_positions, "rest positions");
     observed_nodes_ = make_buffer(observed_.empty() ? std::vector<int>{0} : observed_,
                                   "observed nodes");
-    constants_ = make_buffer(kStepConstants, "step constants");
+    constants_ = make_buffer(kStepConstants + SF_SIGMA_FORCE_COUNT * static_cast<std::size_t>(S_), "step constants");
     ligament_k_buffer_ = make_buffer(ligament_k_, "ligament stiffness");
     x_ = make_buffer(tables.initial_positions, "positions");
     const std::vector<double> zeros(dof, 0.0);
@@ -251,7 +253,13 @@ void OpenClEnsemble::set_parameters(const Eigen::MatrixXd& theta) {
 }
 
 void OpenClEnsemble::write_step_constants(const Eigen::Vector3d& so_position) {
-  write(constants_, step_constants(model_, so_position, tolerance_));
+  so_history_.push(so_position);
+  write(constants_, step_constants(model_, physics_, so_history_, tolerance_));
+}
+
+void OpenClEnsemble::set_physics_effects(const std::vector<PhysicsEffects>& effects) {
+  check_device_physics_effects(effects, S_, "OpenClEnsemble");
+  physics_ = effects;
 }
 
 void OpenClEnsemble::run(cl::Kernel& kernel, std::size_t items, std::size_t local) const {

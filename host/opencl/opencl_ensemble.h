@@ -15,6 +15,7 @@
 
 #include "host/ensemble/device_ensemble.h"
 #include "host/model/model.h"
+#include "host/model/so_history.h"
 #include "host/opencl/opencl_device.h"
 
 namespace sigmafem {
@@ -44,6 +45,7 @@ class OpenClEnsemble : public DeviceEnsemble {
   Eigen::MatrixXd system_product(const Eigen::MatrixXd& d) override;
   double cg_tolerance() const override { return tolerance_; }
   std::string description() const override;
+  void set_physics_effects(const std::vector<PhysicsEffects>& effects) override;
   const OpenClDeviceInfo& device_info() const { return device_.info(); }
   // Bytes of device memory the ensemble holds.
   std::size_t device_bytes() const { return device_bytes_; }
@@ -72,6 +74,8 @@ class OpenClEnsemble : public DeviceEnsemble {
 
   mutable OpenClDevice device_;
   Model model_;                             // a copy: the ensemble outlives its caller's model
+  std::vector<PhysicsEffects> physics_;     // per sigma point (identity unless diagnose sets them)
+  SoHistory so_history_;                    // for the SO lag (time_lag)
   std::vector<int> estimated_, observed_;
   int S_ = 0, nodes_ = 0, elements_ = 0;
   double tolerance_ = 0.0;

@@ -9,7 +9,8 @@
 
 namespace sigmafem {
 
-ReferenceSimulation::ReferenceSimulation(Model model) : model_(std::move(model)) {
+ReferenceSimulation::ReferenceSimulation(Model model)
+    : model_(std::move(model)), so_history_(model_.control_start, model_.dt) {
   for (const SpringSet& ligament : model_.ligaments)
     ligament_stiffness_.push_back(ligament.stiffness);
   const int n = model_.node_count();
@@ -21,7 +22,6 @@ ReferenceSimulation::ReferenceSimulation(Model model) : model_(std::move(model))
   base_damping_ = model_.damping;
   base_d0_ = model_.ligament_d0;
   base_so_lag_ = model_.so_lag;
-  so_history_.push_back(model_.control_start);
 }
 
 void ReferenceSimulation::set_physics_effects(const PhysicsEffects& effects) {
@@ -57,21 +57,11 @@ void ReferenceSimulation::set_state(const Eigen::VectorXd& positions,
   v_ = velocities;
 }
 
-namespace {
-// The nonlinear ligament law's factor (1 + |u|^2/d0^2) on k u, and its tangent's along u,
-// (1 + 3 |u|^2/d0^2): the largest eigenvalue, so that the implicit step stays stable. Both
-// 1 for the linear law (infinite d0).
-double law_factor(const Eigen::Vector3d& u, double d0) { return 1.0 + u.squaredNorm() / (d0 * d0); }
-double law_tangent_factor(const Eigen::Vector3d& u, double d0) { return 1.0 + 3.0 * u.squaredNorm() / (d0 * d0); }
-}  // namespace
-
 Eigen::VectorXd ReferenceSimulation::spring_stiffness() const {
   Eigen::VectorXd k = Eigen::VectorXd::Zero(model_.node_count());
   for (std::size_t l = 0; l < model_.ligaments.size(); ++l) {
     const auto& nodes = model_.ligaments[l].nodes;
-    for (int node : nodes)
-      k[node] += ligament_stiffness_[l] / static_cast<double>(nodes.size()) *
-                 law_tangent_factor(x_.segment<3>(3 * node) - model_.rest_positions[node], model_.ligament_d0);
+    for (int node : nodes) k[node] += ligament_stiffness_[l] / static_cast<double>(nodes.size());
   }
   const auto& control = model_.control.nodes;
   for (int node : control) k[node] += model_.control.stiffness / static_cast<double>(control.size());
@@ -88,7 +78,9 @@ Eigen::VectorXd ReferenceSimulation::forces(const Eigen::VectorXd& x,
     const double k = ligament_stiffness_[l] / static_cast<double>(nodes.size());
     for (int node : nodes) {
       const Eigen::Vector3d u = x.segment<3>(3 * node) - model_.rest_positions[node];
-      f.segment<3>(3 * node) -= k * law_factor(u, model_.ligament_d0) * u;
+      // The ligament law: k u (1 + |u|^2/d0^2); 1/d0^2 = 0 for the linear law (infinite d0).
+      const double inverse_d0_squared = 1.0 / (model_.ligament_d0 * model_.ligament_d0);
+      f.segment<3>(3 * node) -= k * (1.0 + u.squaredNorm() * inverse_d0_squared) * u;
     }
   }
   const auto& control = model_.control.nodes;
@@ -106,21 +98,13 @@ Eigen::VectorXd ReferenceSimulation::forces(const Eigen::VectorXd& x,
   return f;
 }
 
-Eigen::Vector3d ReferenceSimulation::lagged_so(const Eigen::Vector3d& so_position) {
-  so_history_.push_back(so_position);
-  if (model_.so_lag == 0.0) return so_position;
-  const double at = static_cast<double>(so_history_.size() - 1) - model_.so_lag / model_.dt;
-  if (at <= 0.0) return so_history_.front();
-  const std::size_t i = static_cast<std::size_t>(at);
-  const double a = at - static_cast<double>(i);
-  return i + 1 < so_history_.size() ? ((1.0 - a) * so_history_[i] + a * so_history_[i + 1]).eval() : so_history_[i];
-}
-
 CgResult ReferenceSimulation::step(const Eigen::Vector3d& so_position) {
+  so_history_.push(so_position);
+  const Eigen::Vector3d so_target = so_history_.lagged(model_.so_lag);
   element_frames(model_, x_, frames_);
   const Eigen::VectorXd springs = spring_stiffness();
   const ImplicitEulerSystem system(model_, frames_, springs);
-  const Eigen::VectorXd b = system.right_hand_side(forces(x_, frames_, lagged_so(so_position)), v_);
+  const Eigen::VectorXd b = system.right_hand_side(forces(x_, frames_, so_target), v_);
 
   CgResult result;
   if (solver_ == LinearSolver::conjugate_gradient) {

@@ -14,6 +14,7 @@
 
 #include "host/model/effects.h"
 #include "host/model/model.h"
+#include "host/model/so_history.h"
 #include "host/reference/conjugate_gradient.h"
 #include "host/reference/corotational.h"
 
@@ -47,8 +48,9 @@ class ReferenceSimulation {
   void set_state(const Eigen::VectorXd& positions, const Eigen::VectorXd& velocities);
   Eigen::Vector3d node_position(int node) const { return x_.segment<3>(3 * node); }
 
-  // The spring stiffness on each node (ligaments and control), N/m: with a nonlinear
-  // ligament law, its tangent along the displacement at the current positions.
+  // The spring stiffness on each node (ligaments and control), N/m: the linear law's. With
+  // a nonlinear ligament law the implicit step takes the law's linear part implicitly and the
+  // rest, k u |u|^2/d0^2, explicitly in the forces (as the device kernels do).
   Eigen::VectorXd spring_stiffness() const;
   // All forces at positions x with the SO at so_position, for the frames of x.
   Eigen::VectorXd forces(const Eigen::VectorXd& x, const std::vector<Frame>& frames,
@@ -62,16 +64,12 @@ class ReferenceSimulation {
   Eigen::VectorXd x_, v_;
   Eigen::VectorXd dv_;                 // last velocity change: the CG warm start
   std::vector<Frame> frames_;
-  // The SO target of the step that ends at step count `steps` + 1, `so_position` given:
-  // so(t - lag) interpolated in the SO positions of the steps made (so(0) before them).
-  Eigen::Vector3d lagged_so(const Eigen::Vector3d& so_position);
-
   Eigen::Vector3d base_gravity_;
   std::vector<Eigen::Vector2d> base_lame_;   // per element: vlambda, vmu of the model
   double young_scale_ = 1.0;
   Damping base_damping_;
   double base_d0_ = 0.0, base_so_lag_ = 0.0;
-  std::vector<Eigen::Vector3d> so_history_;  // so at the end of each step made; [0]: so(0)
+  SoHistory so_history_;                     // for the lag (Model::so_lag)
 };
 
 }  // namespace sigmafem

@@ -16,10 +16,10 @@
 
 namespace sigmafem {
 
-// Where an effect acts, which decides the back ends that can estimate it per sigma point:
-//   physics      in the simulated physics, set per simulation (the CPU ensemble only);
-//   ligament     an extra spring set, estimated as one more ligament (any back end);
-//   observation  in the observation operator (any back end).
+// Where an effect acts:
+//   physics      in the simulated physics, set per simulation (PhysicsEffects);
+//   ligament     an extra spring set, estimated as one more ligament;
+//   observation  in the observation operator.
 enum class EffectSide { physics, ligament, observation };
 
 // One estimated parameter. In the filter its coordinate is (u - prior_mean) / prior_std with
@@ -44,6 +44,9 @@ struct EffectDefinition {
   int value_count = 0;                     // numbers in a value
   // Candidates: the estimated parameters, one per number of the value, same order.
   std::vector<EffectParameter> parameters;
+  // Per sigma point on the CPU back end only: the device kernels share the element
+  // stiffness and the damping between sigma points (young_scale, damping_scale).
+  bool cpu_only = false;
 };
 
 // An effect with its value (natural units), as declared, injected or discovered. The name is

@@ -714,7 +714,11 @@ void VulkanDevice::barrier(VkCommandBuffer cmd) {
 
 void VulkanDevice::update(VkCommandBuffer cmd, const VulkanBuffer& buffer, const void* data,
                           std::size_t bytes) {
-  api_->vkCmdUpdateBuffer(cmd, buffer.buffer, 0, bytes, data);
+  // vkCmdUpdateBuffer takes at most 65536 bytes at a time.
+  constexpr std::size_t kMostPerUpdate = 65536;
+  for (std::size_t offset = 0; offset < bytes; offset += kMostPerUpdate)
+    api_->vkCmdUpdateBuffer(cmd, buffer.buffer, offset, std::min(kMostPerUpdate, bytes - offset),
+                            static_cast<const unsigned char*>(data) + offset);
 }
 
 void VulkanDevice::reserve_read_back(std::size_t bytes) {

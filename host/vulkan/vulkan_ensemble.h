@@ -19,6 +19,7 @@
 
 #include "host/ensemble/device_ensemble.h"
 #include "host/model/model.h"
+#include "host/model/so_history.h"
 #include "host/vulkan/vulkan_device.h"
 
 namespace sigmafem {
@@ -45,6 +46,7 @@ class VulkanEnsemble : public DeviceEnsemble {
   Eigen::MatrixXd system_product(const Eigen::MatrixXd& d) override;
   double cg_tolerance() const override { return tolerance_; }
   std::string description() const override;
+  void set_physics_effects(const std::vector<PhysicsEffects>& effects) override;
   const VulkanDeviceInfo& device_info() const { return device_.info(); }
   std::size_t device_bytes() const { return device_bytes_; }
   // Host waits (command-buffer submissions) of the last advance().
@@ -75,6 +77,8 @@ class VulkanEnsemble : public DeviceEnsemble {
 
   mutable VulkanDevice device_;
   Model model_;
+  std::vector<PhysicsEffects> physics_;     // per sigma point (identity unless diagnose sets them)
+  SoHistory so_history_;                    // for the SO lag (time_lag)
   std::vector<int> estimated_, observed_;
   int S_ = 0, nodes_ = 0, elements_ = 0;
   double tolerance_ = 0.0;

@@ -20,6 +20,16 @@ __kernel void node_rhs(uint S, uint node_count, __global const real* c,
   uint n = (uint)(gid / S);
   real spring = sf_node_spring(ligament_offsets, ligament_of_node, ligament_k, control_k, n, s, S);
   real m = sf_solver_mass(mass[n], spring);
+  /* This sigma point's loads (step_constants.h): at[k * S] is load k. */
+  __global const real* at = c + SF_STEP_CONSTANTS + s;
+  /* The ligament law's explicit part, k u |u|^2/d0^2 (its linear part k u is in spring): 0
+   * for the linear law. */
+  real u2 = (real)0;
+  for (int k = 0; k < 3; ++k) {
+    real u = x[((size_t)3 * n + k) * S + s] - rest_positions[3 * n + k];
+    u2 += u * u;
+  }
+  real law = (spring - control_k[n]) * u2 * at[SF_INVERSE_D0_SQUARED * S];
   SF_UNROLL
   for (int k = 0; k < 3; ++k) {
     size_t row = ((size_t)3 * n + k) * S + s;
@@ -28,8 +38,10 @@ __kernel void node_rhs(uint S, uint node_count, __global const real* c,
     /* elastic force and (h + a) K v from the elements; springs pull towards rest (control
      * springs towards rest + so_shift); the springs' own (h + a) k v term. */
     real f = sf_corner_sum(element_rhs_out, incidence_offsets, incidence, n, k, s, S);
-    f -= spring * (xr - rest_positions[3 * n + k]) - control_k[n] * c[SF_SO_SHIFT + k];
-    f += mass[n] * c[SF_GRAVITY + k];
+    real u = xr - rest_positions[3 * n + k];
+    f -= spring * u - control_k[n] * at[(SF_SO_SHIFT + k) * S];
+    f -= law * u;
+    f += mass[n] * at[(SF_GRAVITY + k) * S];
     f -= c[SF_VELOCITY_FACTOR] * spring * vr;
     rhs[row] = c[SF_H] * (f - c[SF_RAYLEIGH_MASS] * m * vr);
     real diagonal = sf_corner_sum(element_diagonal, incidence_offsets, incidence, n, k, s, S);

@@ -1,7 +1,9 @@
 /* step_constants.h: the implicit Euler constants of one step, in a small buffer the host
  * writes each step (a buffer, not a struct argument, so that host and device never disagree
  * on padding). Shared by the host (host/ensemble/ensemble_tables.cpp), the OpenCL kernels and
- * the Vulkan shaders: one numbering. */
+ * the Vulkan shaders: one numbering. After the SF_STEP_CONSTANTS shared numbers come
+ * SF_SIGMA_FORCE_COUNT numbers per sigma point s, at [SF_STEP_CONSTANTS + k S + s]: the loads
+ * that the candidate effects (host/model/effects.h) may set per sigma point. */
 #ifndef SIGMAFEM_STEP_CONSTANTS_H
 #define SIGMAFEM_STEP_CONSTANTS_H
 
@@ -10,9 +12,13 @@
 #define SF_STIFFNESS_FACTOR 2  /* h (h + a) */
 #define SF_RAYLEIGH_MASS 3     /* b */
 #define SF_VELOCITY_FACTOR 4   /* h + a */
-#define SF_GRAVITY 5           /* 3 numbers */
-#define SF_SO_SHIFT 8          /* 3 numbers: so(t_{n+1}) - so(0), the control target shift */
-#define SF_CG_TOLERANCE2 11    /* squared relative CG tolerance */
-#define SF_STEP_CONSTANTS 12
+#define SF_CG_TOLERANCE2 5     /* squared relative CG tolerance */
+#define SF_STEP_CONSTANTS 6
+
+/* Per sigma point, k: */
+#define SF_GRAVITY 0           /* 3 numbers: gravity (m/s^2) */
+#define SF_SO_SHIFT 3          /* 3 numbers: the control target shift so(t_{n+1} - lag) - so(0) */
+#define SF_INVERSE_D0_SQUARED 6  /* 1/d0^2 of the ligament law k u (1 + |u|^2/d0^2); 0: linear */
+#define SF_SIGMA_FORCE_COUNT 7
 
 #endif /* SIGMAFEM_STEP_CONSTANTS_H */

@@ -32,6 +32,16 @@ void main() {
   real diagonal[3];
   SF_CORNER_SUMS(element_rhs_out, n, s, S, f_elements)
   SF_CORNER_SUMS(element_diagonal, n, s, S, diagonal)
+  /* This sigma point's loads (step_constants.h): c[at + k S] is load k. */
+  uint at = SF_STEP_CONSTANTS + s;
+  /* The ligament law's explicit part, k u |u|^2/d0^2 (its linear part k u is in spring): 0
+   * for the linear law. */
+  real u2 = real(0);
+  for (uint k = 0u; k < 3u; ++k) {
+    real u = x[(3u * n + k) * S + s] - rest_positions[3u * n + k];
+    u2 += u * u;
+  }
+  real law = (spring - control_k[n]) * u2 * c[at + SF_INVERSE_D0_SQUARED * S];
   for (uint k = 0u; k < 3u; ++k) {
     uint row = (3u * n + k) * S + s;
     real xr = x[row];
@@ -39,8 +49,10 @@ void main() {
     /* elastic force and (h + a) K v from the elements; springs pull towards rest (control
      * springs towards rest + so_shift); the springs' own (h + a) k v term. */
     real f = f_elements[k];
-    f -= spring * (xr - rest_positions[3u * n + k]) - control_k[n] * c[SF_SO_SHIFT + k];
-    f += mass[n] * c[SF_GRAVITY + k];
+    real u = xr - rest_positions[3u * n + k];
+    f -= spring * u - control_k[n] * c[at + (SF_SO_SHIFT + k) * S];
+    f -= law * u;
+    f += mass[n] * c[at + (SF_GRAVITY + k) * S];
     f -= c[SF_VELOCITY_FACTOR] * spring * vr;
     rhs[row] = c[SF_H] * (f - c[SF_RAYLEIGH_MASS] * m * vr);
     inverse_diagonal[row] =
