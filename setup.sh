@@ -54,7 +54,7 @@ echo "== tests (sanitizers)"
 # comparison) ran above; the one-step, re-centring and iteration-cap tests with 1 and 4
 # sigma points run here and cover the same host code. The residual diagnostics' two 100-step
 # box runs (ResidualDiagnosticsBox) ran above too; their synthetic tests run here. So did the
-# whole diagnoses (DiagnoseBox, 4 to 8 filter runs each) and the Vulkan-against-OpenCL
+# whole diagnoses (DiagnoseBox, DiagnoseLiver: 5 to 20 filter runs each) and the Vulkan-against-OpenCL
 # comparison (two 200-step runs on the device back ends, no host code of its own).
 # Vulkan on lavapipe runs under the sanitizers as it is: Mesa is not instrumented, and the
 # Vulkan device holds one instance for the process so that the loader does not unload Mesa
@@ -65,5 +65,5 @@ echo "== tests (sanitizers)"
 # sigmafem's code, and none it could free.
 ASAN_OPTIONS=detect_leaks=1:abort_on_error=1 UBSAN_OPTIONS=print_stacktrace=1:halt_on_error=1 \
   ctest --test-dir build-sanitize --output-on-failure -j "$jobs" \
-  -E 'BoxEstimation|ResidualDiagnosticsBox|DiagnoseBox|WholeRun|VulkanAgainstOpenCl|vulkan_validation|Conformance.*(Trajectory|TwoRuns|_S16)'
+  -E 'BoxEstimation|ResidualDiagnosticsBox|DiagnoseBox|DiagnoseLiver|WholeRun|VulkanAgainstOpenCl|vulkan_validation|Conformance.*(Trajectory|TwoRuns|_S16)'
 

@@ -211,6 +211,12 @@ TEST(DiagnoseLiverOnOpenCl, FindsAnExtraLigamentAmongTheSurfaceRegions) {
   expect_found({"extra_ligament:surface_5", {100.0}}, {}, "liver_diagnose", "opencl");
 }
 
+TEST(DiagnoseLiverOnOpenCl, FindsATimeLag) {
+  // A physics effect the device kernels take per sigma point (step_constants.h).
+  if (opencl_missing()) GTEST_SKIP() << "no OpenCL platform on this machine";
+  expect_found({"time_lag", {0.1}}, {}, "liver_diagnose", "opencl");
+}
+
 TEST(DiagnoseLiverOnOpenCl, CleanDataAddNothing) {
   if (opencl_missing()) GTEST_SKIP() << "no OpenCL platform on this machine";
   const BoxData liver = box_data({}, 1, "liver_diagnose");
