@@ -123,7 +123,6 @@ json write_diagnosis_report(const Scenario& scenario, const Diagnosis& d, const 
   j["conclusion"] = d.conclusion;
   j["penalty"] = "BIC: 0.5 k log N, k the candidate's parameters, N the observed scalars";
   j["candidate_library"] = effect_names(true);
-  j["not_tried_on_this_backend"] = d.left_out;
   json discovered = json::array();
   for (const EffectValue& e : d.discovered) discovered.push_back({{"name", e.name}, {"value", e.value}});
   j["discovered_effects"] = discovered;
@@ -214,11 +213,7 @@ json write_diagnosis_report(const Scenario& scenario, const Diagnosis& d, const 
     md << "![residual before](residual_before.png)\n\n![residual after](residual_after.png)\n\n";
   md << "## Rounds\n\nScore = log-likelihood gain of the innovations with the candidate's parameters "
         "estimated, minus the BIC penalty 0.5 k log N.\n\n";
-  if (!d.left_out.empty()) {
-    md << "Not tried on the " << report.backend << " back end, whose kernels lack them (`--backend cpu` tries them):";
-    for (const std::string& name : d.left_out) md << " `" << name << "`";
-    md << ".\n\n";
-  }
+
   for (std::size_t r = 0; r < d.rounds.size(); ++r) {
     const DiagnosisRound& round = d.rounds[r];
     const ModelFit& fit = d.fits[static_cast<std::size_t>(round.fit)];

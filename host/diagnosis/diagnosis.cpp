@@ -33,18 +33,11 @@ std::string describe_estimate(const EffectEstimate& e) {
 
 }  // namespace
 
-std::vector<std::string> candidate_library(const Scenario& scenario, const std::vector<std::string>& names,
-                                           const std::string& backend, std::vector<std::string>* left_out) {
+std::vector<std::string> candidate_library(const Scenario& scenario, const std::vector<std::string>& names) {
   std::vector<std::string> asked = names;
   if (asked.empty())
-    for (const EffectDefinition& definition : effect_catalogue()) {
-      if (!definition.candidate) continue;
-      if (definition.cpu_only && backend != "cpu") {
-        if (left_out) left_out->push_back(definition.name);
-        continue;
-      }
-      asked.push_back(definition.name);
-    }
+    for (const EffectDefinition& definition : effect_catalogue())
+      if (definition.candidate) asked.push_back(definition.name);
   std::vector<std::string> library;
   for (const std::string& name : asked) {
     const EffectDefinition* definition = find_effect(name);
@@ -209,12 +202,7 @@ ModelFit fit_model(const Scenario& scenario, const ObservationTable& data,
 Diagnosis diagnose(const Scenario& scenario, const ObservationTable& data,
                    const std::optional<TruthTable>& truth, const DiagnoseOptions& options) {
   Diagnosis d;
-  const std::vector<std::string> library = candidate_library(scenario, options.candidates, options.backend, &d.left_out);
-  if (options.log && !d.left_out.empty()) {
-    *options.log << "  not tried on --backend " << options.backend << " (its kernels lack them; --backend cpu tries them):";
-    for (const std::string& name : d.left_out) *options.log << ' ' << name;
-    *options.log << '\n';
-  }
+  const std::vector<std::string> library = candidate_library(scenario, options.candidates);
   auto log_fit = [&](const ModelFit& fit) {
     if (!options.log) return;
     std::string name = "declared model";

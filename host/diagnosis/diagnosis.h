@@ -115,7 +115,6 @@ const char* to_string(DiagnosisOutcome outcome);
 struct Diagnosis {
   std::vector<ModelFit> fits;               // fits[0]: the declared model; then every fit run
   std::vector<DiagnosisRound> rounds;
-  std::vector<std::string> left_out;        // library effects the back end cannot estimate
   std::vector<int> path;                    // the fits along the chosen effects: declared, +1st, ...
   DiagnosisOutcome outcome = DiagnosisOutcome::unexplained;
   std::vector<EffectValue> discovered;      // the effects added, at their final estimates
@@ -134,13 +133,10 @@ ModelFit fit_model(const Scenario& scenario, const ObservationTable& data,
                    const DiagnoseOptions& options, const Eigen::VectorXd& start = {},
                    const Eigen::VectorXd& start_std = {});
 
-// The candidates `names` stand for (empty: every candidate of the library that `backend` can
-// estimate; the physics effects a device back end lacks are appended to `left_out`), a
-// regional family (extra_ligament) once per candidate region of the scenario. Throws
-// InputError for a name outside the library or a region the scenario lacks.
-std::vector<std::string> candidate_library(const Scenario& scenario, const std::vector<std::string>& names,
-                                           const std::string& backend = "cpu",
-                                           std::vector<std::string>* left_out = nullptr);
+// The candidates `names` stand for (empty: every candidate of the library), a regional family
+// (extra_ligament) once per candidate region of the scenario. Throws InputError for a name
+// outside the library or a region the scenario lacks.
+std::vector<std::string> candidate_library(const Scenario& scenario, const std::vector<std::string>& names);
 
 // The rounds above. Throws InputError for a scenario without a filter block, an unknown
 // candidate, or data that does not fit the scenario.

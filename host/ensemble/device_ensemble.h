@@ -28,10 +28,9 @@ class DeviceEnsemble : public Ensemble {
   // "opencl single on <device>", for messages and reports.
   virtual std::string description() const = 0;
 
-  // Per sigma point s, physics effects on top of the model (diagnose's candidates: gravity,
-  // time_lag, ligament_law; one entry per sigma point), kept until changed. Throws InputError
-  // for young_scale or damping_scale other than 1 (the kernels share the element stiffness
-  // and the damping; check_device_physics_effects).
+  // Per sigma point s, physics effects on top of the model (diagnose's candidates; one entry
+  // per sigma point), kept until changed: per-sigma constants of each step
+  // (kernels/shared/step_constants.h).
   virtual void set_physics_effects(const std::vector<PhysicsEffects>& effects) = 0;
 };
 

@@ -24,10 +24,6 @@ EffectEnsemble::EffectEnsemble(std::unique_ptr<Ensemble> inner, const std::vecto
     if (std::count(effects.begin(), effects.end(), name) > 1) throw InputError("effect " + name + ": listed twice");
     if (definition->side == EffectSide::physics && !cpu_ && !device_)
       throw std::invalid_argument("EffectEnsemble: effect " + name + " needs a CPU or device ensemble");
-    if (definition->cpu_only && !cpu_)
-      throw InputError("effect " + name + ": estimating it per sigma point needs the cpu back end (the device "
-                       "kernels share the element stiffness and the damping between sigma points); run with "
-                       "--backend cpu");
     effects_.push_back(definition);
     effect_parameter_count_ += static_cast<int>(definition->parameters.size());
     if (definition->side == EffectSide::ligament) --declared_count_;

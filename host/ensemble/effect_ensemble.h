@@ -6,9 +6,8 @@
 // coordinates], the coordinate of an effect parameter being (u - prior_mean) / prior_std with
 // u = log(value) or value (its transform): prior N(0, 1) for every effect coordinate.
 //   physics effects (gravity, young_scale, ligament_law, time_lag, damping_scale): per sigma
-//     point through set_physics_effects of the CPU or the device ensemble; young_scale and
-//     damping_scale (cpu_only) on a device back end are refused with an InputError (its
-//     kernels share the element stiffness and the damping between sigma points);
+//     point through set_physics_effects of the CPU or the device ensemble (per-sigma step
+//     constants there: kernels/shared/step_constants.h);
 //   ligament effects (extra_ligament:REGION): one more estimated ligament of the inner
 //     ensemble (make() appends it to the model), its log-stiffness mapped from the
 //     coordinate: any back end;
@@ -35,8 +34,7 @@ class EffectEnsemble : public Ensemble {
  public:
   // `effects`: names of candidate effects, each at most once. `inner` estimates the declared
   // ligaments, then one ligament per ligament effect, in the order of `effects`. Throws
-  // InputError for an unknown name, one that is not a candidate, or a physics effect on a
-  // non-CPU back end.
+  // InputError for an unknown name or one that is not a candidate.
   EffectEnsemble(std::unique_ptr<Ensemble> inner, const std::vector<std::string>& effects);
 
   // The ensemble of `model` on `backend` (make_ensemble) with `effects` estimated: the

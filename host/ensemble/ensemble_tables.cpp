@@ -4,7 +4,6 @@
 #include <cmath>
 #include <stdexcept>
 
-#include "host/common/input_error.h"
 #include "step_constants.h"
 
 namespace sigmafem {
@@ -92,38 +91,31 @@ void set_ligament_stiffness(const Model& model, const std::vector<int>& estimate
 
 std::vector<double> step_constants(const Model& m, const std::vector<PhysicsEffects>& physics,
                                    const SoHistory& history, double cg_tolerance) {
-  const double h = m.dt, a = m.damping.rayleigh_stiffness, b = m.damping.rayleigh_mass;
+  const double h = m.dt;
   const std::size_t S = physics.size();
-  std::vector<double> c(SF_STEP_CONSTANTS + SF_SIGMA_FORCE_COUNT * S);
+  std::vector<double> c(SF_STEP_CONSTANTS + SF_SIGMA_CONSTANT_COUNT * S);
   c[SF_H] = h;
-  c[SF_MASS_FACTOR] = 1.0 + h * b;
-  c[SF_STIFFNESS_FACTOR] = h * (h + a);
-  c[SF_RAYLEIGH_MASS] = b;
-  c[SF_VELOCITY_FACTOR] = h + a;
   c[SF_CG_TOLERANCE2] = cg_tolerance * cg_tolerance;
   for (std::size_t s = 0; s < S; ++s) {
+    const PhysicsEffects& e = physics[s];
     auto at = [&](int k) -> double& { return c[SF_STEP_CONSTANTS + k * S + s]; };
-    const Eigen::Vector3d gravity = m.gravity + physics[s].gravity;
-    const Eigen::Vector3d shift = history.lagged(m.so_lag + physics[s].time_lag) - m.control_start;
-    const double d0 = std::isfinite(physics[s].ligament_d0) ? physics[s].ligament_d0 : m.ligament_d0;
+    const Eigen::Vector3d gravity = m.gravity + e.gravity;
+    const Eigen::Vector3d shift = history.lagged(m.so_lag + e.time_lag) - m.control_start;
+    const double d0 = std::isfinite(e.ligament_d0) ? e.ligament_d0 : m.ligament_d0;
+    const double a = e.damping_stiffness_scale * m.damping.rayleigh_stiffness;
+    const double b = e.damping_mass_scale * m.damping.rayleigh_mass;
     for (int k = 0; k < 3; ++k) {
       at(SF_GRAVITY + k) = gravity[k];
       at(SF_SO_SHIFT + k) = shift[k];
     }
     at(SF_INVERSE_D0_SQUARED) = 1.0 / (d0 * d0);   // 0 for the linear law (infinite d0)
+    at(SF_YOUNG_SCALE) = e.young_scale;
+    at(SF_MASS_FACTOR) = 1.0 + h * b;
+    at(SF_STIFFNESS_FACTOR) = h * (h + a);
+    at(SF_RAYLEIGH_MASS) = b;
+    at(SF_VELOCITY_FACTOR) = h + a;
   }
   return c;
-}
-
-void check_device_physics_effects(const std::vector<PhysicsEffects>& physics, int sigma_count,
-                                  const std::string& who) {
-  if (static_cast<int>(physics.size()) != sigma_count)
-    throw std::invalid_argument(who + "::set_physics_effects: expected one entry per sigma point");
-  for (const PhysicsEffects& e : physics)
-    if (e.young_scale != 1.0 || e.damping_mass_scale != 1.0 || e.damping_stiffness_scale != 1.0)
-      throw InputError(who + ": young_scale and damping_scale per sigma point need the cpu back end (the device "
-                       "kernels share the element stiffness and the damping between sigma points); run with "
-                       "--backend cpu");
 }
 
 RecenteringInputs pack_recentering(const Recentering& r, int S, const char* who) {

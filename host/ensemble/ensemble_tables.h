@@ -64,16 +64,11 @@ void set_ligament_stiffness(const Model& model, const std::vector<int>& estimate
                             std::vector<double>& ligament_k);
 
 // The constants of one step (kernels/shared/step_constants.h), SF_STEP_CONSTANTS +
-// SF_SIGMA_FORCE_COUNT S numbers: the shared ones, then per sigma point s its gravity, SO
-// target shift and the ligament law's 1/d0^2, from the model and physics[s] (gravity,
-// time_lag, ligament_d0). `history` holds the SO up to the end of this step.
+// SF_SIGMA_CONSTANT_COUNT S numbers: the shared ones, then per sigma point s its gravity, SO
+// target shift, the ligament law's 1/d0^2, Young's modulus scale and damping factors, from
+// the model and physics[s]. `history` holds the SO up to the end of this step.
 std::vector<double> step_constants(const Model& model, const std::vector<PhysicsEffects>& physics,
                                    const SoHistory& history, double cg_tolerance);
-
-// The device kernels share the element stiffness and the damping between sigma points: an
-// InputError names an effect of `physics` that would need them per sigma point (young_scale,
-// damping_scale), or a count other than `sigma_count`.
-void check_device_physics_effects(const std::vector<PhysicsEffects>& physics, int sigma_count, const std::string& who);
 
 // The re-centring inputs, packed as the recenter kernels read them: scalars[1 + max p]
 // (alpha, the correction), directions and weights W = C I, each [j S + s]. p is the filter's

@@ -100,7 +100,7 @@ OpenClEnsemble::OpenClEnsemble(const Model& model, std::vector<int> estimated,
     rest_positions_ = make_buffer(tables.rest_positions, "rest positions");
     observed_nodes_ = make_buffer(observed_.empty() ? std::vector<int>{0} : observed_,
                                   "observed nodes");
-    constants_ = make_buffer(kStepConstants + SF_SIGMA_FORCE_COUNT * static_cast<std::size_t>(S_), "step constants");
+    constants_ = make_buffer(kStepConstants + SF_SIGMA_CONSTANT_COUNT * static_cast<std::size_t>(S_), "step constants");
     ligament_k_buffer_ = make_buffer(ligament_k_, "ligament stiffness");
     x_ = make_buffer(tables.initial_positions, "positions");
     const std::vector<double> zeros(dof, 0.0);
@@ -258,7 +258,8 @@ void OpenClEnsemble::write_step_constants(const Eigen::Vector3d& so_position) {
 }
 
 void OpenClEnsemble::set_physics_effects(const std::vector<PhysicsEffects>& effects) {
-  check_device_physics_effects(effects, S_, "OpenClEnsemble");
+  if (static_cast<int>(effects.size()) != S_)
+    throw std::invalid_argument("OpenClEnsemble::set_physics_effects: expected one entry per sigma point");
   physics_ = effects;
 }
 

@@ -18,7 +18,7 @@ const std::vector<EffectDefinition>& effect_catalogue() {
        EffectSide::physics, true, false, "gx,gy,gz (m/s^2, added to the scenario's gravity)", 3,
        {{"gx", "m/s^2", false, 0.0, 2.0}, {"gy", "m/s^2", false, 0.0, 2.0}, {"gz", "m/s^2", false, 0.0, 2.0}}},
       {"young_scale", "a global scale of Young's modulus", EffectSide::physics, true, false,
-       "s (> 0, multiplies material.young_modulus)", 1, {{"scale", "", true, 0.0, 0.5}}, true},
+       "s (> 0, multiplies material.young_modulus)", 1, {{"scale", "", true, 0.0, 0.5}}},
       {"camera_offset", "a rigid translation of the observation frame (camera registration error)",
        EffectSide::observation, true, false, "tx,ty,tz (m, added to every observed position)", 3,
        {{"tx", "m", false, 0.0, 5e-3}, {"ty", "m", false, 0.0, 5e-3}, {"tz", "m", false, 0.0, 5e-3}}},
@@ -40,7 +40,7 @@ const std::vector<EffectDefinition>& effect_catalogue() {
       // within a factor of e.
       {"damping_scale", "a mismatch of the Rayleigh damping: factors on its mass and stiffness coefficients",
        EffectSide::physics, true, false, "am,ak (> 0, multiply damping.rayleigh_mass and damping.rayleigh_stiffness)", 2,
-       {{"am", "", true, 0.0, 1.0}, {"ak", "", true, 0.0, 1.0}}, true},
+       {{"am", "", true, 0.0, 1.0}, {"ak", "", true, 0.0, 1.0}}},
       {"inclusion", "a stiffer (or softer) sphere inside the organ: outside the candidate library",
        EffectSide::physics, false, false, "x,y,z,radius,factor (m, m, > 0: multiplies Young's modulus of the elements whose centroid is inside)",
        5, {}},

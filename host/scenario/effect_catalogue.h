@@ -44,9 +44,6 @@ struct EffectDefinition {
   int value_count = 0;                     // numbers in a value
   // Candidates: the estimated parameters, one per number of the value, same order.
   std::vector<EffectParameter> parameters;
-  // Per sigma point on the CPU back end only: the device kernels share the element
-  // stiffness and the damping between sigma points (young_scale, damping_scale).
-  bool cpu_only = false;
 };
 
 // An effect with its value (natural units), as declared, injected or discovered. The name is

@@ -63,7 +63,7 @@ VulkanEnsemble::VulkanEnsemble(const Model& model, std::vector<int> estimated,
   mass_ = make_buffer(tables.mass, "mass");
   rest_positions_ = make_buffer(tables.rest_positions, "rest positions");
   observed_nodes_ = make_buffer(observed_.empty() ? std::vector<int>{0} : observed_, "observed nodes");
-  constants_ = make_buffer(SF_STEP_CONSTANTS + SF_SIGMA_FORCE_COUNT * static_cast<std::size_t>(S_), "step constants");
+  constants_ = make_buffer(SF_STEP_CONSTANTS + SF_SIGMA_CONSTANT_COUNT * static_cast<std::size_t>(S_), "step constants");
   ligament_k_buffer_ = make_buffer(ligament_k_, "ligament stiffness");
   x_ = make_buffer(tables.initial_positions, "positions");
   const std::vector<double> zeros(dof, 0.0);
@@ -330,7 +330,8 @@ void VulkanEnsemble::predicted_observations(Eigen::MatrixXd& y) const {
 }
 
 void VulkanEnsemble::set_physics_effects(const std::vector<PhysicsEffects>& effects) {
-  check_device_physics_effects(effects, S_, "VulkanEnsemble");
+  if (static_cast<int>(effects.size()) != S_)
+    throw std::invalid_argument("VulkanEnsemble::set_physics_effects: expected one entry per sigma point");
   physics_ = effects;
 }
 

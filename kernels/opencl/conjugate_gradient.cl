@@ -284,11 +284,15 @@ static inline __attribute__((always_inline)) void sf_block_node_product(
     __global const real* restrict element_out, __global real* restrict q) {
   const size_t copy_size = (size_t)3 * node_count * S;
   for (uint n = 0; n < node_count; ++n) {
-    real nodal[SF_BLOCK_MAX];
+    real nodal[SF_BLOCK_MAX];    /* (1 + h b) m + h (h + a) k: the nodal terms of A */
+    real elastic[SF_BLOCK_MAX];  /* h (h + a) times Young's modulus scale, on the elements' K d */
     for (uint i = 0; i < count; ++i) {
       real spring = sf_node_spring(ligament_offsets, ligament_of_node, ligament_k, control_k, n,
                                    first + i, S);
-      nodal[i] = c[SF_MASS_FACTOR] * sf_solver_mass(mass[n], spring) + c[SF_STIFFNESS_FACTOR] * spring;
+      nodal[i] = SF_SIGMA_CONSTANT(c, SF_MASS_FACTOR, first + i, S) * sf_solver_mass(mass[n], spring) +
+                 SF_SIGMA_CONSTANT(c, SF_STIFFNESS_FACTOR, first + i, S) * spring;
+      elastic[i] = SF_SIGMA_CONSTANT(c, SF_STIFFNESS_FACTOR, first + i, S) *
+                   SF_SIGMA_CONSTANT(c, SF_YOUNG_SCALE, first + i, S);
     }
     SF_UNROLL
     for (int k = 0; k < 3; ++k) {
@@ -298,7 +302,7 @@ static inline __attribute__((always_inline)) void sf_block_node_product(
       for (uint chunk = 0; chunk < chunks; ++chunk)
         for (uint i = 0; i < count; ++i) sum[i] += element_out[chunk * copy_size + row + i];
       for (uint i = 0; i < count; ++i)
-        q[row + i] = c[SF_STIFFNESS_FACTOR] * sum[i] + nodal[i] * d[row + i];
+        q[row + i] = elastic[i] * sum[i] + nodal[i] * d[row + i];
     }
   }
 }

@@ -2,10 +2,12 @@
  * side and of the Jacobi diagonal, per sigma point, in one pass over the elements (host:
  * element_frames, ImplicitEulerSystem::right_hand_side and ::diagonal):
  *   frame  = the element's QR frame at x   (stored: every CG product of the step uses it)
- *   rhs_e  = f_e(x) - (h + a) K_e v_e      (elastic force and the stiffness-damping product)
+ *   rhs_e  = f_e(x) - (h + a) K_e v_e      (elastic force and the stiffness-damping product;
+ *                                           h + a per sigma point, step_constants.h)
  *   diag_e = diag(R K_e R^T)
  * The node kernel (node_assembly.cl) sums them over the incident elements and adds the
- * nodal terms (mass, springs, gravity). Work-items as in element_product.cl. */
+ * nodal terms (mass, springs, gravity) and a sigma point's Young's modulus scale (the
+ * products are linear in it). Work-items as in element_product.cl. */
 #include "ensemble_layout.h"
 
 __kernel void element_rhs(uint S, uint element_count, __global const int* restrict nodes,
@@ -36,7 +38,7 @@ __kernel void element_rhs(uint S, uint element_count, __global const int* restri
     sf_gather_corners(v, corner_nodes, s, S, corner);
     sf_element_product(frame, grad, vlambda, vmu, corner, product);
     SF_UNROLL
-    for (int i = 0; i < 12; ++i) force[i] -= c[SF_VELOCITY_FACTOR] * product[i];
+    for (int i = 0; i < 12; ++i) force[i] -= SF_SIGMA_CONSTANT(c, SF_VELOCITY_FACTOR, s, S) * product[i];
     sf_store_corners(rhs_out, e, s, S, force);
     sf_element_diagonal(frame, grad, vlambda, vmu, product);
     sf_store_corners(diagonal_out, e, s, S, product);

@@ -30,6 +30,7 @@ __kernel void node_rhs(uint S, uint node_count, __global const real* c,
     u2 += u * u;
   }
   real law = (spring - control_k[n]) * u2 * at[SF_INVERSE_D0_SQUARED * S];
+  real young = at[SF_YOUNG_SCALE * S];
   SF_UNROLL
   for (int k = 0; k < 3; ++k) {
     size_t row = ((size_t)3 * n + k) * S + s;
@@ -37,16 +38,16 @@ __kernel void node_rhs(uint S, uint node_count, __global const real* c,
     real vr = v[row];
     /* elastic force and (h + a) K v from the elements; springs pull towards rest (control
      * springs towards rest + so_shift); the springs' own (h + a) k v term. */
-    real f = sf_corner_sum(element_rhs_out, incidence_offsets, incidence, n, k, s, S);
+    real f = young * sf_corner_sum(element_rhs_out, incidence_offsets, incidence, n, k, s, S);
     real u = xr - rest_positions[3 * n + k];
     f -= spring * u - control_k[n] * at[(SF_SO_SHIFT + k) * S];
     f -= law * u;
     f += mass[n] * at[(SF_GRAVITY + k) * S];
-    f -= c[SF_VELOCITY_FACTOR] * spring * vr;
-    rhs[row] = c[SF_H] * (f - c[SF_RAYLEIGH_MASS] * m * vr);
-    real diagonal = sf_corner_sum(element_diagonal, incidence_offsets, incidence, n, k, s, S);
+    f -= at[SF_VELOCITY_FACTOR * S] * spring * vr;
+    rhs[row] = c[SF_H] * (f - at[SF_RAYLEIGH_MASS * S] * m * vr);
+    real diagonal = young * sf_corner_sum(element_diagonal, incidence_offsets, incidence, n, k, s, S);
     inverse_diagonal[row] =
-        (real)1 / (c[SF_MASS_FACTOR] * m + c[SF_STIFFNESS_FACTOR] * (diagonal + spring));
+        (real)1 / (at[SF_MASS_FACTOR * S] * m + at[SF_STIFFNESS_FACTOR * S] * (diagonal + spring));
   }
 }
 
@@ -89,8 +90,11 @@ __kernel void node_product(uint S, uint node_count, __global const real* restric
     }
 #endif
     for (uint b = 0; b < SF_SIGMA_BLOCK; ++b) {
+      uint s = first + b;
       real db = d[row + b];
-      q[row + b] = c[SF_STIFFNESS_FACTOR] * (sum[b] + spring[b] * db) + c[SF_MASS_FACTOR] * m[b] * db;
+      q[row + b] = SF_SIGMA_CONSTANT(c, SF_STIFFNESS_FACTOR, s, S) *
+                       (SF_SIGMA_CONSTANT(c, SF_YOUNG_SCALE, s, S) * sum[b] + spring[b] * db) +
+                   SF_SIGMA_CONSTANT(c, SF_MASS_FACTOR, s, S) * m[b] * db;
     }
   }
 }

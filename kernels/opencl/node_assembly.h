@@ -3,7 +3,9 @@
  * no atomics), and the node's springs and mass in the implicit Euler system
  *   A = (1 + h b) M + h (h + a) K,   K = elastic tangent + springs on the diagonal.
  * Springs: a node's stiffness is the sum of its ligaments' per-node stiffness (which differs
- * between sigma points: ligament_k[l * S + s]) and its control stiffness (shared). */
+ * between sigma points: ligament_k[l * S + s]) and its control stiffness (shared). The
+ * factors of A, the damping and Young's modulus scale are per sigma point
+ * (SF_SIGMA_CONSTANT, step_constants.h): the elements' K d is scaled where it is gathered. */
 #ifndef SIGMAFEM_NODE_ASSEMBLY_H
 #define SIGMAFEM_NODE_ASSEMBLY_H
 
@@ -34,17 +36,6 @@ static inline real sf_node_spring(__global const int* ligament_offsets,
  * its rows of A are not zero (as in ImplicitEulerSystem). */
 static inline real sf_solver_mass(real mass, real spring) {
   return (mass == (real)0 && spring == (real)0) ? (real)1 : mass;
-}
-
-/* Row `row` (= 3 n + k) of A d for sigma point s, from the element products already
- * gathered-ready in element_out (element_product.cl), the spring and the solver mass. */
-static inline real sf_system_row(__global const real* c, __global const real* element_out,
-                                 __global const int* incidence_offsets,
-                                 __global const int* incidence, real spring, real m,
-                                 __global const real* d, uint n, int k, uint s, uint S) {
-  size_t row = ((size_t)3 * n + k) * S + s;
-  real Kd = sf_corner_sum(element_out, incidence_offsets, incidence, n, k, s, S) + spring * d[row];
-  return c[SF_STIFFNESS_FACTOR] * Kd + c[SF_MASS_FACTOR] * m * d[row];
 }
 
 #endif /* SIGMAFEM_NODE_ASSEMBLY_H */

@@ -2,23 +2,28 @@
  * writes each step (a buffer, not a struct argument, so that host and device never disagree
  * on padding). Shared by the host (host/ensemble/ensemble_tables.cpp), the OpenCL kernels and
  * the Vulkan shaders: one numbering. After the SF_STEP_CONSTANTS shared numbers come
- * SF_SIGMA_FORCE_COUNT numbers per sigma point s, at [SF_STEP_CONSTANTS + k S + s]: the loads
- * that the candidate effects (host/model/effects.h) may set per sigma point. */
+ * SF_SIGMA_CONSTANT_COUNT numbers per sigma point s, at [SF_STEP_CONSTANTS + k S + s]
+ * (SF_SIGMA_CONSTANT): what the candidate effects (host/model/effects.h) may set per sigma
+ * point, from the model's values and the sigma point's effects. */
 #ifndef SIGMAFEM_STEP_CONSTANTS_H
 #define SIGMAFEM_STEP_CONSTANTS_H
 
 #define SF_H 0                 /* time step h */
-#define SF_MASS_FACTOR 1       /* 1 + h b */
-#define SF_STIFFNESS_FACTOR 2  /* h (h + a) */
-#define SF_RAYLEIGH_MASS 3     /* b */
-#define SF_VELOCITY_FACTOR 4   /* h + a */
-#define SF_CG_TOLERANCE2 5     /* squared relative CG tolerance */
-#define SF_STEP_CONSTANTS 6
+#define SF_CG_TOLERANCE2 1     /* squared relative CG tolerance */
+#define SF_STEP_CONSTANTS 2
 
 /* Per sigma point, k: */
-#define SF_GRAVITY 0           /* 3 numbers: gravity (m/s^2) */
-#define SF_SO_SHIFT 3          /* 3 numbers: the control target shift so(t_{n+1} - lag) - so(0) */
+#define SF_GRAVITY 0             /* 3 numbers: gravity (m/s^2) */
+#define SF_SO_SHIFT 3            /* 3 numbers: the control target shift so(t_{n+1} - lag) - so(0) */
 #define SF_INVERSE_D0_SQUARED 6  /* 1/d0^2 of the ligament law k u (1 + |u|^2/d0^2); 0: linear */
-#define SF_SIGMA_FORCE_COUNT 7
+#define SF_YOUNG_SCALE 7         /* multiplies the elastic forces and products (young_scale) */
+#define SF_MASS_FACTOR 8         /* 1 + h b, with Rayleigh damping B = a K + b M */
+#define SF_STIFFNESS_FACTOR 9    /* h (h + a) */
+#define SF_RAYLEIGH_MASS 10      /* b */
+#define SF_VELOCITY_FACTOR 11    /* h + a */
+#define SF_SIGMA_CONSTANT_COUNT 12
+
+/* Constant k of sigma point s, with S sigma points, in the buffer c. */
+#define SF_SIGMA_CONSTANT(c, k, s, S) ((c)[SF_STEP_CONSTANTS + (k) * (S) + (s)])
 
 #endif /* SIGMAFEM_STEP_CONSTANTS_H */

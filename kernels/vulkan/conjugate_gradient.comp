@@ -73,7 +73,7 @@ void main() {
     SF_CORNER_SUMS(element_out, n, s, S, Kd)
     for (uint k = 0u; k < 3u; ++k) {
       uint row = (3u * n + k) * S + s;
-      real q = sf_system_row(Kd[k], spring, m, x[row]);
+      real q = sf_system_row(Kd[k], spring, m, x[row], s, S);
       real bi = b[row];
       real ri = bi - q;
       real zi = inverse_diagonal[row] * ri;

@@ -39,7 +39,7 @@ void main() {
   sf_element_force(frame, grad, vlambda, vmu, corner, force);
   SF_GATHER_CORNERS(v, corner_nodes, s, S, corner)
   sf_element_product(frame, grad, vlambda, vmu, corner, product);
-  for (uint i = 0u; i < 12u; ++i) force[i] -= c[SF_VELOCITY_FACTOR] * product[i];
+  for (uint i = 0u; i < 12u; ++i) force[i] -= SF_SIGMA_CONSTANT(c, SF_VELOCITY_FACTOR, s, S) * product[i];
   SF_STORE_CORNERS(rhs_out, e, s, S, force)
   sf_element_diagonal(frame, grad, vlambda, vmu, product);
   SF_STORE_CORNERS(diagonal_out, e, s, S, product)

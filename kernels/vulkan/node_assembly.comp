@@ -42,21 +42,22 @@ void main() {
     u2 += u * u;
   }
   real law = (spring - control_k[n]) * u2 * c[at + SF_INVERSE_D0_SQUARED * S];
+  real young = c[at + SF_YOUNG_SCALE * S];
   for (uint k = 0u; k < 3u; ++k) {
     uint row = (3u * n + k) * S + s;
     real xr = x[row];
     real vr = v[row];
     /* elastic force and (h + a) K v from the elements; springs pull towards rest (control
      * springs towards rest + so_shift); the springs' own (h + a) k v term. */
-    real f = f_elements[k];
+    real f = young * f_elements[k];
     real u = xr - rest_positions[3u * n + k];
     f -= spring * u - control_k[n] * c[at + (SF_SO_SHIFT + k) * S];
     f -= law * u;
     f += mass[n] * c[at + (SF_GRAVITY + k) * S];
-    f -= c[SF_VELOCITY_FACTOR] * spring * vr;
-    rhs[row] = c[SF_H] * (f - c[SF_RAYLEIGH_MASS] * m * vr);
-    inverse_diagonal[row] =
-        real(1) / (c[SF_MASS_FACTOR] * m + c[SF_STIFFNESS_FACTOR] * (diagonal[k] + spring));
+    f -= c[at + SF_VELOCITY_FACTOR * S] * spring * vr;
+    rhs[row] = c[SF_H] * (f - c[at + SF_RAYLEIGH_MASS * S] * m * vr);
+    inverse_diagonal[row] = real(1) / (c[at + SF_MASS_FACTOR * S] * m +
+                                       c[at + SF_STIFFNESS_FACTOR * S] * (young * diagonal[k] + spring));
   }
 }
 
@@ -77,7 +78,7 @@ void main() {
   SF_CORNER_SUMS(element_out, n, s, S, sum)
   for (uint k = 0u; k < 3u; ++k) {
     uint row = (3u * n + k) * S + s;
-    q[row] = sf_system_row(sum[k], spring, m, d[row]);
+    q[row] = sf_system_row(sum[k], spring, m, d[row], s, S);
   }
 }
 

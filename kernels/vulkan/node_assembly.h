@@ -53,9 +53,12 @@ real sf_solver_mass(real m, real spring) {
   return (m == real(0) && spring == real(0)) ? real(1) : m;
 }
 
-/* Row 3 n + k of A d for sigma point s, from the gathered element products Kd_elements. */
-real sf_system_row(real Kd_elements, real spring, real m, real d_row) {
-  return c[SF_STIFFNESS_FACTOR] * (Kd_elements + spring * d_row) + c[SF_MASS_FACTOR] * m * d_row;
+/* Row 3 n + k of A d for sigma point s, from the gathered element products Kd_elements; the
+ * factors of A and Young's modulus scale are the sigma point's (step_constants.h). */
+real sf_system_row(real Kd_elements, real spring, real m, real d_row, uint s, uint S) {
+  return SF_SIGMA_CONSTANT(c, SF_STIFFNESS_FACTOR, s, S) *
+             (SF_SIGMA_CONSTANT(c, SF_YOUNG_SCALE, s, S) * Kd_elements + spring * d_row) +
+         SF_SIGMA_CONSTANT(c, SF_MASS_FACTOR, s, S) * m * d_row;
 }
 
 #endif /* SIGMAFEM_VULKAN_NODE_ASSEMBLY_H */
