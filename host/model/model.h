@@ -1,8 +1,9 @@
 // Model: everything the simulation needs that does not change during a run, built once from
 // a scenario (or from a mesh and a material, for tests): rest shape, per-element rest
 // stiffness K_e in the element's rest frame, lumped mass, damping, springs and time step.
-// Only the spring stiffnesses differ between the sigma points of an ensemble; everything
-// here is shared by them (ARCHITECTURE.md, "The ensemble on a device").
+// Only the spring stiffnesses (and the candidate effects of host/model/effects.h, which
+// `diagnose` estimates) differ between the sigma points of an ensemble; everything here is
+// shared by them (ARCHITECTURE.md, "The ensemble on a device").
 #pragma once
 
 #include <Eigen/Core>
