@@ -283,16 +283,21 @@ static inline __attribute__((always_inline)) void sf_block_node_product(
     __global const real* restrict mass, __global const real* restrict d,
     __global const real* restrict element_out, __global real* restrict q) {
   const size_t copy_size = (size_t)3 * node_count * S;
+  /* The block's factors of A (step_constants.h), read once: the same at every node. */
+  real mass_factor[SF_BLOCK_MAX];     /* 1 + h b */
+  real spring_factor[SF_BLOCK_MAX];   /* h (h + a) */
+  real elastic[SF_BLOCK_MAX];         /* h (h + a) times Young's modulus scale, on the elements' K d */
+  for (uint i = 0; i < count; ++i) {
+    mass_factor[i] = SF_SIGMA_CONSTANT(c, SF_MASS_FACTOR, first + i, S);
+    spring_factor[i] = SF_SIGMA_CONSTANT(c, SF_STIFFNESS_FACTOR, first + i, S);
+    elastic[i] = spring_factor[i] * SF_SIGMA_CONSTANT(c, SF_YOUNG_SCALE, first + i, S);
+  }
   for (uint n = 0; n < node_count; ++n) {
     real nodal[SF_BLOCK_MAX];    /* (1 + h b) m + h (h + a) k: the nodal terms of A */
-    real elastic[SF_BLOCK_MAX];  /* h (h + a) times Young's modulus scale, on the elements' K d */
     for (uint i = 0; i < count; ++i) {
       real spring = sf_node_spring(ligament_offsets, ligament_of_node, ligament_k, control_k, n,
                                    first + i, S);
-      nodal[i] = SF_SIGMA_CONSTANT(c, SF_MASS_FACTOR, first + i, S) * sf_solver_mass(mass[n], spring) +
-                 SF_SIGMA_CONSTANT(c, SF_STIFFNESS_FACTOR, first + i, S) * spring;
-      elastic[i] = SF_SIGMA_CONSTANT(c, SF_STIFFNESS_FACTOR, first + i, S) *
-                   SF_SIGMA_CONSTANT(c, SF_YOUNG_SCALE, first + i, S);
+      nodal[i] = mass_factor[i] * sf_solver_mass(mass[n], spring) + spring_factor[i] * spring;
     }
     SF_UNROLL
     for (int k = 0; k < 3; ++k) {
