@@ -63,12 +63,27 @@ void set_ligament_stiffness(const Model& model, const std::vector<int>& estimate
                             const Eigen::MatrixXd& theta, int sigma_count,
                             std::vector<double>& ligament_k);
 
-// The constants of one step (kernels/shared/step_constants.h), SF_STEP_CONSTANTS +
-// SF_SIGMA_CONSTANT_COUNT S numbers: the shared ones, then per sigma point s its gravity, SO
-// target shift, the ligament law's 1/d0^2, Young's modulus scale and damping factors, from
-// the model and physics[s]. `history` holds the SO up to the end of this step.
-std::vector<double> step_constants(const Model& model, const std::vector<PhysicsEffects>& physics,
-                                   const SoHistory& history, double cg_tolerance);
+// The constants of each step of a device ensemble (kernels/shared/step_constants.h),
+// SF_STEP_CONSTANTS + SF_SIGMA_CONSTANT_COUNT S numbers: the shared ones, then per sigma point
+// s its gravity, SO target shift, the ligament law's 1/d0^2, Young's modulus scale and damping
+// factors, from the model and the sigma point's physics effects (identity until set). Keeps
+// the SO history the lags need.
+class StepConstants {
+ public:
+  StepConstants(const Model& model, int sigma_count, double cg_tolerance);   // model: so(0), dt
+  // One entry per sigma point (DeviceEnsemble::set_physics_effects); `who` names the caller
+  // in the error for a wrong count.
+  void set_physics_effects(const std::vector<PhysicsEffects>& effects, const std::string& who);
+  // The constants of the next step of `model` (the one given at construction), whose SO is at
+  // `so_position` at its end.
+  std::vector<double> next_step(const Model& model, const Eigen::Vector3d& so_position);
+  std::size_t size() const;
+
+ private:
+  std::vector<PhysicsEffects> physics_;
+  SoHistory so_history_;
+  double cg_tolerance_;
+};
 
 // The re-centring inputs, packed as the recenter kernels read them: scalars[1 + max p]
 // (alpha, the correction), directions and weights W = C I, each [j S + s]. p is the filter's

@@ -13,7 +13,6 @@ namespace sigmafem {
 namespace {
 
 constexpr std::size_t kGroup = 64;        // work-group size of the element and node kernels
-constexpr int kStepConstants = SF_STEP_CONSTANTS;
 constexpr int kMaxParameters = kDeviceMaxParameters;   // SF_MAX_PARAMETERS in recenter.cl
 
 std::size_t round_up(std::size_t n, std::size_t multiple) {
@@ -34,8 +33,7 @@ OpenClEnsemble::OpenClEnsemble(const Model& model, std::vector<int> estimated,
                                const DeviceOptions& options)
     : device_(options.device, options.precision),
       model_(model),
-      physics_(static_cast<std::size_t>(std::max(sigma_count, 0))),
-      so_history_(model.control_start, model.dt),
+      step_constants_(model, sigma_count, device_cg_tolerance(model, options.precision)),
       estimated_(std::move(estimated)),
       observed_(std::move(observed)),
       S_(sigma_count),
@@ -100,7 +98,7 @@ OpenClEnsemble::OpenClEnsemble(const Model& model, std::vector<int> estimated,
     rest_positions_ = make_buffer(tables.rest_positions, "rest positions");
     observed_nodes_ = make_buffer(observed_.empty() ? std::vector<int>{0} : observed_,
                                   "observed nodes");
-    constants_ = make_buffer(kStepConstants + SF_SIGMA_CONSTANT_COUNT * static_cast<std::size_t>(S_), "step constants");
+    constants_ = make_buffer(step_constants_.size(), "step constants");
     ligament_k_buffer_ = make_buffer(ligament_k_, "ligament stiffness");
     x_ = make_buffer(tables.initial_positions, "positions");
     const std::vector<double> zeros(dof, 0.0);
@@ -253,14 +251,11 @@ void OpenClEnsemble::set_parameters(const Eigen::MatrixXd& theta) {
 }
 
 void OpenClEnsemble::write_step_constants(const Eigen::Vector3d& so_position) {
-  so_history_.push(so_position);
-  write(constants_, step_constants(model_, physics_, so_history_, tolerance_));
+  write(constants_, step_constants_.next_step(model_, so_position));
 }
 
 void OpenClEnsemble::set_physics_effects(const std::vector<PhysicsEffects>& effects) {
-  if (static_cast<int>(effects.size()) != S_)
-    throw std::invalid_argument("OpenClEnsemble::set_physics_effects: expected one entry per sigma point");
-  physics_ = effects;
+  step_constants_.set_physics_effects(effects, "OpenClEnsemble");
 }
 
 void OpenClEnsemble::run(cl::Kernel& kernel, std::size_t items, std::size_t local) const {

@@ -14,8 +14,8 @@
 #include <vector>
 
 #include "host/ensemble/device_ensemble.h"
+#include "host/ensemble/ensemble_tables.h"
 #include "host/model/model.h"
-#include "host/model/so_history.h"
 #include "host/opencl/opencl_device.h"
 
 namespace sigmafem {
@@ -74,8 +74,7 @@ class OpenClEnsemble : public DeviceEnsemble {
 
   mutable OpenClDevice device_;
   Model model_;                             // a copy: the ensemble outlives its caller's model
-  std::vector<PhysicsEffects> physics_;     // per sigma point (identity unless diagnose sets them)
-  SoHistory so_history_;                    // for the SO lag (time_lag)
+  StepConstants step_constants_;            // per step, with the per-sigma effects
   std::vector<int> estimated_, observed_;
   int S_ = 0, nodes_ = 0, elements_ = 0;
   double tolerance_ = 0.0;

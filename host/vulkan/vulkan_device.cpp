@@ -560,15 +560,7 @@ void VulkanDevice::download(const VulkanBuffer& buffer, void* data, std::size_t 
   grow(staging_, bytes, VK_BUFFER_USAGE_TRANSFER_SRC_BIT | VK_BUFFER_USAGE_TRANSFER_DST_BIT,
        "a staging buffer");
   VkCommandBuffer cmd = begin();
-  barrier(cmd);
-  VkBufferCopy region{0, 0, bytes};
-  api_->vkCmdCopyBuffer(cmd, buffer.buffer, staging_.buffer, 1, &region);
-  VkMemoryBarrier host{};
-  host.sType = VK_STRUCTURE_TYPE_MEMORY_BARRIER;
-  host.srcAccessMask = VK_ACCESS_TRANSFER_WRITE_BIT;
-  host.dstAccessMask = VK_ACCESS_HOST_READ_BIT;
-  api_->vkCmdPipelineBarrier(cmd, VK_PIPELINE_STAGE_TRANSFER_BIT, VK_PIPELINE_STAGE_HOST_BIT, 0, 1,
-                             &host, 0, nullptr, 0, nullptr);
+  copy_for_host(cmd, buffer, staging_, 0, bytes);
   submit_and_wait(cmd);
   std::memcpy(data, staging_.map, bytes);
 }
@@ -729,9 +721,14 @@ void VulkanDevice::copy_to_host(VkCommandBuffer cmd, const VulkanBuffer& buffer,
                                 std::size_t offset) {
   if (offset + bytes > read_back_.bytes)
     throw std::logic_error("VulkanDevice::copy_to_host: read-back area too small");
-  barrier(cmd);
+  copy_for_host(cmd, buffer, read_back_, offset, bytes);
+}
+
+void VulkanDevice::copy_for_host(VkCommandBuffer cmd, const VulkanBuffer& from, const HostBuffer& to,
+                                 std::size_t offset, std::size_t bytes) {
+  barrier(cmd);   // after the shaders' writes
   VkBufferCopy region{0, offset, bytes};
-  api_->vkCmdCopyBuffer(cmd, buffer.buffer, read_back_.buffer, 1, &region);
+  api_->vkCmdCopyBuffer(cmd, from.buffer, to.buffer, 1, &region);
   VkMemoryBarrier host{};
   host.sType = VK_STRUCTURE_TYPE_MEMORY_BARRIER;
   host.srcAccessMask = VK_ACCESS_TRANSFER_WRITE_BIT;

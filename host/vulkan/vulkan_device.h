@@ -144,6 +144,10 @@ class VulkanDevice {
   // Makes `host` at least `bytes` long (a new buffer if it is shorter; its contents go).
   void grow(HostBuffer& host, std::size_t bytes, VkBufferUsageFlags usage, const char* what);
   void destroy(HostBuffer& host);
+  // Records a copy of `bytes` of `from` into `to` at `offset`, between the barriers that make
+  // the shaders' writes visible to the copy and the copy visible to the host.
+  void copy_for_host(VkCommandBuffer cmd, const VulkanBuffer& from, const HostBuffer& to, std::size_t offset,
+                     std::size_t bytes);
   HostBuffer staging_;
   HostBuffer read_back_;
 };

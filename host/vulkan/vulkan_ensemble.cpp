@@ -25,8 +25,7 @@ VulkanEnsemble::VulkanEnsemble(const Model& model, std::vector<int> estimated,
                                const DeviceOptions& options)
     : device_(options.device, options.precision),
       model_(model),
-      physics_(static_cast<std::size_t>(std::max(sigma_count, 0))),
-      so_history_(model.control_start, model.dt),
+      step_constants_(model, sigma_count, device_cg_tolerance(model, options.precision)),
       estimated_(std::move(estimated)),
       observed_(std::move(observed)),
       S_(sigma_count),
@@ -63,7 +62,7 @@ VulkanEnsemble::VulkanEnsemble(const Model& model, std::vector<int> estimated,
   mass_ = make_buffer(tables.mass, "mass");
   rest_positions_ = make_buffer(tables.rest_positions, "rest positions");
   observed_nodes_ = make_buffer(observed_.empty() ? std::vector<int>{0} : observed_, "observed nodes");
-  constants_ = make_buffer(SF_STEP_CONSTANTS + SF_SIGMA_CONSTANT_COUNT * static_cast<std::size_t>(S_), "step constants");
+  constants_ = make_buffer(step_constants_.size(), "step constants");
   ligament_k_buffer_ = make_buffer(ligament_k_, "ligament stiffness");
   x_ = make_buffer(tables.initial_positions, "positions");
   const std::vector<double> zeros(dof, 0.0);
@@ -241,8 +240,7 @@ StepReport VulkanEnsemble::advance(const Eigen::Vector3d& so_position) {
   // The right-hand side, the warm start and the first batch of iterations: as many as the
   // last step needed (warm-started steps need about the same).
   VkCommandBuffer cmd = device_.begin();
-  so_history_.push(so_position);
-  const std::vector<unsigned char> constants = to_device(step_constants(model_, physics_, so_history_, tolerance_));
+  const std::vector<unsigned char> constants = to_device(step_constants_.next_step(model_, so_position));
   device_.update(cmd, constants_, constants.data(), constants.size());
   device_.barrier(cmd);
   dispatch_items(cmd, k_element_rhs_, s_element_rhs_, elements_ * S, elements_);
@@ -330,9 +328,7 @@ void VulkanEnsemble::predicted_observations(Eigen::MatrixXd& y) const {
 }
 
 void VulkanEnsemble::set_physics_effects(const std::vector<PhysicsEffects>& effects) {
-  if (static_cast<int>(effects.size()) != S_)
-    throw std::invalid_argument("VulkanEnsemble::set_physics_effects: expected one entry per sigma point");
-  physics_ = effects;
+  step_constants_.set_physics_effects(effects, "VulkanEnsemble");
 }
 
 void VulkanEnsemble::recenter(const Recentering& r) {

@@ -18,8 +18,8 @@
 #include <vector>
 
 #include "host/ensemble/device_ensemble.h"
+#include "host/ensemble/ensemble_tables.h"
 #include "host/model/model.h"
-#include "host/model/so_history.h"
 #include "host/vulkan/vulkan_device.h"
 
 namespace sigmafem {
@@ -77,8 +77,7 @@ class VulkanEnsemble : public DeviceEnsemble {
 
   mutable VulkanDevice device_;
   Model model_;
-  std::vector<PhysicsEffects> physics_;     // per sigma point (identity unless diagnose sets them)
-  SoHistory so_history_;                    // for the SO lag (time_lag)
+  StepConstants step_constants_;            // per step, with the per-sigma effects
   std::vector<int> estimated_, observed_;
   int S_ = 0, nodes_ = 0, elements_ = 0;
   double tolerance_ = 0.0;
