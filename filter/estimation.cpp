@@ -36,6 +36,12 @@ EstimationRun run_estimation(Ensemble& ensemble, const EstimationOptions& option
     step.normalised_innovation = result.normalised_innovation;
     step.log_det_innovation_covariance = result.log_det_innovation_covariance;
     step.observed_rows = result.observed_rows;
+    step.noise_scale = result.noise_scale;
+    step.unexplained_ratio = result.unexplained_ratio;
+    if (result.noise_scale > 1.0) {
+      if (run.noise_scaled_steps++ == 0) run.first_noise_scaled_step = step.step;
+      run.max_noise_scale = std::max(run.max_noise_scale, result.noise_scale);
+    }
     step.innovation = Eigen::VectorXd::Constant(points.cols(), NAN);
     step.innovation_std = Eigen::VectorXd::Constant(points.cols(), NAN);
     for (std::size_t j = 0; j < result.observed_indices.size(); ++j) {
@@ -46,7 +52,9 @@ EstimationRun run_estimation(Ensemble& ensemble, const EstimationOptions& option
     for (std::size_t s = 0; s < result.ensemble.cg_iterations.size(); ++s)
       step.max_cg_iterations = std::max(step.max_cg_iterations, result.ensemble.cg_iterations[s]);
     step.unconverged_sigma_points = result.ensemble.unconverged_count();
-    step.change_detected = detector.update(result.normalised_innovation, result.observed_rows);
+    // The NIS under the R the correction used: a steady model error, which the adaptive noise
+    // absorbs, is not a sequence of sudden changes.
+    step.change_detected = detector.update(result.adapted_normalised_innovation, result.observed_rows);
     if (step.change_detected) {
       filter.inflate(options.detector.inflation_log_std);
       ++run.changes_detected;

@@ -44,6 +44,10 @@ struct EstimationStep {
   Eigen::VectorXd innovation_std;
   double normalised_innovation = 0.0;
   double log_det_innovation_covariance = 0.0;   // log det S (Roukf)
+  // The adaptive observation-noise scale of the step's correction (1: nominal R) and the
+  // unexplained-innovation ratio behind it (filter/adaptive_noise.h).
+  double noise_scale = 1.0;
+  double unexplained_ratio = 1.0;
   int observed_rows = 0;
   bool change_detected = false;
   int max_cg_iterations = 0;       // over the sigma points
@@ -56,6 +60,11 @@ struct EstimationRun {
   bool complete = true;
   std::string stop_reason;             // why it stopped early ("" when complete)
   int changes_detected = 0;
+  // The adaptive observation noise (filter/adaptive_noise.h): the steps whose correction used
+  // lambda > 1, the first of them (data row; 0: none) and the largest lambda.
+  int noise_scaled_steps = 0;
+  int first_noise_scaled_step = 0;
+  double max_noise_scale = 1.0;
 };
 
 // `times` (rows), `so` (rows x 3) and `points` (rows x 3m, NaN = missing) are the data;

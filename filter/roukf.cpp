@@ -13,7 +13,8 @@ Roukf::Roukf(const RoukfOptions& options, Ensemble& ensemble)
     : options_(options),
       ensemble_(ensemble),
       points_(make_sigma_points(options.sigma_points,
-                                static_cast<int>(options.initial_theta.size()))) {
+                                static_cast<int>(options.initial_theta.size()))),
+      adaptive_noise_(options.adaptive_noise) {
   const int p = points_.parameter_count();
   if (ensemble.parameter_count() != p || ensemble.sigma_count() != points_.count())
     throw std::invalid_argument("Roukf: the ensemble has " +
@@ -116,12 +117,22 @@ RoukfStep Roukf::step(const Eigen::Vector3d& so_position, const Eigen::VectorXd&
     const Eigen::VectorXd z_bar = alpha * Z.rowwise().sum();
     result.innovation = z_bar;
     result.innovation_rms = std::sqrt(z_bar.squaredNorm() / m);
-    result.normalised_innovation = correct(Z, result.log_det_innovation_covariance);
-    // diag(S) = row norms of HL (H P^- H^T = HL HL^T) plus R's diagonal: what standardises
-    // each row's innovation for the residual diagnostics, at the cost of one m x p product.
+    // HL = alpha sum Z_i I_i^T (m x p): H P^- H^T = HL HL^T for either set.
     const Eigen::MatrixXd HL = alpha * Z * I.transpose();
-    result.innovation_variance = HL.rowwise().squaredNorm().array() +
-                                 options_.observation_std * options_.observation_std;
+    const double variance = options_.observation_std * options_.observation_std;
+    result.noise_scale = adaptive_noise_.update(unexplained_innovation(HL, z_bar, variance, rows, y.size()));
+    result.unexplained_ratio = adaptive_noise_.ratio();
+    correct(Z, 1.0 / (variance * result.noise_scale));
+    result.normalised_innovation = normalised_innovation(Z, z_bar, 1.0 / variance,
+                                                         result.log_det_innovation_covariance);
+    double adapted_log_det = 0.0;
+    result.adapted_normalised_innovation =
+        result.noise_scale == 1.0
+            ? result.normalised_innovation
+            : normalised_innovation(Z, z_bar, 1.0 / (variance * result.noise_scale), adapted_log_det);
+    // diag(S) = row norms of HL plus R's diagonal: what standardises each row's innovation
+    // for the residual diagnostics (nominal R: the diagnostics judge the model as declared).
+    result.innovation_variance = HL.rowwise().squaredNorm().array() + variance;
     theta_ += L_theta_ * correction_;
   }
   result.theta = theta_;
@@ -131,11 +142,10 @@ RoukfStep Roukf::step(const Eigen::Vector3d& so_position, const Eigen::VectorXd&
   return result;
 }
 
-double Roukf::correct(const Eigen::MatrixXd& Z, double& log_det) {
+void Roukf::correct(const Eigen::MatrixXd& Z, double r_inv) {
   const int p = points_.parameter_count(), r = points_.count();
   const Eigen::MatrixXd& I = points_.directions;   // p x r (I^T is the r x p of ROUKF.md)
   const double alpha = points_.alpha;
-  const double r_inv = 1.0 / (options_.observation_std * options_.observation_std);
   const Eigen::VectorXd z_bar = alpha * Z.rowwise().sum();
 
   Eigen::MatrixXd HL_t;   // p x m: HL^T
@@ -163,7 +173,6 @@ double Roukf::correct(const Eigen::MatrixXd& Z, double& log_det) {
   U_inv_ = U_llt.solve(Eigen::MatrixXd::Identity(p, p));
   const Eigen::VectorXd HLt_Rinv_z = r_inv * HL_t * z_bar;
   correction_ = -U_inv_ * HLt_Rinv_z;
-  return normalised_innovation(Z, z_bar, r_inv, log_det);
 }
 
 double Roukf::normalised_innovation(const Eigen::MatrixXd& Z, const Eigen::VectorXd& z_bar,

@@ -18,6 +18,7 @@
 #include <Eigen/Core>
 #include <vector>
 
+#include "filter/adaptive_noise.h"
 #include "filter/ensemble.h"
 #include "filter/sigma_points.h"
 
@@ -35,6 +36,9 @@ struct RoukfOptions {
   Eigen::VectorXd initial_std;          // p: prior std of each theta
   Eigen::VectorXd drift_std;            // p: random-walk std of each theta per step
   double observation_std = 1e-3;        // sqrt of R's diagonal
+  // The correction's R is lambda R when the innovations hold more than the parameters can
+  // explain (filter/adaptive_noise.h): the filter stays stable under model error.
+  AdaptiveNoiseOptions adaptive_noise;
 };
 
 struct RoukfStep {
@@ -50,6 +54,12 @@ struct RoukfStep {
   // -0.5 (NIS + log det S + m log 2 pi), the prediction-error decomposition the residual
   // analysis compares models by. det S = det R det(I + HL^T R^-1 HL) (Sylvester).
   double log_det_innovation_covariance = 0.0;
+  // The adaptive noise scale lambda this step's correction used (1: nominal R), the window's
+  // unexplained-innovation ratio it came from, and the NIS under lambda R (what the change
+  // detector reads; the fields above stay nominal).
+  double noise_scale = 1.0;
+  double unexplained_ratio = 1.0;
+  double adapted_normalised_innovation = 0.0;
   StepReport ensemble;
 };
 
@@ -76,9 +86,9 @@ class Roukf {
  private:
   // P_theta += diag(variance) (p).
   void add_theta_variance(const Eigen::VectorXd& variance);
-  // Kalman correction from the innovations Z (m x r) of the observed rows: sets U_inv_ and
-  // correction_, and returns the normalised innovation squared.
-  double correct(const Eigen::MatrixXd& Z, double& log_det);
+  // Kalman correction from the innovations Z (m x r) of the observed rows with R = I / r_inv:
+  // sets U_inv_ and correction_.
+  void correct(const Eigen::MatrixXd& Z, double r_inv);
   // z^T S^-1 z, and log det S in `log_det`.
   double normalised_innovation(const Eigen::MatrixXd& Z, const Eigen::VectorXd& z_bar,
                                double r_inv, double& log_det) const;
@@ -92,6 +102,7 @@ class Roukf {
   Eigen::VectorXd correction_;          // k of the last correction, applied at re-sampling
   double pending_variance_ = 0.0;       // inflation to add before the next sampling
   Eigen::VectorXd drift_variance_;      // p: q_j^2
+  AdaptiveNoise adaptive_noise_;
 };
 
 }  // namespace sigmafem

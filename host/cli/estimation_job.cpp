@@ -10,6 +10,7 @@
 #include "filter/estimation.h"
 #include "filter/residual_diagnostics.h"
 #include "host/cli/estimation_report.h"
+#include "host/data/csv_format.h"
 #include "host/common/input_error.h"
 #include "host/common/progress.h"
 #include "host/data/observation_table.h"
@@ -104,6 +105,11 @@ void print_estimation_summary(std::ostream& out, const json& summary, const std:
       out << '\n';
     }
   }
+  if (summary["adaptive_noise"]["engaged"].get<bool>())
+    out << "  adaptive noise: engaged on " << summary["adaptive_noise"]["steps"].get<int>() << " steps from step "
+        << summary["adaptive_noise"]["first_step"].get<int>() << ", noise variance scaled by up to "
+        << format_number(summary["adaptive_noise"]["max_scale"].get<double>())
+        << " (the model does not explain the data)\n";
   if (summary["residual"].is_object()) {
     const auto& residual = summary["residual"];
     out << "  residuals: " << residual["verdict"].get<std::string>();

@@ -30,6 +30,22 @@ std::optional<Eigen::MatrixXd> truth_at_steps(const TruthTable& truth,
   return values;
 }
 
+json adaptive_noise_json(const EstimationRun& run) {
+  json j;
+  j["engaged"] = run.noise_scaled_steps > 0;
+  j["steps"] = run.noise_scaled_steps;
+  j["first_step"] = run.noise_scaled_steps > 0 ? json(run.first_noise_scaled_step) : json(nullptr);
+  j["max_scale"] = run.max_noise_scale;
+  j["detail"] = run.noise_scaled_steps == 0
+                    ? "the innovations stayed within what the parameters and the stated noise explain: "
+                      "every correction used the nominal observation noise"
+                    : "the innovations held more than the parameters and the stated noise explain (a model "
+                      "error): on " + std::to_string(run.noise_scaled_steps) + " steps the correction used the "
+                      "observation noise variance scaled by up to " + format_number(run.max_noise_scale) +
+                      " so that the parameters are not driven by it; the residual tests use the nominal noise";
+  return j;
+}
+
 namespace {
 
 std::string estimates_csv(const EstimationReport& report, const EstimationRun& run) {
@@ -40,14 +56,14 @@ std::string estimates_csv(const EstimationReport& report, const EstimationRun& r
   if (!run.complete) out << "# incomplete: " << run.stop_reason << '\n';
   out << "step,time";
   for (const std::string& name : report.names) out << ',' << name << ',' << name << "_std";
-  out << ",innovation_rms,normalised_innovation,change_detected\n";
+  out << ",innovation_rms,normalised_innovation,change_detected,noise_scale\n";
   for (const EstimationStep& step : run.steps) {
     out << step.step << ',' << format_number(step.time);
     for (Eigen::Index j = 0; j < step.stiffness.size(); ++j)
       out << ',' << format_number(step.stiffness[j]) << ',' << format_number(step.stiffness_std[j]);
     out << ',' << (std::isnan(step.innovation_rms) ? "" : format_number(step.innovation_rms)) << ','
-        << format_number(step.normalised_innovation) << ',' << (step.change_detected ? 1 : 0)
-        << '\n';
+        << format_number(step.normalised_innovation) << ',' << (step.change_detected ? 1 : 0) << ','
+        << format_number(step.noise_scale) << '\n';
   }
   return out.str();
 }
@@ -177,6 +193,7 @@ nlohmann::ordered_json write_estimation_report(const EstimationReport& report, c
                        {"total_s", report.total_seconds}};
   summary["cg"] = {{"max_iterations", max_cg}, {"unconverged_sigma_steps", unconverged}};
   summary["changes_detected_at_steps"] = changes;
+  summary["adaptive_noise"] = adaptive_noise_json(run);
   if (truth) {
     Eigen::MatrixXd estimate(static_cast<Eigen::Index>(run.steps.size()),
                              static_cast<Eigen::Index>(report.names.size()));
@@ -199,7 +216,9 @@ nlohmann::ordered_json write_estimation_report(const EstimationReport& report, c
   if (!run.steps.empty() && 3 * report.observed_positions.rows() == series.innovation.cols()) {
     residual = diagnose_residuals(series, report.observed_positions, report.residual);
     const fs::path file = out / "residual.json";
-    write_file_atomically(file.string(), residual_json(*residual, report.residual).dump(2) + "\n");
+    json residual_file = residual_json(*residual, report.residual);
+    residual_file["adaptive_noise"] = summary["adaptive_noise"];
+    write_file_atomically(file.string(), residual_file.dump(2) + "\n");
     summary["residual"] = {{"verdict", to_string(residual->verdict.consistency)},
                            {"failed_tests", residual->verdict.failed()},
                            {"file", file.string()}};

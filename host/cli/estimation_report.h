@@ -38,6 +38,10 @@ std::optional<Eigen::MatrixXd> truth_at_steps(const TruthTable& truth,
                                               const std::vector<std::string>& names,
                                               const std::vector<int>& steps);
 
+// When and how far the adaptive observation noise engaged (filter/adaptive_noise.h), for
+// summary.json and residual.json.
+nlohmann::ordered_json adaptive_noise_json(const EstimationRun& run);
+
 // Writes every output into report.out_dir (atomically, file by file) and returns the
 // summary. Plots are skipped with a note in the summary when gnuplot is missing.
 nlohmann::ordered_json write_estimation_report(const EstimationReport& report, const EstimationRun& run);

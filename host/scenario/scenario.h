@@ -99,6 +99,14 @@ struct ChangeDetectionSpec {
   std::optional<double> inflation_log_std;
 };
 
+// filter.adaptive_noise: the observation-noise scale under model error
+// (filter/adaptive_noise.h); a field left out keeps the default.
+struct AdaptiveNoiseSpec {
+  std::optional<bool> enabled;
+  std::optional<int> window;
+  std::optional<double> false_alarm;
+};
+
 struct FilterSpec {
   std::vector<int> estimate;        // indices into Scenario::ligaments
   std::vector<double> initial_stiffness;   // median prior stiffness per estimated ligament
@@ -107,6 +115,7 @@ struct FilterSpec {
   double observation_std = 0.0;
   std::string sigma_points = "simplex";    // "simplex" or "star"
   ChangeDetectionSpec change_detection;
+  AdaptiveNoiseSpec adaptive_noise;
 };
 
 struct OutputSpec {

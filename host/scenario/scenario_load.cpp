@@ -680,7 +680,7 @@ void read_filter(const Checker& c, const json& root, Scenario& s) {
   const json& filter = root.at("filter");
   c.check_object(filter, "filter",
                  {"estimate", "initial_stiffness", "initial_log_std", "parameter_drift_log_std",
-                  "observation_std", "sigma_points", "change_detection"},
+                  "observation_std", "sigma_points", "change_detection", "adaptive_noise"},
                  {"estimate", "initial_stiffness", "observation_std"});
   FilterSpec spec;
   const json& estimate = c.array(filter.at("estimate"), "filter.estimate");
@@ -746,6 +746,26 @@ void read_filter(const Checker& c, const json& root, Scenario& s) {
     if (detection.contains("inflation_log_std")) {
       d.inflation_log_std = c.number(detection.at("inflation_log_std"), child(path, "inflation_log_std"));
       c.non_negative(*d.inflation_log_std, child(path, "inflation_log_std"));
+    }
+  }
+  if (filter.contains("adaptive_noise")) {
+    const json& adaptive = filter.at("adaptive_noise");
+    const std::string path = "filter.adaptive_noise";
+    c.check_object(adaptive, path, {"enabled", "window", "false_alarm"}, {});
+    AdaptiveNoiseSpec& a = spec.adaptive_noise;
+    if (adaptive.contains("enabled")) {
+      c.require(adaptive.at("enabled").is_boolean(), child(path, "enabled"),
+                "expected true or false, found " + adaptive.at("enabled").dump());
+      a.enabled = adaptive.at("enabled").get<bool>();
+    }
+    if (adaptive.contains("window")) {
+      a.window = c.integer(adaptive.at("window"), child(path, "window"));
+      c.require(*a.window >= 1 && *a.window <= 1000, child(path, "window"), "must be 1..1000 steps");
+    }
+    if (adaptive.contains("false_alarm")) {
+      a.false_alarm = c.number(adaptive.at("false_alarm"), child(path, "false_alarm"));
+      c.require(*a.false_alarm > 0.0 && *a.false_alarm < 0.5, child(path, "false_alarm"),
+                "must be a probability in (0, 0.5)");
     }
   }
   c.require(!s.observations.nodes.empty(), "filter",
