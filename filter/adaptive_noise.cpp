@@ -41,9 +41,19 @@ double residual_correlation(const Eigen::VectorXd& a, const Eigen::VectorXd& b) 
 
 }  // namespace
 
+void AdaptiveNoise::hold(int steps) {
+  held_for_ = steps;
+  window_.clear();
+  correlations_.clear();
+}
+
 double AdaptiveNoise::update(const UnexplainedInnovation& step) {
   scale_ = 1.0;
   if (!options_.enabled) return scale_;
+  if (held_for_ > 0) {
+    --held_for_;
+    return scale_;
+  }
   if (step.degrees_of_freedom > 0 && std::isfinite(step.chi_square)) {
     if (!window_.empty()) correlations_.push_back(residual_correlation(window_.back().residual, step.residual));
     window_.push_back(step);

@@ -30,8 +30,14 @@
 // at most what one step of it holds.
 // What lambda does not change: the innovations, S and the NIS that the residual diagnostics
 // and the likelihood read stay nominal (sigma^2), so a model that needed lambda > 1 is still
-// called inconsistent; only the gain is tempered. The change detector reads the NIS under
-// lambda R, so that a steady model error is not taken for a sequence of cuts.
+// called inconsistent; only the gain is tempered.
+// With the change detector it is one mechanism (filter/estimation.cpp): a jump of the NIS
+// while the model explained the data (lambda = 1 on the step before) is a change of the
+// parameters: the detector opens P and lambda is held at 1 through its hold-off, so that the
+// filter follows (measured on the liver under full gravity: a cut makes the organ swing, a
+// state error the one-step sensitivities do not span, and lambda engaged first and stalled the
+// following). Innovations beyond the band while lambda > 1 are model error: the detector is
+// not armed, and P is not opened again and again by a steady error.
 #pragma once
 
 #include <Eigen/Core>
@@ -65,6 +71,10 @@ class AdaptiveNoise {
   explicit AdaptiveNoise(const AdaptiveNoiseOptions& options) : options_(options) {}
   // Adds one step and returns lambda for its correction (>= 1).
   double update(const UnexplainedInnovation& step);
+  // Holds lambda at 1 for the next `steps` updates and forgets the window: after a detected
+  // change (a cut) the innovations are large while the parameters catch up, and they are
+  // the parameters' to explain (the change detector opened P for it), not model error.
+  void hold(int steps);
   double scale() const { return scale_; }
   // The window's T / d (1 expected for a consistent model), the threshold T was held to,
   // divided by d, and rho.
@@ -77,6 +87,7 @@ class AdaptiveNoise {
   std::deque<UnexplainedInnovation> window_;
   std::deque<double> correlations_;   // lag-1 correlations of the residuals in the window
   double scale_ = 1.0, ratio_ = 1.0, threshold_ratio_ = 1.0, correlation_ = 0.0;
+  int held_for_ = 0;
 };
 
 }  // namespace sigmafem

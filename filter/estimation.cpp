@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <deque>
 #include <sstream>
 #include <stdexcept>
 
@@ -15,6 +16,7 @@ EstimationRun run_estimation(Ensemble& ensemble, const EstimationOptions& option
   Roukf filter(options.roukf, ensemble);
   ChangeDetector detector(options.detector);
   EstimationRun run;
+  std::deque<bool> scaled;   // the last 2W steps: did the correction use lambda > 1?
   for (Eigen::Index k = 1; k < so.rows(); ++k) {
     const auto start = std::chrono::steady_clock::now();
     EstimationStep step;
@@ -52,11 +54,19 @@ EstimationRun run_estimation(Ensemble& ensemble, const EstimationOptions& option
     for (std::size_t s = 0; s < result.ensemble.cg_iterations.size(); ++s)
       step.max_cg_iterations = std::max(step.max_cg_iterations, result.ensemble.cg_iterations[s]);
     step.unconverged_sigma_points = result.ensemble.unconverged_count();
-    // The NIS under the R the correction used: a steady model error, which the adaptive noise
-    // absorbs, is not a sequence of sudden changes.
-    step.change_detected = detector.update(result.adapted_normalised_innovation, result.observed_rows);
+    // One mechanism with the adaptive noise (filter/adaptive_noise.h): a jump of the NIS is a
+    // change of the parameters only if the model explained the data before it, i.e. lambda
+    // stayed 1 over the W steps before the detector's window of W (the adaptive noise, on a
+    // shorter window, may engage inside it); then P opens and lambda stays 1 while the filter
+    // follows. In the first 2W steps there is no such history and the detector is not armed.
+    const auto W = static_cast<std::size_t>(options.detector.window);
+    scaled.push_back(result.noise_scale > 1.0);   // scaled[i]: step k - scaled.size() + 1 + i
+    if (scaled.size() > 2 * W) scaled.pop_front();
+    const bool armed = scaled.size() == 2 * W && std::none_of(scaled.begin(), scaled.begin() + W, [](bool b) { return b; });
+    step.change_detected = detector.update(result.normalised_innovation, result.observed_rows) && armed;
     if (step.change_detected) {
       filter.inflate(options.detector.inflation_log_std);
+      filter.hold_adaptive_noise(options.detector.hold_off);
       ++run.changes_detected;
     }
     step.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();

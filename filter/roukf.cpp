@@ -125,11 +125,6 @@ RoukfStep Roukf::step(const Eigen::Vector3d& so_position, const Eigen::VectorXd&
     correct(Z, 1.0 / (variance * result.noise_scale));
     result.normalised_innovation = normalised_innovation(Z, z_bar, 1.0 / variance,
                                                          result.log_det_innovation_covariance);
-    double adapted_log_det = 0.0;
-    result.adapted_normalised_innovation =
-        result.noise_scale == 1.0
-            ? result.normalised_innovation
-            : normalised_innovation(Z, z_bar, 1.0 / (variance * result.noise_scale), adapted_log_det);
     // diag(S) = row norms of HL plus R's diagonal: what standardises each row's innovation
     // for the residual diagnostics (nominal R: the diagnostics judge the model as declared).
     result.innovation_variance = HL.rowwise().squaredNorm().array() + variance;

@@ -54,12 +54,10 @@ struct RoukfStep {
   // -0.5 (NIS + log det S + m log 2 pi), the prediction-error decomposition the residual
   // analysis compares models by. det S = det R det(I + HL^T R^-1 HL) (Sylvester).
   double log_det_innovation_covariance = 0.0;
-  // The adaptive noise scale lambda this step's correction used (1: nominal R), the window's
-  // unexplained-innovation ratio it came from, and the NIS under lambda R (what the change
-  // detector reads; the fields above stay nominal).
+  // The adaptive noise scale lambda this step's correction used (1: nominal R) and the
+  // window's unexplained-innovation ratio it came from (the fields above stay nominal).
   double noise_scale = 1.0;
   double unexplained_ratio = 1.0;
-  double adapted_normalised_innovation = 0.0;
   StepReport ensemble;
 };
 
@@ -74,6 +72,8 @@ class Roukf {
   // Widens the parameter uncertainty by `log_std` (added in quadrature, like drift) before
   // the next sampling: the change detector's response to a sudden change.
   void inflate(double log_std);
+  // Holds the adaptive noise at lambda = 1 for `steps` steps (AdaptiveNoise::hold).
+  void hold_adaptive_noise(int steps) { adaptive_noise_.hold(steps); }
 
   const SigmaPoints& sigma_points() const { return points_; }
   const Eigen::VectorXd& theta() const { return theta_; }

@@ -144,6 +144,7 @@ json write_diagnosis_report(const Scenario& scenario, const Diagnosis& d, const 
                             {"penalty", number(c.penalty)},
                             {"score", number(c.score)},
                             {"complete", c.complete},
+                            {"steps", c.steps},
                             {"stop_reason", c.stop_reason},
                             {"verdict_with_it", to_string(c.verdict)},
                             {"failed_tests_with_it", failed_details(d.fits[static_cast<std::size_t>(c.fit)])},
@@ -211,8 +212,8 @@ json write_diagnosis_report(const Scenario& scenario, const Diagnosis& d, const 
   md << "\n";
   if (files.contains("residual_before"))
     md << "![residual before](residual_before.png)\n\n![residual after](residual_after.png)\n\n";
-  md << "## Rounds\n\nScore = log-likelihood gain of the innovations with the candidate's parameters "
-        "estimated, minus the BIC penalty 0.5 k log N.\n\n";
+  md << "## Rounds\n\nScore = log-likelihood gain of the innovations over every step with the candidate's "
+        "parameters estimated, minus the BIC penalty 0.5 k log N. A fit that stopped early is not ranked.\n\n";
 
   for (std::size_t r = 0; r < d.rounds.size(); ++r) {
     const DiagnosisRound& round = d.rounds[r];
@@ -226,11 +227,16 @@ json write_diagnosis_report(const Scenario& scenario, const Diagnosis& d, const 
     }
     md << ", innovation RMS " << fixed(1e3 * fit.innovation_rms, 4) << " mm.\n\n";
     if (round.candidates.empty()) continue;
-    md << "| candidate | k | gain | penalty | score | residual with it | estimate |\n|---|---|---|---|---|---|---|\n";
+    md << "| candidate | k | steps | gain | penalty | score | residual with it | estimate |\n"
+          "|---|---|---|---|---|---|---|---|\n";
     for (const CandidateScore& c : round.candidates)
-      md << "| " << c.effect << " | " << c.parameters << " | " << fixed(c.gain, 1) << " | " << fixed(c.penalty, 1)
-         << " | " << fixed(c.score, 1) << (c.complete ? "" : " (diverged)") << " | " << to_string(c.verdict)
-         << " | " << estimate_text(c.estimate) << " |\n";
+      md << "| " << c.effect << " | " << c.parameters << " | " << c.steps
+         << (c.complete ? "" : " (stopped: " + c.stop_reason + "; not ranked)") << " | " << fixed(c.gain, 1)
+         << " | " << fixed(c.penalty, 1) << " | " << fixed(c.score, 1) << " | " << to_string(c.verdict) << " | "
+         << estimate_text(c.estimate) << " |\n";
+    if (!fit.run.complete)
+      md << "\nThe round's model stopped early (" << fit.run.stop_reason
+         << "): the complete candidates are ranked by their own log-likelihood minus the penalty.\n";
     md << "\nChosen: " << (round.chosen.empty() ? std::string("none (no positive score)") : "`" + round.chosen + "`")
        << "\n\n";
   }

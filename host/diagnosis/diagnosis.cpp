@@ -137,7 +137,6 @@ ModelFit fit_model(const Scenario& scenario, const ObservationTable& data,
     const double ll = step.observed_rows == 0 ? 0.0
                                               : -0.5 * (step.normalised_innovation + step.log_det_innovation_covariance +
                                                         step.observed_rows * kLog2Pi);
-    fit.step_log_likelihood.push_back(ll);
     fit.log_likelihood += ll;
     fit.observed_scalars += step.observed_rows;
   }
@@ -227,7 +226,7 @@ Diagnosis diagnose(const Scenario& scenario, const ObservationTable& data,
       d.rounds.push_back(r);
       break;
     }
-    const std::vector<double> base_ll = fit.step_log_likelihood;
+    const double base_ll = fit.log_likelihood;
     const bool base_complete = fit.run.complete;
     const double log_n = std::log(static_cast<double>(std::max<long long>(fit.observed_scalars, 2)));
     for (const std::string& name : library) {
@@ -241,13 +240,18 @@ Diagnosis diagnose(const Scenario& scenario, const ObservationTable& data,
       score.effect = name;
       score.parameters = static_cast<int>(find_effect(name)->parameters.size());
       score.log_likelihood = candidate.log_likelihood;
-      const std::size_t common = std::min(base_ll.size(), candidate.step_log_likelihood.size());
-      for (std::size_t k = 0; k < common; ++k) score.gain += candidate.step_log_likelihood[k] - base_ll[k];
+      score.complete = candidate.run.complete;
+      score.steps = static_cast<int>(candidate.run.steps.size());
       score.penalty = 0.5 * score.parameters * log_n;
-      score.score = score.gain - score.penalty;
-      // A candidate with which the filter diverges explains nothing; one that runs where the
-      // round's model diverged is eligible on its gain over the steps both made.
-      score.complete = candidate.run.complete || (!base_complete && candidate.run.steps.size() > base_ll.size());
+      if (!score.complete) {
+        score.gain = score.score = NAN;
+      } else if (base_complete) {
+        score.gain = candidate.log_likelihood - base_ll;
+        score.score = score.gain - score.penalty;
+      } else {
+        score.gain = NAN;
+        score.score = candidate.log_likelihood - score.penalty;
+      }
       score.stop_reason = candidate.run.stop_reason;
       score.verdict = candidate.residual.verdict.consistency;
       if (!candidate.estimates.empty()) score.estimate = candidate.estimates.back();
@@ -256,9 +260,12 @@ Diagnosis diagnose(const Scenario& scenario, const ObservationTable& data,
     }
     std::sort(r.candidates.begin(), r.candidates.end(), [](const CandidateScore& a, const CandidateScore& b) {
       if (a.complete != b.complete) return a.complete;
+      if (!a.complete) return a.steps > b.steps;
       return a.score > b.score;
     });
-    const bool found = !r.candidates.empty() && r.candidates[0].complete && r.candidates[0].score > 0.0;
+    // A complete candidate improves on a round model that stopped early whatever its score.
+    const bool found = !r.candidates.empty() && r.candidates[0].complete &&
+                       (r.candidates[0].score > 0.0 || !base_complete);
     if (found) {
       r.chosen = r.candidates[0].effect;
       current.push_back(r.chosen);
@@ -268,7 +275,8 @@ Diagnosis diagnose(const Scenario& scenario, const ObservationTable& data,
       d.fits.push_back(fit_model(scenario, data, truth, current, options, start, start_std));
       if (options.log) *options.log << "  refined:";
       log_fit(d.fits.back());
-      d.path.push_back(static_cast<int>(d.fits.size()) - 1);
+      // A refined pass that stopped early does not replace the complete first pass.
+      d.path.push_back(d.fits.back().run.complete ? static_cast<int>(d.fits.size()) - 1 : r.candidates[0].fit);
     }
     d.rounds.push_back(r);
     if (!found) break;

@@ -6,13 +6,18 @@
 //   2. if the verdict is consistent, stop: nothing (more) is missing;
 //   3. else score every candidate effect not yet in the model: the filter's log-likelihood of
 //      the innovations (prediction-error decomposition, sum over steps of
-//      -0.5 (z^T S^-1 z + log det S + m log 2 pi)) with the candidate's parameters estimated,
-//      minus the current model's, minus the BIC penalty 0.5 k log N (k the candidate's
-//      parameters, N the observed scalars). The best positive score is added; none: stop.
-//   4. refine: run the chosen model once more with the prior centred on the first pass's
+//      -0.5 (z^T S^-1 z + log det S + m log 2 pi), S with the nominal R) with the candidate's
+//      parameters estimated, minus the current model's, minus the BIC penalty 0.5 k log N (k
+//      the candidate's parameters, N the observed scalars). Only fits that ran over every step
+//      are compared (a fit that stopped early is listed with its steps and reason, never ranked
+//      by a partial sum); when the round's model itself stopped early, the complete candidates
+//      are ranked by their own log-likelihood minus the penalty. The best positive score is
+//      added; none: stop.
+//   4. refine: run the chosen model once more (always from a complete first pass; if the
+//      refined pass stops early, the first pass stands) with the prior centred on its
 //      estimates, stiffnesses and effects (std: 10 times the posterior std, at least 0.05 in
 //      log-stiffness or effect coordinates, at most the first prior). In the
-//      first pass the sigma points start a prior std apart (gravity 2 m/s^2), which moves the
+//      first pass the sigma points start a prior std apart (gravity 5 m/s^2), which moves the
 //      organ while the filter learns; the filter re-samples positions but not velocities, and
 //      without drift it locks in a small bias (measured on the box: g off by 1%, 4 of its
 //      std, and a rigid residual of 0.05 mm whose t-test fails). The refined pass starts
@@ -49,7 +54,7 @@ struct DiagnoseOptions {
   std::vector<std::string> candidates;      // empty: every candidate of the library
   // The residual tests' options; a burn_in_steps of -1 becomes burn_in_fraction of the steps:
   // 20% rather than the estimate command's 10%, because a candidate's wide prior (gravity:
-  // 2 m/s^2 per axis) moves the state more in the first steps than the declared model does.
+  // 5 m/s^2 per axis) moves the state more in the first steps than the declared model does.
   ResidualDiagnosticsOptions residual;
   double burn_in_fraction = 0.2;
   std::ostream* log = nullptr;              // a line per fit, when set
@@ -70,7 +75,6 @@ struct ModelFit {
   InnovationSeries series;
   ResidualDiagnostics residual;
   double log_likelihood = 0.0;              // over every step with an observed row
-  std::vector<double> step_log_likelihood;  // per filter step made (0 where nothing observed)
   long long observed_scalars = 0;           // N: observed rows summed over steps
   int parameter_count = 0;
   double innovation_rms = 0.0;              // m, over the steps the residual tests use
@@ -89,14 +93,16 @@ struct ModelFit {
 struct CandidateScore {
   std::string effect;
   int parameters = 0;
-  double log_likelihood = 0.0;
-  // Over the model of the round, on the steps both filters made: a model that diverged
-  // (stopped early) is compared on the steps it made, and it cannot explain the rest.
+  double log_likelihood = 0.0;              // over every step (complete fits only compared)
+  // Over the model of the round, both over every step of the data: only complete fits are
+  // compared, never partial sums over different numbers of steps. NaN when the round's model
+  // stopped early: the complete candidates are then ranked by log_likelihood - penalty.
   double gain = 0.0;
   double penalty = 0.0;                     // 0.5 k log N
-  double score = 0.0;                       // gain - penalty
-  bool complete = true;                     // false: the filter with it diverged (not eligible)
-  std::string stop_reason;
+  double score = 0.0;                       // gain - penalty (or log_likelihood - penalty)
+  bool complete = true;                     // false: the filter with it stopped (not eligible)
+  int steps = 0;                            // filter steps it made
+  std::string stop_reason;                  // why it stopped ("" when complete)
   Consistency verdict = Consistency::too_few_steps;
   EffectEstimate estimate;
   int fit = -1;                             // index into Diagnosis::fits

@@ -10,13 +10,15 @@
 namespace sigmafem {
 
 const std::vector<EffectDefinition>& effect_catalogue() {
-  // Priors: wide enough to hold the effects a real set-up has (a patient in any orientation:
-  // |g| up to 9.81 m/s^2; a registration error of millimetres; a modulus off by a factor of
-  // up to ~3), narrow enough that the first sigma points stay physical.
+  // Priors: wide enough to hold the effects a real set-up has at full size (issue 13: a
+  // patient in any orientation, |g| = 9.81 m/s^2 in any direction, is at most 2 std on its
+  // largest axis; camera registration errors up to 5 mm, 1 std per axis; tracking latencies
+  // up to 0.15 s, 1.1 std; a modulus off by a factor of up to ~3), narrow enough that the
+  // first sigma points stay physical.
   static const std::vector<EffectDefinition> catalogue = {
       {"gravity", "gravity the model lacks (a vector: the patient may lie in any orientation)",
        EffectSide::physics, true, false, "gx,gy,gz (m/s^2, added to the scenario's gravity)", 3,
-       {{"gx", "m/s^2", false, 0.0, 2.0}, {"gy", "m/s^2", false, 0.0, 2.0}, {"gz", "m/s^2", false, 0.0, 2.0}}},
+       {{"gx", "m/s^2", false, 0.0, 5.0}, {"gy", "m/s^2", false, 0.0, 5.0}, {"gz", "m/s^2", false, 0.0, 5.0}}},
       {"young_scale", "a global scale of Young's modulus", EffectSide::physics, true, false,
        "s (> 0, multiplies material.young_modulus)", 1, {{"scale", "", true, 0.0, 0.5}}},
       {"camera_offset", "a rigid translation of the observation frame (camera registration error)",
