@@ -1,4 +1,5 @@
-// `sigmafem generate SCENARIO --out DIR [--seed N] [--vtk-every K]`: synthetic data.
+// `sigmafem generate SCENARIO --out DIR [--seed N] [--vtk-every K] [--truth-refine N |
+// --truth-mesh FILE]`: synthetic data.
 #include <iostream>
 #include <memory>
 
@@ -19,6 +20,8 @@ Action add_generate_command(CLI::App& app) {
     bool quiet = false;
     double noise_std = -1.0;
     std::vector<std::string> inject;
+    int truth_refine = 0;
+    std::string truth_mesh;
   };
   auto options = std::make_shared<Options>();
   CLI::App* sub = app.add_subcommand(
@@ -42,9 +45,23 @@ Action add_generate_command(CLI::App& app) {
                   "effects: " + effect_names() + ". Recorded in truth.json")
       ->expected(1)
       ->multi_option_policy(CLI::MultiOptionPolicy::TakeAll);
+  sub->add_option("--truth-refine", options->truth_refine,
+                  "Simulate the truth on the scenario's mesh refined N more levels (1 to 3), with "
+                  "the same node sets: the data then carry a discretisation error the model lacks. "
+                  "Observed positions are read at the observed nodes. Recorded in truth.json")
+      ->type_name("N");
+  sub->add_option("--truth-mesh", options->truth_mesh,
+                  "Simulate the truth on another mesh FILE of the organ (scaled and translated as "
+                  "the scenario's mesh; selections made again on it, listed nodes matched by "
+                  "position); observed positions are interpolated at the observed nodes' rest "
+                  "positions. Recorded in truth.json")
+      ->type_name("FILE");
   add_backend_options(sub, options->backend);
   sub->add_flag("--quiet", options->quiet, "No progress line and no summary");
-  return [options]() {
+  return [options, sub]() {
+    // Given or not, whatever the value: --truth-refine 0 is an error, not "off".
+    if (sub->count("--truth-refine") > 0) options->generate.truth_mesh.refine = options->truth_refine;
+    if (sub->count("--truth-mesh") > 0) options->generate.truth_mesh.file = options->truth_mesh;
     Scenario scenario = load_scenario(options->scenario);
     for (const std::string& text : options->inject) {
       options->generate.inject.push_back(parse_effect_assignment(text, "--inject"));

@@ -13,12 +13,19 @@ void print_generate_summary(std::ostream& out, const Scenario& scenario,
   std::snprintf(line, sizeof line,
                 "generated %d steps of '%s' (%d nodes, %d tetrahedra) in %.2f s: "
                 "%.1f ms/step, CG %.1f iterations/step (max %d), largest displacement %.1f mm\n",
-                result.steps, scenario.name.c_str(), scenario.mesh.node_count(),
-                scenario.mesh.tetrahedron_count(), result.seconds,
+                result.steps, scenario.name.c_str(), result.truth_nodes,
+                result.truth_tetrahedra, result.seconds,
                 1e3 * result.seconds / result.steps,
                 static_cast<double>(result.cg_iterations) / result.steps, result.max_cg_iterations,
                 1e3 * result.max_displacement);
   out << line;
+  out << "  truth simulated on " << result.truth_mesh;
+  if (result.truth_nodes != scenario.mesh.node_count() ||
+      result.truth_tetrahedra != scenario.mesh.tetrahedron_count())
+    out << "; the model's mesh has " << scenario.mesh.node_count() << " nodes, "
+        << scenario.mesh.tetrahedron_count() << " tetrahedra (observed positions interpolated at "
+           "its observed nodes' rest positions)";
+  out << '\n';
   if (result.unconverged_steps > 0)
     out << "  warning: CG hit its iteration cap in " << result.unconverged_steps
         << " steps (see the messages above)\n";

@@ -18,19 +18,40 @@
 #include "host/model/effects.h"
 #include "host/model/model.h"
 #include <nlohmann/json.hpp>
+#include "host/generator/truth_mesh.h"
 #include "host/generator/truth_simulation.h"
 
 namespace sigmafem {
 namespace fs = std::filesystem;
 
+namespace {
+
+// truth.json's "truth_mesh": which mesh the truth ran on (docs/FORMATS.md).
+nlohmann::ordered_json truth_mesh_json(const TruthMesh& truth, const TruthMeshOptions& options) {
+  nlohmann::ordered_json j;
+  if (options.file) {
+    j["file"] = *options.file;
+  } else {
+    j["refine"] = options.refine.value_or(0);   // levels beyond the scenario's mesh
+  }
+  j["nodes"] = truth.scenario.mesh.node_count();
+  j["tetrahedra"] = truth.scenario.mesh.tetrahedron_count();
+  j["max_observed_outside_m"] = truth.max_outside_distance;
+  return j;
+}
+
+}  // namespace
+
 GenerateResult generate(const Scenario& scenario, const GenerateOptions& options,
                         std::ostream& log) {
   const auto start = std::chrono::steady_clock::now();
+  // Before the output folder: bad truth mesh options leave nothing behind.
+  const TruthMesh truth_mesh = make_truth_mesh(scenario, options.truth_mesh);
   std::error_code error;
   fs::create_directories(options.out_dir, error);
   if (error) throw InputError(options.out_dir + ": cannot create output folder: " + error.message());
 
-  Model truth_model = make_model(scenario);   // declared effects included
+  Model truth_model = make_model(truth_mesh.scenario);   // declared effects included
   apply_effects(options.inject, truth_model);
   // What a camera adds to every observed position: declared and injected registration errors.
   const Eigen::Vector3d offset = camera_offset(scenario.effects) + camera_offset(options.inject);
@@ -63,11 +84,12 @@ GenerateResult generate(const Scenario& scenario, const GenerateOptions& options
     table.steps.push_back(k);
     table.times.push_back(t);
     table.so.row(k) = scenario.control.trajectory.position(t, scenario.control.start).transpose();
-    for (std::size_t p = 0; p < observed.size(); ++p)
+    for (std::size_t p = 0; p < observed.size(); ++p) {
+      const Eigen::Vector3d point = truth_mesh.observed_position(p, positions);
       for (int a = 0; a < 3; ++a)
         table.points(k, static_cast<Eigen::Index>(3 * p + a)) =
-            positions[3 * observed[p] + a] + offset[a] +
-            scenario.observations.noise_std * noise.next();
+            point[a] + offset[a] + scenario.observations.noise_std * noise.next();
+    }
     truth.steps.push_back(k);
     truth.times.push_back(t);
     for (std::size_t l = 0; l < scenario.ligaments.size(); ++l)
@@ -79,7 +101,8 @@ GenerateResult generate(const Scenario& scenario, const GenerateOptions& options
   };
 
   std::unique_ptr<VtkSeries> vtk;
-  if (vtk_every > 0) vtk = std::make_unique<VtkSeries>(model, observed, options.out_dir, scenario.name);
+  if (vtk_every > 0)
+    vtk = std::make_unique<VtkSeries>(model, truth_mesh.nearest_observed_nodes(), options.out_dir, scenario.name);
 
   // The scenario's ligaments (events applied), then any extra ligament of an effect at the
   // model's stiffness.
@@ -125,13 +148,17 @@ GenerateResult generate(const Scenario& scenario, const GenerateOptions& options
                                        {"scenario", scenario.name},
                                        {"seed", options.seed},
                                        {"declared_effects", effects_json(scenario.effects)},
-                                       {"injected_effects", effects_json(options.inject)}};
+                                       {"injected_effects", effects_json(options.inject)},
+                                       {"truth_mesh", truth_mesh_json(truth_mesh, options.truth_mesh)}};
   write_file_atomically((out / "truth.json").string(), truth_json.dump(2) + "\n");
   if (vtk) {
     vtk->finish();
     result.vtk_frames = vtk->frame_count();
   }
   result.steps = steps;
+  result.truth_mesh = truth_mesh.description;
+  result.truth_nodes = model.node_count();
+  result.truth_tetrahedra = model.element_count();
   result.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   return result;
 }

@@ -6,7 +6,8 @@
 //                           noise of the scenario's noise_std (docs/FORMATS.md)
 //   <out>/truth.csv         each ligament's true stiffness per step
 //   <out>/truth.json        the effects in the data: declared in the scenario, and injected
-//                           (--inject) without being declared (docs/FORMATS.md)
+//                           (--inject) without being declared; the mesh the truth ran on
+//                           (docs/FORMATS.md)
 //   <out>/<name>.pvd + <out>/vtk/*.vtu   the organ every vtk_every steps, for ParaView
 // Row k of each CSV is the state after k steps (time k dt); row 0 is the rest state. A step
 // uses the SO position and the ligament stiffnesses at its END time (an event at time T acts
@@ -15,13 +16,22 @@
 
 #include <cstdint>
 #include <iosfwd>
+#include <optional>
 #include <string>
+#include <vector>
 
 #include "host/common/device_options.h"
 #include "host/scenario/effect_catalogue.h"
 #include "host/scenario/scenario.h"
 
 namespace sigmafem {
+
+// Which mesh the truth is simulated on (host/generator/truth_mesh.h); neither set: the
+// scenario's. At most one may be set.
+struct TruthMeshOptions {
+  std::optional<int> refine;        // --truth-refine: the scenario's mesh refined 1..3 more levels
+  std::optional<std::string> file;  // --truth-mesh: another mesh file of the organ (mesh.file units)
+};
 
 struct GenerateOptions {
   std::string out_dir;
@@ -33,6 +43,7 @@ struct GenerateOptions {
   // Effects put into the data but not into the scenario (`--inject NAME=VALUE`): the model
   // a filter builds from the scenario lacks them. Recorded in truth.json.
   std::vector<EffectValue> inject;
+  TruthMeshOptions truth_mesh;
 };
 
 struct GenerateResult {
@@ -43,12 +54,17 @@ struct GenerateResult {
   int unconverged_steps = 0;       // steps whose CG hit solver.cg_max_iterations
   int vtk_frames = 0;
   double max_displacement = 0.0;   // m, largest node displacement over the run
+  // The mesh the truth ran on: "the scenario's mesh", "... refined N more levels" or the file.
+  std::string truth_mesh;
+  int truth_nodes = 0;             // of the truth mesh
+  int truth_tetrahedra = 0;
 };
 
-// Runs the experiment and writes the files. Creates out_dir if needed. Throws InputError if
-// an output cannot be written and std::runtime_error if the simulation fails (non-finite
-// state); in both cases no observations.csv or truth.csv is written. CG steps that hit the
-// iteration cap are reported on `log` with the step and residual, and counted.
+// Runs the experiment and writes the files. Creates out_dir if needed. Throws InputError for
+// invalid truth mesh options (truth_mesh.h) or an output that cannot be written, and
+// std::runtime_error if the simulation fails (non-finite state); in these cases no
+// observations.csv or truth.csv is written. CG steps that hit the iteration cap are reported
+// on `log` with the step and residual, and counted.
 GenerateResult generate(const Scenario& scenario, const GenerateOptions& options,
                         std::ostream& log);
 

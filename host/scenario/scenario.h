@@ -44,10 +44,27 @@ struct SolverSpec {
   double cg_tolerance = 1e-10;      // relative residual |Ax - b| / |b|
 };
 
+// How a node set was written (docs/FORMATS.md `nodes` or `select`; candidate regions also
+// `automatic`), kept so that the set can be resolved again on another mesh of the same organ
+// (generate --truth-mesh, host/scenario/scenario_on_mesh.h). For `nodes` the list is the
+// resolved set itself.
+struct NodeSetSpec {
+  enum class Kind { nodes, near, box, automatic };
+  Kind kind = Kind::nodes;
+  std::string field;                // where it was written, e.g. `ligaments[1] "middle"`
+  Eigen::Vector3d near = Eigen::Vector3d::Zero();   // near: centre, metres
+  double radius = 0.0;                              // near
+  Eigen::Vector3d min = Eigen::Vector3d::Zero();    // box: corners, metres
+  Eigen::Vector3d max = Eigen::Vector3d::Zero();
+};
+
 struct Ligament {
   std::string name;
   std::vector<int> nodes;           // resolved, sorted, unique
   double stiffness = 0.0;           // N/m, total: each node gets stiffness / nodes.size()
+  // How `nodes` was written. Last, with "= {}", so that {name, nodes, stiffness} still
+  // initialises a Ligament (tests, regions built in code) without a missing-field warning.
+  NodeSetSpec selection = {};
 };
 
 // The SO trajectory so(t). so(0) is the centroid of the control nodes' rest positions.
@@ -74,6 +91,7 @@ struct Control {
   double stiffness = 0.0;           // N/m, total
   Trajectory trajectory;
   Eigen::Vector3d start = Eigen::Vector3d::Zero();        // so(0): centroid of rest positions
+  NodeSetSpec selection = {};       // how `nodes` was written
 };
 
 // At `time`, ligament `ligament` (index into Scenario::ligaments) gets `stiffness`.

@@ -317,9 +317,12 @@ std::vector<int> node_indices(const Checker& c, const json& value, const std::st
 }
 
 // The node set of a ligament or of the control: `nodes` or `select` (near + radius, or box),
-// in the transformed frame. Returns sorted, unique indices; an empty set is an error.
+// in the transformed frame. Returns sorted, unique indices; an empty set is an error. `spec`
+// gets how the set was written.
 std::vector<int> node_set(const Checker& c, const json& owner, const std::string& path,
-                          const Mesh& mesh) {
+                          const Mesh& mesh, NodeSetSpec& spec) {
+  spec = NodeSetSpec();
+  spec.field = path;
   const bool has_nodes = owner.contains("nodes");
   const bool has_select = owner.contains("select");
   c.require(!(has_nodes && has_select), path, "give either \"nodes\" or \"select\", not both");
@@ -350,6 +353,9 @@ std::vector<int> node_set(const Checker& c, const json& owner, const std::string
       const double radius = c.number(select.at("radius"), child(select_path, "radius"));
       c.positive(radius, child(select_path, "radius"));
       nodes = select_nodes_near(mesh, near, radius);
+      spec.kind = NodeSetSpec::Kind::near;
+      spec.near = near;
+      spec.radius = radius;
       asked = "near " + format_vector(near) + ", radius " + format_number(radius) + " m";
       advice = "enlarge radius or list nodes";
     } else {
@@ -362,6 +368,9 @@ std::vector<int> node_set(const Checker& c, const json& owner, const std::string
                 "min " + format_vector(min) + " exceeds max " + format_vector(max) +
                     " in some coordinate");
       nodes = select_nodes_in_box(mesh, min, max);
+      spec.kind = NodeSetSpec::Kind::box;
+      spec.min = min;
+      spec.max = max;
       asked = "box min " + format_vector(min) + ", max " + format_vector(max) + " m";
       advice = "enlarge the box or list nodes";
     }
@@ -534,7 +543,7 @@ void read_ligaments(const Checker& c, const json& root, Scenario& s) {
     c.require(s.ligament_index(ligament.name) < 0, child(path, "name"),
               "duplicate ligament name (also ligaments[" +
                   std::to_string(s.ligament_index(ligament.name)) + "]); names must be unique");
-    ligament.nodes = node_set(c, item, path, s.mesh);
+    ligament.nodes = node_set(c, item, path, s.mesh, ligament.selection);
     ligament.stiffness = c.number(item.at("stiffness"), child(path, "stiffness"));
     c.non_negative(ligament.stiffness, child(path, "stiffness"));
     s.ligaments.push_back(std::move(ligament));
@@ -563,7 +572,7 @@ void read_candidate_regions(const Checker& c, const json& root, Scenario& s) {
                 "characters or edge spaces");
       c.require(s.candidate_region_index(region.name) < 0, child(path, "name"),
                 "duplicate region name; names must be unique");
-      region.nodes = node_set(c, regions[i], path, s.mesh);
+      region.nodes = node_set(c, regions[i], path, s.mesh, region.selection);
       s.candidate_regions.push_back(std::move(region));
     }
     return;
@@ -571,6 +580,10 @@ void read_candidate_regions(const Checker& c, const json& root, Scenario& s) {
   std::vector<int> held = s.control.nodes;
   for (const Ligament& ligament : s.ligaments) held.insert(held.end(), ligament.nodes.begin(), ligament.nodes.end());
   s.candidate_regions = automatic_surface_regions(s.mesh, automatic, held);
+  for (Ligament& region : s.candidate_regions) {
+    region.selection.kind = NodeSetSpec::Kind::automatic;
+    region.selection.field = "candidate_regions " + in_quotes(region.name) + " (automatic)";
+  }
 }
 
 Trajectory read_trajectory(const Checker& c, const json& value, const std::string& path,
@@ -630,7 +643,7 @@ void read_control(const Checker& c, const json& root, const std::string& scenari
   const json& control = root.at("control");
   c.check_object(control, "control", {"nodes", "select", "stiffness", "trajectory"},
                  {"stiffness", "trajectory"});
-  s.control.nodes = node_set(c, control, "control", s.mesh);
+  s.control.nodes = node_set(c, control, "control", s.mesh, s.control.selection);
   s.control.stiffness = c.number(control.at("stiffness"), "control.stiffness");
   c.non_negative(s.control.stiffness, "control.stiffness");
   s.control.trajectory =

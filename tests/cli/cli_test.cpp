@@ -10,6 +10,7 @@
 #include <nlohmann/json.hpp>
 #include <sstream>
 #include <string>
+#include <vector>
 
 #include "temp_path.h"
 
@@ -156,6 +157,37 @@ TEST_F(CliTest, RejectsAnExtraLigamentAtARegionTheScenarioLacks) {
       << run.output;
   EXPECT_NE(run.output.find("candidate_regions: bottom"), std::string::npos) << run.output;
   EXPECT_FALSE(fs::exists(dir_ / "out"));
+}
+
+TEST_F(CliTest, GenerateSimulatesTheTruthOnARefinedMesh) {
+  json scenario = box_;
+  scenario["time"]["steps"] = 5;
+  std::ofstream(dir_ / "short.json") << scenario.dump(2);
+  const CommandRun run = run_sigmafem("generate " + (dir_ / "short.json").string() + " --out " +
+                                      (dir_ / "out").string() + " --vtk-every 0 --truth-refine 1");
+  ASSERT_EQ(run.exit_code, 0) << run.output;
+  EXPECT_NE(run.output.find("truth simulated on the scenario's mesh refined 1 more level"), std::string::npos)
+      << "the summary says which mesh the truth ran on: " << run.output;
+  std::ifstream truth_file(dir_ / "out" / "truth.json");
+  EXPECT_EQ(json::parse(truth_file)["truth_mesh"]["refine"], 1);
+}
+
+// Bad truth mesh options: exit 2, a message naming `option`, no output folder.
+TEST_F(CliTest, RejectsInvalidTruthMeshOptions) {
+  std::ofstream(dir_ / "box.json") << box_.dump(2);
+  auto expect_rejected_options = [&](const std::string& options, const std::vector<std::string>& named) {
+    const CommandRun run = run_sigmafem("generate " + (dir_ / "box.json").string() + " --out " +
+                                        (dir_ / "out").string() + " --quiet " + options);
+    EXPECT_EQ(run.exit_code, 2) << options << ": " << run.output;
+    for (const std::string& name : named)
+      EXPECT_NE(run.output.find(name), std::string::npos) << "the message names " << name << ": " << run.output;
+    EXPECT_FALSE(fs::exists(dir_ / "out")) << options << ": no output folder";
+  };
+  expect_rejected_options("--truth-refine 1 --truth-mesh " + (dir_ / "box.msh").string(),
+                          {"--truth-refine", "--truth-mesh"});
+  expect_rejected_options("--truth-refine 0", {"--truth-refine 0"});
+  expect_rejected_options("--truth-refine 4", {"--truth-refine 4"});
+  expect_rejected_options("--truth-mesh " + (dir_ / "absent.msh").string(), {"--truth-mesh", "absent.msh"});
 }
 
 TEST_F(CliTest, DiagnoseFindsAnInjectedEffectAndWritesItsReport) {

@@ -1,0 +1,112 @@
+#include "host/generator/truth_mesh.h"
+
+#include <algorithm>
+#include <filesystem>
+#include <sstream>
+
+#include "host/common/input_error.h"
+#include "host/scenario/scenario_on_mesh.h"
+
+namespace sigmafem {
+
+namespace {
+
+// The same limit as the scenario's mesh.refine: each level is x8 tetrahedra.
+constexpr int kMaxTruthRefine = 3;
+
+std::string levels(int n) { return std::to_string(n) + (n == 1 ? " more level" : " more levels"); }
+
+// Reads, transforms, orients and checks FILE like load_scenario does the scenario's mesh.
+Mesh read_truth_mesh(const Scenario& scenario, const std::string& file) {
+  const std::string option = "--truth-mesh " + file;
+  std::error_code error;
+  if (!std::filesystem::is_regular_file(file, error)) throw InputError(option + ": file not found");
+  try {
+    Mesh mesh = read_mesh(file);
+    transform_mesh(mesh, scenario.mesh_spec.scale, scenario.mesh_spec.translate);
+    orient_and_check(mesh, file);
+    return mesh;
+  } catch (const InputError& e) {
+    throw InputError(option + ": " + e.what());
+  }
+}
+
+double bounding_diagonal(const Mesh& mesh) {
+  Eigen::Vector3d low = mesh.nodes.front(), high = mesh.nodes.front();
+  for (const Eigen::Vector3d& p : mesh.nodes) {
+    low = low.cwiseMin(p);
+    high = high.cwiseMax(p);
+  }
+  return (high - low).norm();
+}
+
+}  // namespace
+
+Eigen::Vector3d TruthMesh::observed_position(std::size_t p, const Eigen::VectorXd& x) const {
+  if (observed.empty()) return x.segment<3>(3 * observed_nodes[p]);
+  return interpolate(scenario.mesh, observed[p], x);
+}
+
+std::vector<int> TruthMesh::nearest_observed_nodes() const {
+  if (observed.empty()) return observed_nodes;
+  std::vector<int> nodes;
+  for (const MeshLocation& location : observed) {
+    const auto largest = std::max_element(location.weights.begin(), location.weights.end()) -
+                         location.weights.begin();
+    nodes.push_back(scenario.mesh.tetrahedra[static_cast<std::size_t>(location.tetrahedron)]
+                                            [static_cast<std::size_t>(largest)]);
+  }
+  return nodes;
+}
+
+TruthMesh make_truth_mesh(const Scenario& scenario, const TruthMeshOptions& options) {
+  if (options.refine && options.file)
+    throw InputError("--truth-refine and --truth-mesh: give one or the other (the truth runs on "
+                     "the scenario's mesh refined, or on another mesh file)");
+  if (options.refine && (*options.refine < 1 || *options.refine > kMaxTruthRefine))
+    throw InputError("--truth-refine " + std::to_string(*options.refine) + ": must be 1 to " +
+                     std::to_string(kMaxTruthRefine) +
+                     " (levels of uniform refinement of the scenario's mesh, each x8 tetrahedra)");
+  TruthMesh truth;
+  const std::vector<int>& observed = scenario.observations.nodes;
+  if (options.file) {
+    truth.scenario = scenario_on_mesh(scenario, read_truth_mesh(scenario, *options.file),
+                                      "--truth-mesh " + *options.file);
+    truth.description = *options.file;
+  } else {
+    truth.scenario = scenario;
+    if (options.refine) {
+      // Node sets keep their indices (refine_uniform keeps the old nodes' indices); the new
+      // elements are checked as load_scenario checks mesh.refine's.
+      for (int level = 0; level < *options.refine; ++level)
+        truth.scenario.mesh = refine_uniform(truth.scenario.mesh);
+      orient_and_check(truth.scenario.mesh, "--truth-refine " + std::to_string(*options.refine));
+      truth.description = "the scenario's mesh refined " + levels(*options.refine);
+    } else {
+      truth.description = "the scenario's mesh";
+    }
+  }
+  if (!options.refine && !options.file) {
+    truth.observed_nodes = observed;   // read directly: the data are bit for bit as before
+    return truth;
+  }
+  const double limit = kMaxObservedOutsideShare * bounding_diagonal(truth.scenario.mesh);
+  for (std::size_t p = 0; p < observed.size(); ++p) {
+    const Eigen::Vector3d& rest = scenario.mesh.nodes[static_cast<std::size_t>(observed[p])];
+    const MeshLocation location = locate_point(truth.scenario.mesh, rest);
+    if (location.outside_distance > limit) {
+      std::ostringstream what;
+      what << (options.file ? "--truth-mesh " + *options.file : "--truth-refine") << ": observations.nodes["
+           << p << "] (node " << observed[p] << ") lies " << location.outside_distance * 1e3
+           << " mm outside the truth mesh, more than " << kMaxObservedOutsideShare * 100
+           << "% of its size: do the meshes describe the same organ in the same frame (mesh.scale, "
+              "mesh.translate)?";
+      throw InputError(what.str());
+    }
+    truth.max_outside_distance = std::max(truth.max_outside_distance, location.outside_distance);
+    truth.observed.push_back(location);
+  }
+  return truth;
+}
+
+}  // namespace sigmafem

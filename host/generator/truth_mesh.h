@@ -1,0 +1,56 @@
+// TruthMesh: the mesh `generate` simulates the truth on, and where the model's observed points
+// lie on it. By default the scenario's own mesh; with GenerateOptions::truth_mesh another
+// discretisation of the same organ, so that the data carries the model-form error measured data
+// always has (issue 13):
+//   --truth-refine N   the scenario's mesh refined N more levels (refine_uniform: its nodes keep
+//                      their indices, so every node set, ligaments, control, candidate regions,
+//                      observed nodes, keeps its indices: the same springs at the same material
+//                      points, only the discretisation differs). Selections are NOT made again
+//                      on the refined mesh: a "near" selection would catch more nodes there, with
+//                      another centroid (on the liver the SO's would move 7.3 mm, see
+//                      scenarios/liver_fine.json).
+//   --truth-mesh FILE  another mesh file, transformed, oriented and checked like the scenario's
+//                      mesh (mesh.scale, mesh.translate; not mesh.refine), with the node sets
+//                      resolved again on it (host/scenario/scenario_on_mesh.h).
+// Either way an observed position is the truth interpolated at the rest position of the model's
+// observed node (host/mesh/mesh_locate.h), so observations.csv keeps the scenario's columns.
+#pragma once
+
+#include <Eigen/Core>
+#include <string>
+#include <vector>
+
+#include "host/generator/generate.h"
+#include "host/mesh/mesh_locate.h"
+#include "host/scenario/scenario.h"
+
+namespace sigmafem {
+
+// An observed point farther outside the truth mesh than this share of the truth mesh's size
+// (bounding-box diagonal) is an error: faceting of a curved surface explains a fraction of a
+// millimetre, not this; the meshes are not of the same organ in the same frame.
+constexpr double kMaxObservedOutsideShare = 0.01;
+
+struct TruthMesh {
+  Scenario scenario;                    // the scenario on the truth mesh
+  // Where the observed points are: on the scenario's mesh the observed nodes themselves;
+  // on another mesh each observed node's rest position located on it (then observed_nodes is
+  // empty).
+  std::vector<int> observed_nodes;
+  std::vector<MeshLocation> observed;
+  double max_outside_distance = 0.0;    // m, the farthest observed point outside the truth mesh
+  std::string description;              // "the scenario's mesh", "the scenario's mesh refined 1 more level", "FILE"
+
+  // Observed point p at the truth positions x (3 per truth node).
+  Eigen::Vector3d observed_position(std::size_t p, const Eigen::VectorXd& x) const;
+  // The truth node nearest each observed point (its largest weight), to mark it in the VTK.
+  std::vector<int> nearest_observed_nodes() const;
+};
+
+// The truth mesh for `options` (refine 0 and no file: the scenario's mesh). Throws InputError
+// naming the option for both options at once, a refinement outside 1..3, a mesh file that
+// cannot be read or is invalid, node sets that cannot be resolved on it, or an observed point
+// far outside it.
+TruthMesh make_truth_mesh(const Scenario& scenario, const TruthMeshOptions& options);
+
+}  // namespace sigmafem
