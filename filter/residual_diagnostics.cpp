@@ -17,6 +17,8 @@ namespace {
 constexpr int kTestCount = 6;        // the verdict's tests; each gets false_alarm / kTestCount
 constexpr int kMinRowValues = 10;    // a row needs this many values for its own statistics
 constexpr double kRowLjungBoxTailExcess = 3.0;   // see whiteness_tests
+constexpr double kConservativeS = 0.1;           // see nis_tests
+constexpr int kDetrendSteps = 100;               // see whiteness_tests
 constexpr double kNan = std::numeric_limits<double>::quiet_NaN();
 const char* const kAxes = "xyz";
 
@@ -40,6 +42,24 @@ double finite_rms(const Eigen::VectorXd& v) {
       ++count;
     }
   return count ? std::sqrt(sum / count) : kNan;
+}
+
+// The effective number of independent values in a series with lag-1 autocorrelation rho >= 0
+// (AR(1): n (1 - rho) / (1 + rho)), from the consecutive pairs of finite values of `x` minus
+// `mean`. The innovations of a filter that is still settling (an estimate converging from its
+// prior, or following a cut by drift) are correlated over many steps; a t-test that took them
+// for independent called a consistent model biased (measured: rigid_bias failed on 1 of 8
+// clean liver_diagnose seeds, at a 0.17% level).
+double effective_count(const Eigen::VectorXd& x, double mean, double count) {
+  double c0 = 0.0, c1 = 0.0;
+  for (Eigen::Index t = 0; t < x.size(); ++t) {
+    if (!std::isfinite(x[t])) continue;
+    const double a = x[t] - mean;
+    c0 += a * a;
+    if (t > 0 && std::isfinite(x[t - 1])) c1 += a * (x[t - 1] - mean);
+  }
+  const double rho = c0 > 0.0 ? std::clamp(c1 / c0, 0.0, 0.99) : 0.0;
+  return std::max(2.0, count * (1.0 - rho) / (1.0 + rho));
 }
 
 Eigen::MatrixX3d as_points(const Eigen::VectorXd& rows) {
@@ -69,7 +89,13 @@ void nis_tests(const InnovationSeries& series, const std::vector<int>& used, dou
   }
   nis.mean = total / N;
   nis.mean_dof = dof / N;
-  nis.band_low = chi_square_quantile(0.5 * level, dof) / N;
+  // A missing effect adds innovation and raises the NIS. A NIS below its expectation means the
+  // filter overstates its uncertainty, and the random-walk drift makes S conservative by
+  // design (measured: mean NIS 35.2-35.9 against 36 over box.json seeds 1-10, on average 1.5
+  // std of the mean below it, which the plain two-sided band failed 1 time in 10). So the
+  // lower bound lets S overstate the innovation variance by up to kConservativeS (10%); an
+  // observation_std set well above the data's noise still fails it.
+  nis.band_low = (1.0 - kConservativeS) * chi_square_quantile(0.5 * level, dof) / N;
   nis.band_high = chi_square_tail_quantile(0.5 * level, dof) / N;
   nis.band95_low = chi_square_quantile(0.025, dof) / N;
   nis.band95_high = chi_square_tail_quantile(0.025, dof) / N;
@@ -92,7 +118,7 @@ void nis_tests(const InnovationSeries& series, const std::vector<int>& used, dou
   mean.detail = format("mean NIS %.4g over %.0f steps, expected %.4g (the mean number of observed "
                        "rows); accepted ",
                        nis.mean, N, nis.mean_dof) +
-                format("%.4g..%.4g", nis.band_low, nis.band_high);
+                format("%.4g..%.4g (the low end allows a 10%% conservative S)", nis.band_low, nis.band_high);
   d.verdict.tests.push_back(mean);
 
   DiagnosticTest outside;
@@ -109,6 +135,25 @@ void nis_tests(const InnovationSeries& series, const std::vector<int>& used, dou
   d.verdict.tests.push_back(outside);
 }
 
+// The centred moving average of the finite values of x over `window` steps (fewer at the
+// ends), by prefix sums; NaN where no value is in reach.
+Eigen::VectorXd moving_average(const Eigen::VectorXd& x, int window) {
+  const Eigen::Index N = x.size(), half = window / 2;
+  Eigen::VectorXd sum = Eigen::VectorXd::Zero(N + 1), count = Eigen::VectorXd::Zero(N + 1);
+  for (Eigen::Index t = 0; t < N; ++t) {
+    const bool finite = std::isfinite(x[t]);
+    sum[t + 1] = sum[t] + (finite ? x[t] : 0.0);
+    count[t + 1] = count[t] + (finite ? 1.0 : 0.0);
+  }
+  Eigen::VectorXd mean(N);
+  for (Eigen::Index t = 0; t < N; ++t) {
+    const Eigen::Index a = std::max<Eigen::Index>(0, t - half), b = std::min<Eigen::Index>(N, t + half + 1);
+    const double n = count[b] - count[a];
+    mean[t] = n > 0.0 ? (sum[b] - sum[a]) / n : kNan;
+  }
+  return mean;
+}
+
 // X: N x n standardised innovations (NaN = missing).
 void whiteness_tests(const Eigen::MatrixXd& X, int max_lag, double level, ResidualDiagnostics& d) {
   WhitenessDiagnostics& w = d.whiteness;
@@ -119,21 +164,32 @@ void whiteness_tests(const Eigen::MatrixXd& X, int max_lag, double level, Residu
   w.row_p_value.assign(static_cast<std::size_t>(n), kNan);
 
   // Each usable row demeaned (so that a bias does not read as correlation), missing values
-  // set to zero so that sums over products skip them; `observed` marks the others.
+  // set to zero so that sums over products skip them; `observed` marks the others. For the
+  // per-row test, X0_local: each row less its local mean instead, a centred moving average over
+  // kDetrendSteps, so that a slow drift of the mean does not read as correlation at lags 1..L
+  // either. Slow drifts are the bias tests' business: a filter following a cut by drift moves
+  // its innovations' mean over hundreds of steps, which the per-row Ljung-Box test read as
+  // colour (box.json seed 1, the default demo: 40.67 against 40.23 at the row nearest the cut;
+  // 1 of 10 seeds). The local mean biases each lag's correlation by about -1/kDetrendSteps:
+  // nothing against one row's threshold, but far more than the band of the average over rows,
+  // which therefore keeps the plain mean.
   std::vector<Eigen::Index> rows;
   for (Eigen::Index i = 0; i < n; ++i)
     if (X.col(i).array().isFinite().count() >= std::max(kMinRowValues, L + 2)) rows.push_back(i);
   const Eigen::Index nv = static_cast<Eigen::Index>(rows.size());
   Eigen::MatrixXd X0 = Eigen::MatrixXd::Zero(N, nv), observed = Eigen::MatrixXd::Zero(N, nv);
+  Eigen::MatrixXd X0_local = Eigen::MatrixXd::Zero(N, nv);
   Eigen::VectorXd count(nv);
   for (Eigen::Index c = 0; c < nv; ++c) {
     const Eigen::VectorXd column = X.col(rows[static_cast<std::size_t>(c)]);
     const Eigen::Array<bool, Eigen::Dynamic, 1> finite = column.array().isFinite();
     count[c] = static_cast<double>(finite.count());
     const double mean = finite.select(column.array(), 0.0).sum() / count[c];
+    const Eigen::VectorXd local_mean = moving_average(column, kDetrendSteps);
     for (Eigen::Index t = 0; t < N; ++t)
       if (finite[t]) {
         X0(t, c) = column[t] - mean;
+        X0_local(t, c) = column[t] - local_mean[t];
         observed(t, c) = 1.0;
       }
   }
@@ -143,13 +199,13 @@ void whiteness_tests(const Eigen::MatrixXd& X, int max_lag, double level, Residu
   w.autocorrelation.assign(static_cast<std::size_t>(L), 0.0);
   int averaged = 0;
   for (Eigen::Index c = 0; c < nv; ++c) {
-    const double c0 = X0.col(c).squaredNorm();
-    if (!(c0 > 0.0)) continue;
+    const double c0 = X0.col(c).squaredNorm(), c0_local = X0_local.col(c).squaredNorm();
+    if (!(c0 > 0.0) || !(c0_local > 0.0)) continue;
     const double Ni = count[c];
     double q = 0.0;
     for (int k = 1; k <= L; ++k) {
-      const double r = X0.col(c).head(N - k).dot(X0.col(c).tail(N - k)) / c0;
-      w.autocorrelation[static_cast<std::size_t>(k - 1)] += r;
+      w.autocorrelation[static_cast<std::size_t>(k - 1)] += X0.col(c).head(N - k).dot(X0.col(c).tail(N - k)) / c0;
+      const double r = X0_local.col(c).head(N - k).dot(X0_local.col(c).tail(N - k)) / c0_local;
       q += r * r / (Ni - k);
     }
     q *= Ni * (Ni + 2.0);
@@ -258,8 +314,9 @@ void bias_tests(const Eigen::MatrixXd& Z, double level, ResidualDiagnostics& d) 
     if (b.count[i] < kMinRowValues) continue;
     const Eigen::Array<bool, Eigen::Dynamic, 1> finite = Z.col(i).array().isFinite();
     const double ss = finite.select((Z.col(i).array() - b.mean[i]).square(), 0.0).sum();
-    const double dof = b.count[i] - 1.0;
-    b.standard_error[i] = std::sqrt(ss / dof / b.count[i]);
+    const double n_effective = effective_count(Z.col(i), b.mean[i], b.count[i]);
+    const double dof = n_effective - 1.0;
+    b.standard_error[i] = std::sqrt(ss / (b.count[i] - 1.0) / n_effective);
     b.t[i] = b.standard_error[i] > 0.0 ? b.mean[i] / b.standard_error[i] : 0.0;
     b.t_threshold[i] = student_t_two_sided_quantile(level / tested, dof);
     if (std::fabs(b.t[i]) > b.t_threshold[i]) b.flagged_rows.push_back(static_cast<int>(i));
@@ -323,9 +380,15 @@ void spatial_pattern(const Eigen::MatrixXd& Z, const Eigen::MatrixX3d& positions
   const Eigen::RowVectorXd mean = motion.colwise().mean();
   const Eigen::RowVectorXd sd =
       ((motion.rowwise() - mean).colwise().squaredNorm() / static_cast<double>(N - 1)).cwiseSqrt();
-  for (int c = 0; c < 6; ++c)
-    s.component_t[c] = sd[c] > 0.0 ? mean[c] / (sd[c] / std::sqrt(static_cast<double>(N))) : 0.0;
-  s.component_t_threshold = student_t_two_sided_quantile(level / 6.0, static_cast<double>(N - 1));
+  // Each component's standard error from its effective number of independent steps (as the
+  // bias rows'); the bound takes the smallest, the most conservative degrees of freedom.
+  double least_effective = static_cast<double>(N);
+  for (int c = 0; c < 6; ++c) {
+    const double n_effective = effective_count(motion.col(c), mean[c], static_cast<double>(N));
+    least_effective = std::min(least_effective, n_effective);
+    s.component_t[c] = sd[c] > 0.0 ? mean[c] / (sd[c] / std::sqrt(n_effective)) : 0.0;
+  }
+  s.component_t_threshold = student_t_two_sided_quantile(level / 6.0, least_effective - 1.0);
 
   DiagnosticTest test;
   test.name = "rigid_bias";
@@ -333,7 +396,7 @@ void spatial_pattern(const Eigen::MatrixXd& Z, const Eigen::MatrixX3d& positions
   test.statistic = s.component_t.cwiseAbs().maxCoeff(&worst);
   test.accept_low = kNan;
   test.accept_high = s.component_t_threshold;
-  test.p_value = student_t_two_sided_tail(test.statistic, static_cast<double>(N - 1));
+  test.p_value = student_t_two_sided_tail(test.statistic, least_effective - 1.0);
   test.level = level;
   test.passed = test.statistic <= test.accept_high;
   static const char* const names[] = {"translation x", "translation y", "translation z",

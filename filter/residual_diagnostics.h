@@ -3,14 +3,19 @@
 // are zero-mean, white in time and have the covariance S = H P^- H^T + R the filter
 // predicts. Four families of tests look for the ways a missing effect breaks that:
 //   NIS        z^T S^-1 z over the steps: is the size of the innovations what S says?
-//              (sum over N steps ~ chi^2 with sum m_k dof; and the share of steps outside
-//              their own 95% chi^2 band ~ Binomial(N, 0.05))
+//              (sum over N steps ~ chi^2 with sum m_k dof, the low end allowing a 10%
+//              conservative S, which the filter's drift makes; and the share of steps
+//              outside their own 95% chi^2 band ~ Binomial(N, 0.05))
 //   whiteness  autocorrelation of the standardised innovations z_i / sqrt(S_ii) at lags
-//              1..L, averaged over rows, with a Ljung-Box test; and per row
-//   bias       mean innovation per observed point and axis, its t-statistic
+//              1..L, averaged over rows, with a Ljung-Box test; and per row (each row less its
+//              100-step moving average: short-term colour only, slow drifts are the bias
+//              tests')
+//   bias       mean innovation per observed point and axis, its t-statistic (the standard
+//              error from the row's effective number of independent steps: a settling
+//              filter's innovations are correlated in time)
 //   pattern    the mean innovation field over the observed points split into a rigid part
 //              (translation + small rotation about the centroid, least squares) and the rest,
-//              with a t-test of the rigid components from per-step fits
+//              with a t-test of the rigid components from per-step fits (effective counts too)
 // and a verdict: consistent when every test passes.
 //
 // False alarms: the verdict runs six tests, each at options.false_alarm / 6 (tests over
