@@ -3,7 +3,7 @@
 // mesh than the organ's) leaves innovations far outside the band S = H P H^T + R predicts;
 // a Kalman correction with the nominal R then treats all of it as information about the
 // parameters and drives them to their limits in a few dozen steps (measured on the liver with
-// an undeclared 9.81 m/s^2: every stiffness out of 1e-6..1e9 N/m by step 42).
+// an undeclared 9.81 m/s^2: every stiffness out of 1e-6..1e9 N/m (the bound then) by step 42).
 //
 // The response is innovation-based adaptive estimation of R (Mehra 1972; Mohamed and Schwarz
 // 1999, "Adaptive Kalman filtering for INS/GPS"): the correction uses lambda R with lambda

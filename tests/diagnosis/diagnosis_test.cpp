@@ -237,7 +237,7 @@ namespace {
 
 // Issue 13, item 1, on the shipped liver (2000 steps, the cut at 10 s, 0.5 mm noise) with a
 // full-size gravity the scenario does not declare (9.81 m/s^2, oblique): the declared model's
-// filter drove every stiffness out of 1e-6..1e9 N/m by step 42 before the adaptive observation
+// filter drove every stiffness out of 1e-6..1e9 N/m (the bound then) by step 42 before the adaptive observation
 // noise (filter/adaptive_noise.h). Now it runs to the end, keeps the stiffnesses within a factor
 // of 3 of their prior medians (300, 600, 400 N/m: nothing it could learn from data it cannot
 // explain) and calls its residual inconsistent; the gravity candidate's fit explains the data
