@@ -688,6 +688,27 @@ void read_observations(const Checker& c, const json& root, Scenario& s) {
   c.non_negative(s.observations.noise_std, "observations.noise_std");
 }
 
+// The fields the filter's windowed tests share (filter.change_detection,
+// filter.adaptive_noise): enabled, window (steps), false_alarm (a probability).
+void read_windowed_test(const Checker& c, const json& object, const std::string& path,
+                        std::optional<bool>& enabled, std::optional<int>& window,
+                        std::optional<double>& false_alarm) {
+  if (object.contains("enabled")) {
+    c.require(object.at("enabled").is_boolean(), child(path, "enabled"),
+              "expected true or false, found " + object.at("enabled").dump());
+    enabled = object.at("enabled").get<bool>();
+  }
+  if (object.contains("window")) {
+    window = c.integer(object.at("window"), child(path, "window"));
+    c.require(*window >= 1 && *window <= 1000, child(path, "window"), "must be 1..1000 steps");
+  }
+  if (object.contains("false_alarm")) {
+    false_alarm = c.number(object.at("false_alarm"), child(path, "false_alarm"));
+    c.require(*false_alarm > 0.0 && *false_alarm < 0.5, child(path, "false_alarm"),
+              "must be a probability in (0, 0.5)");
+  }
+}
+
 void read_filter(const Checker& c, const json& root, Scenario& s) {
   if (!root.contains("filter")) return;
   const json& filter = root.at("filter");
@@ -738,20 +759,7 @@ void read_filter(const Checker& c, const json& root, Scenario& s) {
     c.check_object(detection, path,
                    {"enabled", "window", "false_alarm", "hold_off", "inflation_log_std"}, {});
     ChangeDetectionSpec& d = spec.change_detection;
-    if (detection.contains("enabled")) {
-      c.require(detection.at("enabled").is_boolean(), child(path, "enabled"),
-                "expected true or false, found " + detection.at("enabled").dump());
-      d.enabled = detection.at("enabled").get<bool>();
-    }
-    if (detection.contains("window")) {
-      d.window = c.integer(detection.at("window"), child(path, "window"));
-      c.require(*d.window >= 1, child(path, "window"), "must be at least 1 step");
-    }
-    if (detection.contains("false_alarm")) {
-      d.false_alarm = c.number(detection.at("false_alarm"), child(path, "false_alarm"));
-      c.require(*d.false_alarm > 0.0 && *d.false_alarm < 0.5, child(path, "false_alarm"),
-                "must be a probability in (0, 0.5)");
-    }
+    read_windowed_test(c, detection, path, d.enabled, d.window, d.false_alarm);
     if (detection.contains("hold_off")) {
       d.hold_off = c.integer(detection.at("hold_off"), child(path, "hold_off"));
       c.require(*d.hold_off >= 0, child(path, "hold_off"), "must not be negative");
@@ -766,20 +774,7 @@ void read_filter(const Checker& c, const json& root, Scenario& s) {
     const std::string path = "filter.adaptive_noise";
     c.check_object(adaptive, path, {"enabled", "window", "false_alarm"}, {});
     AdaptiveNoiseSpec& a = spec.adaptive_noise;
-    if (adaptive.contains("enabled")) {
-      c.require(adaptive.at("enabled").is_boolean(), child(path, "enabled"),
-                "expected true or false, found " + adaptive.at("enabled").dump());
-      a.enabled = adaptive.at("enabled").get<bool>();
-    }
-    if (adaptive.contains("window")) {
-      a.window = c.integer(adaptive.at("window"), child(path, "window"));
-      c.require(*a.window >= 1 && *a.window <= 1000, child(path, "window"), "must be 1..1000 steps");
-    }
-    if (adaptive.contains("false_alarm")) {
-      a.false_alarm = c.number(adaptive.at("false_alarm"), child(path, "false_alarm"));
-      c.require(*a.false_alarm > 0.0 && *a.false_alarm < 0.5, child(path, "false_alarm"),
-                "must be a probability in (0, 0.5)");
-    }
+    read_windowed_test(c, adaptive, path, a.enabled, a.window, a.false_alarm);
   }
   c.require(!s.observations.nodes.empty(), "filter",
             "the filter needs observed nodes, and observations.nodes is empty");

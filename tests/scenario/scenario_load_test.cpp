@@ -19,6 +19,7 @@
 #include "temp_path.h"
 #include "host/common/input_error.h"
 #include "host/scenario/scenario.h"
+#include "host/scenario/estimation_options.h"
 
 namespace sigmafem {
 namespace {
@@ -157,6 +158,13 @@ TEST_F(ScenarioLoadTest, GivenOptionalFieldsAreRead) {
   EXPECT_EQ(s.filter->initial_log_std, 0.5);
   EXPECT_EQ(s.filter->parameter_drift_log_std, 0.01);
   EXPECT_EQ(s.filter->sigma_points, "star");
+  EXPECT_FALSE(s.filter->adaptive_noise.enabled.has_value()) << "left out: the defaults";
+  // Set, it reaches the filter's options.
+  j["filter"]["adaptive_noise"] = {{"enabled", false}, {"window", 7}, {"false_alarm", 1e-3}};
+  const EstimationOptions options = estimation_options(load_scenario(write(j, "adaptive.json")));
+  EXPECT_FALSE(options.roukf.adaptive_noise.enabled);
+  EXPECT_EQ(options.roukf.adaptive_noise.window, 7);
+  EXPECT_EQ(options.roukf.adaptive_noise.false_alarm, 1e-3);
 }
 
 TEST_F(ScenarioLoadTest, ControlStartIsTheCentroidOfTheControlNodes) {
@@ -341,6 +349,18 @@ TEST_F(ScenarioLoadTest, BadFieldsAreNamed) {
       {"unknown in filter",
        [](json& j) { j["filter"]["sigma_point"] = "star"; },
        {"filter.sigma_point: unknown field", "did you mean \"sigma_points\""}},
+      {"adaptive noise window out of range",
+       [](json& j) { j["filter"]["adaptive_noise"] = {{"window", 0}}; },
+       {"filter.adaptive_noise.window", "1..1000"}},
+      {"adaptive noise false alarm not a probability",
+       [](json& j) { j["filter"]["adaptive_noise"] = {{"false_alarm", 0.7}}; },
+       {"filter.adaptive_noise.false_alarm", "probability"}},
+      {"adaptive noise enabled not a boolean",
+       [](json& j) { j["filter"]["adaptive_noise"] = {{"enabled", "yes"}}; },
+       {"filter.adaptive_noise.enabled", "expected true or false"}},
+      {"change detection window out of range",
+       [](json& j) { j["filter"]["change_detection"] = {{"window", 5000}}; },
+       {"filter.change_detection.window", "1..1000"}},
       {"unknown in output",
        [](json& j) {
          j["output"] = {{"vtk", 1}};
