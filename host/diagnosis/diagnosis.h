@@ -13,9 +13,9 @@
 //      by a partial sum); when the round's model itself stopped early, the complete candidates
 //      are ranked by their own log-likelihood minus the penalty. The best positive score is
 //      added; none: stop.
-//   4. refine: run the chosen model once more (always from a complete first pass; if the
-//      refined pass stops early, the first pass stands) with the prior centred on its
-//      estimates, stiffnesses and effects (std: 10 times the posterior std, at least 0.05 in
+//   4. refine: run the chosen model once more (always from a complete first pass; the
+//      refined pass replaces it only with a log-likelihood at least as high, and never when
+//      it stops early) with the prior centred on its estimates, stiffnesses and effects (std: 10 times the posterior std, at least 0.05 in
 //      log-stiffness or effect coordinates, at most the first prior). In the
 //      first pass the sigma points start a prior std apart (gravity 5 m/s^2), which moves the
 //      organ while the filter learns; the filter re-samples positions but not velocities, and
