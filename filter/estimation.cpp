@@ -39,7 +39,6 @@ EstimationRun run_estimation(Ensemble& ensemble, const EstimationOptions& option
     step.log_det_innovation_covariance = result.log_det_innovation_covariance;
     step.observed_rows = result.observed_rows;
     step.noise_scale = result.noise_scale;
-    step.unexplained_ratio = result.unexplained_ratio;
     if (result.noise_scale > 1.0) {
       if (run.noise_scaled_steps++ == 0) run.first_noise_scaled_step = step.step;
       run.max_noise_scale = std::max(run.max_noise_scale, result.noise_scale);

@@ -50,10 +50,9 @@ struct EstimationStep {
   Eigen::VectorXd innovation_std;
   double normalised_innovation = 0.0;
   double log_det_innovation_covariance = 0.0;   // log det S (Roukf)
-  // The adaptive observation-noise scale of the step's correction (1: nominal R) and the
-  // unexplained-innovation ratio behind it (filter/adaptive_noise.h).
+  // The adaptive observation-noise scale of the step's correction (1: nominal R;
+  // filter/adaptive_noise.h).
   double noise_scale = 1.0;
-  double unexplained_ratio = 1.0;
   int observed_rows = 0;
   bool change_detected = false;
   int max_cg_iterations = 0;       // over the sigma points

@@ -121,7 +121,6 @@ RoukfStep Roukf::step(const Eigen::Vector3d& so_position, const Eigen::VectorXd&
     const Eigen::MatrixXd HL = alpha * Z * I.transpose();
     const double variance = options_.observation_std * options_.observation_std;
     result.noise_scale = adaptive_noise_.update(unexplained_innovation(HL, z_bar, variance, rows, y.size()));
-    result.unexplained_ratio = adaptive_noise_.ratio();
     correct(Z, 1.0 / (variance * result.noise_scale));
     result.normalised_innovation = normalised_innovation(Z, z_bar, 1.0 / variance,
                                                          result.log_det_innovation_covariance);

@@ -54,10 +54,9 @@ struct RoukfStep {
   // -0.5 (NIS + log det S + m log 2 pi), the prediction-error decomposition the residual
   // analysis compares models by. det S = det R det(I + HL^T R^-1 HL) (Sylvester).
   double log_det_innovation_covariance = 0.0;
-  // The adaptive noise scale lambda this step's correction used (1: nominal R) and the
-  // window's unexplained-innovation ratio it came from (the fields above stay nominal).
+  // The adaptive noise scale lambda this step's correction used (1: nominal R; the fields
+  // above stay nominal).
   double noise_scale = 1.0;
-  double unexplained_ratio = 1.0;
   StepReport ensemble;
 };
 
