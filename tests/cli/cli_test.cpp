@@ -59,6 +59,15 @@ class CliTest : public ::testing::Test {
   }
   void TearDown() override { fs::remove_all(dir_); }
 
+  // `generate` on box.json cut to 5 steps, into dir_/out, without VTK, plus `extra` options.
+  CommandRun generate_five_steps(const std::string& extra) const {
+    json scenario = box_;
+    scenario["time"]["steps"] = 5;
+    std::ofstream(dir_ / "short.json") << scenario.dump(2);
+    return run_sigmafem("generate " + (dir_ / "short.json").string() + " --out " + (dir_ / "out").string() +
+                        " --vtk-every 0" + extra);
+  }
+
   // Writes a variant of box.json changed by `edit` and runs generate on it.
   CommandRun generate_variant(const std::function<void(json&)>& edit) {
     json scenario = box_;
@@ -85,11 +94,7 @@ class CliTest : public ::testing::Test {
 };
 
 TEST_F(CliTest, GenerateWritesItsFilesAndSummary) {
-  json scenario = box_;
-  scenario["time"]["steps"] = 5;
-  std::ofstream(dir_ / "short.json") << scenario.dump(2);
-  const CommandRun run = run_sigmafem("generate " + (dir_ / "short.json").string() + " --out " +
-                                      (dir_ / "out").string() + " --vtk-every 0");
+  const CommandRun run = generate_five_steps("");
   ASSERT_EQ(run.exit_code, 0) << run.output;
   EXPECT_NE(run.output.find("generated 5 steps"), std::string::npos) << run.output;
   EXPECT_TRUE(fs::exists(dir_ / "out" / "observations.csv"));
@@ -160,11 +165,7 @@ TEST_F(CliTest, RejectsAnExtraLigamentAtARegionTheScenarioLacks) {
 }
 
 TEST_F(CliTest, GenerateSimulatesTheTruthOnARefinedMesh) {
-  json scenario = box_;
-  scenario["time"]["steps"] = 5;
-  std::ofstream(dir_ / "short.json") << scenario.dump(2);
-  const CommandRun run = run_sigmafem("generate " + (dir_ / "short.json").string() + " --out " +
-                                      (dir_ / "out").string() + " --vtk-every 0 --truth-refine 1");
+  const CommandRun run = generate_five_steps(" --truth-refine 1");
   ASSERT_EQ(run.exit_code, 0) << run.output;
   EXPECT_NE(run.output.find("truth simulated on the scenario's mesh refined 1 more level"), std::string::npos)
       << "the summary says which mesh the truth ran on: " << run.output;
