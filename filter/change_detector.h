@@ -18,6 +18,9 @@ struct ChangeDetectorOptions {
   double false_alarm = 1e-9;       // probability that one test fires on a correct model
   int hold_off = 50;               // steps of silence after firing
   double inflation_log_std = 0.7;  // how much the parameter std (log) is widened on firing
+  // The catch-up after a change (EstimationStep::catching_up): at most this many steps after
+  // firing; 0: none.
+  int max_catch_up = 300;
 };
 
 class ChangeDetector {
@@ -28,6 +31,11 @@ class ChangeDetector {
   // The statistic of the last update and the threshold it was compared with.
   double statistic() const { return statistic_; }
   double threshold() const { return threshold_; }
+  // True when the last window is full and its sum is within the threshold: the innovations
+  // are back to what the model explains (ends a catch-up).
+  bool settled() const {
+    return static_cast<int>(nis_.size()) == options_.window && statistic_ <= threshold_;
+  }
 
  private:
   ChangeDetectorOptions options_;

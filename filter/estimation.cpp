@@ -17,6 +17,7 @@ EstimationRun run_estimation(Ensemble& ensemble, const EstimationOptions& option
   ChangeDetector detector(options.detector);
   EstimationRun run;
   std::deque<bool> scaled;   // the last 2W steps: did the correction use lambda > 1?
+  int catch_up_start = -1;   // index into run.steps of the firing that began the catch-up; -1: none
   for (Eigen::Index k = 1; k < so.rows(); ++k) {
     const auto start = std::chrono::steady_clock::now();
     EstimationStep step;
@@ -67,6 +68,25 @@ EstimationRun run_estimation(Ensemble& ensemble, const EstimationOptions& option
       filter.inflate(options.detector.inflation_log_std);
       filter.hold_adaptive_noise(options.detector.hold_off);
       ++run.changes_detected;
+      // The change began inside the window that fired: its earlier steps are part of the
+      // catch-up. A firing during a catch-up continues it (the cap counts from its start).
+      if (catch_up_start < 0) {
+        catch_up_start = static_cast<int>(run.steps.size());
+        for (std::size_t i = run.steps.size() - std::min(run.steps.size(), W - 1); i < run.steps.size(); ++i)
+          if (!run.steps[i].catching_up) {
+            run.steps[i].catching_up = true;
+            ++run.catch_up_steps;
+          }
+      }
+    }
+    if (catch_up_start >= 0) {
+      const int since = static_cast<int>(run.steps.size()) - catch_up_start;   // 0: the firing step
+      if ((since > options.detector.hold_off && detector.settled()) || since >= options.detector.max_catch_up) {
+        catch_up_start = -1;
+      } else {
+        step.catching_up = true;
+        ++run.catch_up_steps;
+      }
     }
     step.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
     run.steps.push_back(step);

@@ -7,7 +7,9 @@
 //              conservative S, which the filter's drift makes; and the share of steps
 //              outside their own 95% chi^2 band ~ Binomial(N, 0.05))
 //   whiteness  autocorrelation of the standardised innovations z_i / sqrt(S_ii) at lags
-//              1..L, averaged over rows, with a Ljung-Box test; and per row (each row less its
+//              1..L, averaged over rows, with a one-sided Ljung-Box test (positive
+//              correlations: a persisting error; a negative lag 1 is the filter's drift
+//              over-correcting, reported, not failed); and per row (each row less its
 //              100-step moving average: short-term colour only, slow drifts are the bias
 //              tests')
 //   bias       mean innovation per observed point and axis, its t-statistic (the standard
@@ -47,6 +49,9 @@ struct InnovationSeries {
   Eigen::MatrixXd innovation_std;         // N x 3m: sqrt(S_ii) (m); NaN = missing
   Eigen::VectorXd normalised_innovation;  // N: z^T S^-1 z with the full S
   std::vector<int> observed_rows;         // N: rows observed at the step (the NIS's dof)
+  // N, or empty for none: the step lies in the filter's catch-up after a detected change
+  // (EstimationStep::catching_up); the tests leave it out.
+  std::vector<bool> catching_up;
 };
 
 // The series of a run from run_estimation (steps without any observed row are kept; the
@@ -103,7 +108,8 @@ struct WhitenessDiagnostics {
   std::vector<double> autocorrelation;  // lags 1..L: standardised innovations, averaged over rows
   double effective_rows = 0.0;          // n^2 / sum_ij C_ij^2 from the rows' correlation C
   double band = 0.0;                    // 95% band of each averaged lag: 1.96 / sqrt(N effective_rows)
-  double ljung_box = 0.0;               // on the averaged autocorrelation, chi^2 with L dof
+  double ljung_box = 0.0;               // on the averaged autocorrelation's positive lags,
+                                        // chi-bar-square of L
   double p_value = 0.0;
   std::vector<double> row_ljung_box;    // per data row (NaN where the row has too few values)
   std::vector<double> row_p_value;
@@ -139,7 +145,9 @@ struct SpatialPattern {
 
 struct ResidualDiagnostics {
   int burn_in_steps = 0;      // steps left out at the start
-  int steps_used = 0;         // N: steps after the burn-in with at least one observed row
+  int steps_used = 0;         // N: steps after the burn-in with at least one observed row,
+                              //    outside a catch-up
+  int catch_up_steps = 0;     // steps after the burn-in left out as a catch-up after a change
   int first_step = 0;         // data row of the first step used
   std::vector<int> used;      // indices into the series of the steps used
   NisDiagnostics nis;

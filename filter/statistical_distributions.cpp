@@ -201,6 +201,31 @@ double chi_square_quantile(double probability, double dof) {
                     start > 0.0 ? start : 1e-3 * dof);
 }
 
+double chi_bar_square_tail(double x, int L) {
+  require(L > 0, "chi_bar_square_tail", "L must be positive");
+  if (x < 0.0) return 1.0;
+  if (x == 0.0) return 1.0 - std::ldexp(1.0, -L);   // all L at or below zero: P = 2^-L
+  double sum = 0.0, weight = std::ldexp(1.0, -L);   // C(L, j) 2^-L, from j = 0
+  for (int j = 1; j <= L; ++j) {
+    weight *= static_cast<double>(L - j + 1) / j;
+    sum += weight * chi_square_tail(x, j);
+  }
+  return sum;
+}
+
+double chi_bar_square_tail_quantile(double tail, int L) {
+  require(L > 0, "chi_bar_square_tail_quantile", "L must be positive");
+  require(tail > 0.0 && tail < 1.0 - std::ldexp(1.0, -L), "chi_bar_square_tail_quantile",
+          "tail must be in (0, 1 - 2^-L)");
+  // The tail decreases in x and lies between the chi-square(1)'s and the chi-square(L)'s.
+  double low = 0.0, high = chi_square_tail_quantile(tail, L);
+  for (int i = 0; i < 200 && high - low > 1e-12 * high; ++i) {
+    const double mid = 0.5 * (low + high);
+    (chi_bar_square_tail(mid, L) > tail ? low : high) = mid;
+  }
+  return 0.5 * (low + high);
+}
+
 double student_t_two_sided_tail(double t, double dof) {
   require(dof > 0.0, "student_t_two_sided_tail", "dof must be positive");
   t = std::fabs(t);

@@ -30,6 +30,13 @@ double chi_square_tail(double x, double dof);
 double chi_square_quantile(double probability, double dof);
 double chi_square_tail_quantile(double tail, double dof);
 
+// Chi-bar-square of L: the sum over L independent N(0, 1) variables of max(z, 0)^2, the null
+// distribution of a one-sided test on L statistics (only positive deviations count):
+// P(X > x) = sum_{j=1..L} C(L, j) 2^-L P(chi^2_j > x) (x > 0), and the x with P(X > x) = tail
+// (tail < 1 - 2^-L).
+double chi_bar_square_tail(double x, int L);
+double chi_bar_square_tail_quantile(double tail, int L);
+
 // Student's t with `dof` degrees of freedom: P(|T| > t) and the t > 0 with P(|T| > t) = tail.
 double student_t_two_sided_tail(double t, double dof);
 double student_t_two_sided_quantile(double tail, double dof);

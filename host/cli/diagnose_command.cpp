@@ -24,6 +24,7 @@ Action add_diagnose_command(CLI::App& app) {
     int max_rounds = 3;
     double burn_in = 0.2;
     BackendChoice backend;
+    std::string sigma_points = "star";
     bool quiet = false;
   };
   auto options = std::make_shared<Options>();
@@ -48,6 +49,11 @@ Action add_diagnose_command(CLI::App& app) {
       ->check(CLI::Range(0.0, 0.9))
       ->capture_default_str();
   add_backend_options(sub, options->backend);
+  sub->add_option("--sigma", options->sigma_points,
+                  "Sigma-point set of every fit: star (symmetric, 2p points) or simplex (p + 1 points), or "
+                  "scenario for the scenario's filter.sigma_points")
+      ->check(CLI::IsMember(std::vector<std::string>{"simplex", "star", "scenario"}))
+      ->capture_default_str();
   sub->add_flag("--quiet", options->quiet, "No progress lines and no summary");
   return [options]() {
     const Scenario scenario = load_scenario(options->scenario);
@@ -80,6 +86,9 @@ Action add_diagnose_command(CLI::App& app) {
     diagnose_options.device = options->backend.device_options();
     diagnose_options.max_rounds = options->max_rounds;
     diagnose_options.burn_in_fraction = options->burn_in;
+    diagnose_options.sigma_points = options->sigma_points == "scenario"
+                                        ? std::nullopt
+                                        : std::optional<SigmaPointSet>(parse_sigma_point_set(options->sigma_points));
     std::stringstream names(options->candidates);
     for (std::string name; std::getline(names, name, ',');)
       if (!name.empty()) diagnose_options.candidates.push_back(name);

@@ -145,6 +145,7 @@ json write_diagnosis_report(const Scenario& scenario, const Diagnosis& d, const 
                             {"score", number(c.score)},
                             {"complete", c.complete},
                             {"steps", c.steps},
+                            {"compared_steps", c.compared_steps},
                             {"stop_reason", c.stop_reason},
                             {"verdict_with_it", to_string(c.verdict)},
                             {"failed_tests_with_it", failed_details(d.fits[static_cast<std::size_t>(c.fit)])},
@@ -234,6 +235,11 @@ json write_diagnosis_report(const Scenario& scenario, const Diagnosis& d, const 
          << (c.complete ? "" : " (stopped: " + c.stop_reason + "; not ranked)") << " | " << fixed(c.gain, 1)
          << " | " << fixed(c.penalty, 1) << " | " << fixed(c.score, 1) << " | " << to_string(c.verdict) << " | "
          << estimate_text(c.estimate) << " |\n";
+    if (!round.candidates.empty() && round.candidates[0].complete &&
+        round.candidates[0].compared_steps < round.candidates[0].steps)
+      md << "\nThe gains are over " << round.candidates[0].compared_steps << " of the "
+         << round.candidates[0].steps << " steps: those where a fit was catching up after a detected change "
+         << "are left out of every fit's sum.\n";
     if (!fit.run.complete)
       md << "\nThe round's model stopped early (" << fit.run.stop_reason
          << "): the complete candidates are ranked by their own log-likelihood minus the penalty.\n";

@@ -110,6 +110,10 @@ void print_estimation_summary(std::ostream& out, const json& summary, const std:
         << summary["adaptive_noise"]["first_step"].get<int>() << ", noise variance scaled by up to "
         << format_number(summary["adaptive_noise"]["max_scale"].get<double>())
         << " (the model does not explain the data)\n";
+  if (summary["catch_up_steps"].get<int>() > 0)
+    out << "  changes detected at steps " << summary["changes_detected_at_steps"].dump() << "; "
+        << summary["catch_up_steps"].get<int>()
+        << " steps of catch-up after them are left out of the residual tests\n";
   if (summary["residual"].is_object()) {
     const auto& residual = summary["residual"];
     out << "  residuals: " << residual["verdict"].get<std::string>();

@@ -56,14 +56,14 @@ std::string estimates_csv(const EstimationReport& report, const EstimationRun& r
   if (!run.complete) out << "# incomplete: " << run.stop_reason << '\n';
   out << "step,time";
   for (const std::string& name : report.names) out << ',' << name << ',' << name << "_std";
-  out << ",innovation_rms,normalised_innovation,change_detected,noise_scale\n";
+  out << ",innovation_rms,normalised_innovation,change_detected,noise_scale,catching_up\n";
   for (const EstimationStep& step : run.steps) {
     out << step.step << ',' << format_number(step.time);
     for (Eigen::Index j = 0; j < step.stiffness.size(); ++j)
       out << ',' << format_number(step.stiffness[j]) << ',' << format_number(step.stiffness_std[j]);
     out << ',' << (std::isnan(step.innovation_rms) ? "" : format_number(step.innovation_rms)) << ','
         << format_number(step.normalised_innovation) << ',' << (step.change_detected ? 1 : 0) << ','
-        << format_number(step.noise_scale) << '\n';
+        << format_number(step.noise_scale) << ',' << (step.catching_up ? 1 : 0) << '\n';
   }
   return out.str();
 }
@@ -193,6 +193,7 @@ nlohmann::ordered_json write_estimation_report(const EstimationReport& report, c
                        {"total_s", report.total_seconds}};
   summary["cg"] = {{"max_iterations", max_cg}, {"unconverged_sigma_steps", unconverged}};
   summary["changes_detected_at_steps"] = changes;
+  summary["catch_up_steps"] = run.catch_up_steps;
   summary["adaptive_noise"] = adaptive_noise_json(run);
   if (truth) {
     Eigen::MatrixXd estimate(static_cast<Eigen::Index>(run.steps.size()),

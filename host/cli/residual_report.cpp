@@ -36,6 +36,7 @@ json residual_json(const ResidualDiagnostics& d, const ResidualDiagnosticsOption
   j["false_alarm"] = options.false_alarm;
   j["burn_in_steps"] = d.burn_in_steps;
   j["steps_used"] = d.steps_used;
+  j["catch_up_steps"] = d.catch_up_steps;
   j["first_step"] = d.first_step;
   json tests = json::array();
   for (const DiagnosticTest& test : d.verdict.tests) tests.push_back(test_json(test));

@@ -91,6 +91,7 @@ ModelFit fit_model(const Scenario& scenario, const ObservationTable& data,
     p += static_cast<int>(definition->parameters.size());
   }
   RoukfOptions& roukf = estimation.roukf;
+  if (options.sigma_points) roukf.sigma_points = *options.sigma_points;
   roukf.initial_theta.conservativeResize(p);
   roukf.initial_theta.tail(p - p0).setZero();
   roukf.initial_std = Eigen::VectorXd::Ones(p);
@@ -138,6 +139,7 @@ ModelFit fit_model(const Scenario& scenario, const ObservationTable& data,
                                               : -0.5 * (step.normalised_innovation + step.log_det_innovation_covariance +
                                                         step.observed_rows * kLog2Pi);
     fit.log_likelihood += ll;
+    fit.step_log_likelihood.push_back(ll);
     fit.observed_scalars += step.observed_rows;
   }
   double sum = 0.0;
@@ -198,6 +200,30 @@ ModelFit fit_model(const Scenario& scenario, const ObservationTable& data,
   return fit;
 }
 
+namespace {
+
+// Steps (filter step indices) where any of `fits` that completed was catching up after a
+// detected change: the steps the comparison of their likelihoods leaves out.
+std::vector<bool> catch_up_union(const std::vector<const ModelFit*>& fits) {
+  std::vector<bool> left_out;
+  for (const ModelFit* fit : fits) {
+    if (!fit->run.complete) continue;
+    left_out.resize(std::max(left_out.size(), fit->run.steps.size()), false);
+    for (std::size_t k = 0; k < fit->run.steps.size(); ++k)
+      if (fit->run.steps[k].catching_up) left_out[k] = true;
+  }
+  return left_out;
+}
+
+double log_likelihood_outside(const ModelFit& fit, const std::vector<bool>& left_out) {
+  double sum = 0.0;
+  for (std::size_t k = 0; k < fit.step_log_likelihood.size(); ++k)
+    if (k >= left_out.size() || !left_out[k]) sum += fit.step_log_likelihood[k];
+  return sum;
+}
+
+}  // namespace
+
 Diagnosis diagnose(const Scenario& scenario, const ObservationTable& data,
                    const std::optional<TruthTable>& truth, const DiagnoseOptions& options) {
   Diagnosis d;
@@ -226,7 +252,7 @@ Diagnosis diagnose(const Scenario& scenario, const ObservationTable& data,
       d.rounds.push_back(r);
       break;
     }
-    const double base_ll = fit.log_likelihood;
+    const int base_fit = d.path.back();
     const bool base_complete = fit.run.complete;
     const double log_n = std::log(static_cast<double>(std::max<long long>(fit.observed_scalars, 2)));
     for (const std::string& name : library) {
@@ -239,24 +265,33 @@ Diagnosis diagnose(const Scenario& scenario, const ObservationTable& data,
       CandidateScore score;
       score.effect = name;
       score.parameters = static_cast<int>(find_effect(name)->parameters.size());
-      score.log_likelihood = candidate.log_likelihood;
       score.complete = candidate.run.complete;
       score.steps = static_cast<int>(candidate.run.steps.size());
       score.penalty = 0.5 * score.parameters * log_n;
-      if (!score.complete) {
-        score.gain = score.score = NAN;
-      } else if (base_complete) {
-        score.gain = candidate.log_likelihood - base_ll;
-        score.score = score.gain - score.penalty;
-      } else {
-        score.gain = NAN;
-        score.score = candidate.log_likelihood - score.penalty;
-      }
       score.stop_reason = candidate.run.stop_reason;
       score.verdict = candidate.residual.verdict.consistency;
       if (!candidate.estimates.empty()) score.estimate = candidate.estimates.back();
       score.fit = static_cast<int>(d.fits.size()) - 1;
       r.candidates.push_back(score);
+    }
+    // The likelihoods compared on the same steps (CandidateScore::log_likelihood).
+    std::vector<const ModelFit*> compared = {&d.fits[static_cast<std::size_t>(base_fit)]};
+    for (const CandidateScore& c : r.candidates) compared.push_back(&d.fits[static_cast<std::size_t>(c.fit)]);
+    const std::vector<bool> left_out = catch_up_union(compared);
+    const double base_ll = log_likelihood_outside(d.fits[static_cast<std::size_t>(base_fit)], left_out);
+    for (CandidateScore& c : r.candidates) {
+      const ModelFit& candidate = d.fits[static_cast<std::size_t>(c.fit)];
+      c.log_likelihood = log_likelihood_outside(candidate, left_out);
+      c.compared_steps = static_cast<int>(candidate.run.steps.size() - std::count(left_out.begin(), left_out.end(), true));
+      if (!c.complete) {
+        c.gain = c.score = NAN;
+      } else if (base_complete) {
+        c.gain = c.log_likelihood - base_ll;
+        c.score = c.gain - c.penalty;
+      } else {
+        c.gain = NAN;
+        c.score = c.log_likelihood - c.penalty;
+      }
     }
     std::sort(r.candidates.begin(), r.candidates.end(), [](const CandidateScore& a, const CandidateScore& b) {
       if (a.complete != b.complete) return a.complete;
@@ -282,7 +317,9 @@ Diagnosis diagnose(const Scenario& scenario, const ObservationTable& data,
       // a modulus scale of 1.09 the data do not hold.) One that stopped early never does.
       const ModelFit& refined = d.fits.back();
       const ModelFit& first_pass = d.fits[static_cast<std::size_t>(r.candidates[0].fit)];
-      const bool better = refined.run.complete && refined.log_likelihood >= first_pass.log_likelihood;
+      const std::vector<bool> either_catching_up = catch_up_union({&refined, &first_pass});
+      const bool better = refined.run.complete && log_likelihood_outside(refined, either_catching_up) >=
+                                                      log_likelihood_outside(first_pass, either_catching_up);
       d.path.push_back(better ? static_cast<int>(d.fits.size()) - 1 : r.candidates[0].fit);
     }
     d.rounds.push_back(r);

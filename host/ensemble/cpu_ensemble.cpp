@@ -90,20 +90,22 @@ void CpuEnsemble::predicted_observations(Eigen::MatrixXd& y) const {
 void CpuEnsemble::recenter(const Recentering& r) {
   const int S = sigma_count();
   const Eigen::Index n = simulations_[0].positions().size();
-  Eigen::MatrixXd X(n, S);
-  Eigen::VectorXd velocity = Eigen::VectorXd::Zero(n);
+  Eigen::MatrixXd X(n, S), V(n, S);
   for (int s = 0; s < S; ++s) {
     X.col(s) = simulations_[s].positions();
-    velocity += r.alpha * simulations_[s].velocities();
+    V.col(s) = simulations_[s].velocities();
   }
   // docs/ROUKF.md steps 1-2 (see Recentering): mean and factor of the predicted states, the
-  // correction, then the new factor L C and the re-sampled states.
-  const Eigen::VectorXd mean = r.alpha * X.rowwise().sum();
-  const Eigen::MatrixXd L = r.alpha * X * r.directions.transpose();   // n x p
-  const Eigen::VectorXd x_hat = mean + L * r.correction;
-  const Eigen::MatrixXd LC = L * r.factor;
-  for (int s = 0; s < S; ++s)
-    simulations_[s].set_state(x_hat + LC * r.directions.col(s), velocity);
+  // correction, then the new factor L C and the re-sampled states; positions and velocities
+  // alike (the state of a dynamic simulation is both).
+  auto resample = [&](const Eigen::MatrixXd& Y) {
+    const Eigen::VectorXd mean = r.alpha * Y.rowwise().sum();
+    const Eigen::MatrixXd L = r.alpha * Y * r.directions.transpose();   // n x p
+    const Eigen::VectorXd y_hat = mean + L * r.correction;
+    return Eigen::MatrixXd(y_hat.replicate(1, S) + L * r.factor * r.directions);
+  };
+  const Eigen::MatrixXd X_new = resample(X), V_new = resample(V);
+  for (int s = 0; s < S; ++s) simulations_[s].set_state(X_new.col(s), V_new.col(s));
 }
 
 }  // namespace sigmafem

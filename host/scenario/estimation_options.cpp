@@ -20,6 +20,7 @@ EstimationOptions estimation_options(const Scenario& scenario) {
   if (detection.false_alarm) options.detector.false_alarm = *detection.false_alarm;
   if (detection.hold_off) options.detector.hold_off = *detection.hold_off;
   if (detection.inflation_log_std) options.detector.inflation_log_std = *detection.inflation_log_std;
+  if (detection.max_catch_up) options.detector.max_catch_up = *detection.max_catch_up;
   const AdaptiveNoiseSpec& adaptive = spec.adaptive_noise;
   if (adaptive.enabled) options.roukf.adaptive_noise.enabled = *adaptive.enabled;
   if (adaptive.window) options.roukf.adaptive_noise.window = *adaptive.window;

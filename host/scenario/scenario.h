@@ -115,6 +115,7 @@ struct ChangeDetectionSpec {
   std::optional<double> false_alarm;
   std::optional<int> hold_off;
   std::optional<double> inflation_log_std;
+  std::optional<int> max_catch_up;
 };
 
 // filter.adaptive_noise: the observation-noise scale under model error

@@ -757,7 +757,7 @@ void read_filter(const Checker& c, const json& root, Scenario& s) {
     const json& detection = filter.at("change_detection");
     const std::string path = "filter.change_detection";
     c.check_object(detection, path,
-                   {"enabled", "window", "false_alarm", "hold_off", "inflation_log_std"}, {});
+                   {"enabled", "window", "false_alarm", "hold_off", "inflation_log_std", "max_catch_up"}, {});
     ChangeDetectionSpec& d = spec.change_detection;
     read_windowed_test(c, detection, path, d.enabled, d.window, d.false_alarm);
     if (detection.contains("hold_off")) {
@@ -767,6 +767,10 @@ void read_filter(const Checker& c, const json& root, Scenario& s) {
     if (detection.contains("inflation_log_std")) {
       d.inflation_log_std = c.number(detection.at("inflation_log_std"), child(path, "inflation_log_std"));
       c.non_negative(*d.inflation_log_std, child(path, "inflation_log_std"));
+    }
+    if (detection.contains("max_catch_up")) {
+      d.max_catch_up = c.integer(detection.at("max_catch_up"), child(path, "max_catch_up"));
+      c.require(*d.max_catch_up >= 0, child(path, "max_catch_up"), "must not be negative");
     }
   }
   if (filter.contains("adaptive_noise")) {

@@ -3,7 +3,8 @@
  * CpuEnsemble::recenter; filter/ensemble.h, struct Recentering). Per dof row, with X_s the
  * sigma states and I_s the directions:
  *   mean = alpha sum_s X_s,  L_j = alpha sum_s X_s I_js,  X_hat = mean + L correction,
- *   X_s <- X_hat + sum_j L_j W_js  (W = C I, formed on the host),  V_s <- alpha sum_s V_s.
+ *   X_s <- X_hat + sum_j L_j W_js  (W = C I, formed on the host),
+ * and the same for the velocities V (the state of a dynamic simulation is both).
  * The sums are taken relative to sigma point 0 (the directions sum to zero and the weights
  * to one), which keeps float32 rounding at the size of the spread between sigma points. */
 #version 450
@@ -32,23 +33,37 @@ void main() {
   real mean = real(0);
   real velocity = real(0);
   real L[SF_MAX_PARAMETERS];
-  for (uint j = 0u; j < p; ++j) L[j] = real(0);
+  real Lv[SF_MAX_PARAMETERS];
+  for (uint j = 0u; j < p; ++j) {
+    L[j] = real(0);
+    Lv[j] = real(0);
+  }
   for (uint s = 0u; s < S; ++s) {
     real dx = x[base + s] - x0;
     mean += dx;
-    velocity += v[base + s] - v0;
-    for (uint j = 0u; j < p; ++j) L[j] += dx * directions[j * S + s];
+    real dv = v[base + s] - v0;
+    velocity += dv;
+    for (uint j = 0u; j < p; ++j) {
+      L[j] += dx * directions[j * S + s];
+      Lv[j] += dv * directions[j * S + s];
+    }
   }
   real x_hat = x0 + alpha * mean;
+  real v_hat = v0 + alpha * velocity;
   for (uint j = 0u; j < p; ++j) {
     L[j] *= alpha;
+    Lv[j] *= alpha;
     x_hat += L[j] * scalars[1u + j];
+    v_hat += Lv[j] * scalars[1u + j];
   }
-  velocity = v0 + alpha * velocity;
   for (uint s = 0u; s < S; ++s) {
     real xs = x_hat;
-    for (uint j = 0u; j < p; ++j) xs += L[j] * weights[j * S + s];
+    real vs = v_hat;
+    for (uint j = 0u; j < p; ++j) {
+      xs += L[j] * weights[j * S + s];
+      vs += Lv[j] * weights[j * S + s];
+    }
     x[base + s] = xs;
-    v[base + s] = velocity;
+    v[base + s] = vs;
   }
 }

@@ -268,11 +268,10 @@ TEST_P(EnsembleConformance, RecenteringMatchesTheFormula) {
   device->set_parameters(theta_);
   for (int k = 1; k <= 10; ++k) device->advance(so(k));
   const int p = static_cast<int>(estimated_.size());
-  Eigen::MatrixXd X(model_.dof_count(), S_);
-  Eigen::VectorXd velocity = Eigen::VectorXd::Zero(model_.dof_count());
+  Eigen::MatrixXd X(model_.dof_count(), S_), V(model_.dof_count(), S_);
   for (int s = 0; s < S_; ++s) {
     X.col(s) = device->positions(s);
-    velocity += device->velocities(s) / S_;
+    V.col(s) = device->velocities(s);
   }
   Recentering r;
   r.alpha = 1.0 / S_;
@@ -286,12 +285,15 @@ TEST_P(EnsembleConformance, RecenteringMatchesTheFormula) {
   device->recenter(r);
   const Eigen::MatrixXd L = r.alpha * X * r.directions.transpose();
   const Eigen::VectorXd x_hat = r.alpha * X.rowwise().sum() + L * r.correction;
+  const Eigen::MatrixXd Lv = r.alpha * V * r.directions.transpose();
+  const Eigen::VectorXd v_hat = r.alpha * V.rowwise().sum() + Lv * r.correction;
   for (int s = 0; s < S_; ++s) {
     const Eigen::VectorXd expected = x_hat + L * r.factor * r.directions.col(s);
     // float32: positions to ~2e-8 m; the spread terms are far smaller than the positions.
     EXPECT_LT((device->positions(s) - expected).cwiseAbs().maxCoeff(), tolerance(1e-7, 1e-14))
         << "sigma point " << s;
-    EXPECT_LT((device->velocities(s) - velocity).cwiseAbs().maxCoeff(), tolerance(1e-7, 1e-14));
+    const Eigen::VectorXd expected_velocity = v_hat + Lv * r.factor * r.directions.col(s);
+    EXPECT_LT((device->velocities(s) - expected_velocity).cwiseAbs().maxCoeff(), tolerance(1e-7, 1e-14));
   }
 }
 

@@ -59,11 +59,10 @@ TEST_F(CpuEnsembleTest, RecenteringResamplesAroundTheCorrectedMean) {
   theta << std::log(100.0), std::log(300.0), std::log(900.0);
   ensemble.set_parameters(theta);
   for (int k = 1; k <= 20; ++k) ensemble.advance(so(k));
-  Eigen::MatrixXd X(model_.dof_count(), S);
-  Eigen::VectorXd mean_velocity = Eigen::VectorXd::Zero(model_.dof_count());
+  Eigen::MatrixXd X(model_.dof_count(), S), V(model_.dof_count(), S);
   for (int s = 0; s < S; ++s) {
     X.col(s) = ensemble.simulation(s).positions();
-    mean_velocity += ensemble.simulation(s).velocities() / S;
+    V.col(s) = ensemble.simulation(s).velocities();
   }
   Recentering r;
   r.alpha = 1.0 / S;
@@ -75,13 +74,17 @@ TEST_F(CpuEnsembleTest, RecenteringResamplesAroundTheCorrectedMean) {
   const Eigen::VectorXd mean = X.rowwise().mean();
   const Eigen::VectorXd L = r.alpha * X * r.directions.transpose();
   const Eigen::VectorXd x_hat = mean + 0.3 * L;
+  const Eigen::VectorXd Lv = r.alpha * V * r.directions.transpose();
+  const Eigen::VectorXd v_hat = V.rowwise().mean() + 0.3 * Lv;
+  ASSERT_GT(Lv.norm(), 1e-6 * v_hat.norm()) << "the sigma points' velocities differ";
   for (int s = 0; s < S; ++s) {
     const Eigen::VectorXd expected = x_hat + 0.5 * L * r.directions(0, s);
     EXPECT_LT((ensemble.simulation(s).positions() - expected).norm(), 1e-12 * expected.norm())
         << "re-sampled positions of sigma point " << s;
-    EXPECT_LT((ensemble.simulation(s).velocities() - mean_velocity).norm(),
-              1e-12 * (1.0 + mean_velocity.norm()))
-        << "velocities are the mean velocity, sigma point " << s;
+    const Eigen::VectorXd expected_velocity = v_hat + 0.5 * Lv * r.directions(0, s);
+    EXPECT_LT((ensemble.simulation(s).velocities() - expected_velocity).norm(),
+              1e-12 * (1.0 + expected_velocity.norm()))
+        << "re-sampled velocities of sigma point " << s;
   }
 }
 

@@ -155,6 +155,22 @@ TEST(BoxEstimation, ChangeDetectorFiresOnTheCutWithASmallDrift) {
   ASSERT_FALSE(fired.empty()) << "the cut must be detected";
   EXPECT_GE(fired.front(), cut_step) << "fired before the cut";
   EXPECT_LE(fired.front(), cut_step + 50) << "fired late";
+
+  // The catch-up (EstimationStep::catching_up): one block from the first step of the window
+  // that fired, through at least the hold-off, at most max_catch_up steps after the firing;
+  // nothing is marked before it, and the run counts exactly the marked steps.
+  int first = -1, last = -1, marked = 0;
+  for (const EstimationStep& step : run.steps)
+    if (step.catching_up) {
+      if (first < 0) first = step.step;
+      last = step.step;
+      ++marked;
+    }
+  EXPECT_EQ(marked, run.catch_up_steps);
+  EXPECT_EQ(first, fired.front() - options.detector.window + 1);
+  EXPECT_GE(last, fired.front() + options.detector.hold_off);
+  EXPECT_LE(last, fired.back() + options.detector.max_catch_up);
+  EXPECT_LT(marked, static_cast<int>(run.steps.size()) / 4) << "the catch-up ends";
 }
 
 TEST(BoxEstimation, HandlesMissingObservations) {

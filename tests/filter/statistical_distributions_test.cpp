@@ -4,7 +4,10 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
+#include <random>
+#include <vector>
 
 namespace sigmafem {
 namespace {
@@ -61,6 +64,30 @@ TEST(StatisticalDistributions, BinomialTail) {
   EXPECT_NEAR(binomial_tail(10, 10, 0.5), 1.0 / 1024.0, 1e-15);
   EXPECT_EQ(binomial_tail(0, 10, 0.3), 1.0);
   EXPECT_EQ(binomial_tail(11, 10, 0.3), 0.0);
+}
+
+TEST(StatisticalDistributions, ChiBarSquareIsTheOneSidedSumOfSquares) {
+  // L = 1: half the chi-square(1) tail (z > 0 half the time).
+  EXPECT_NEAR(chi_bar_square_tail(3.841459, 1), 0.025, 1e-7);
+  EXPECT_NEAR(chi_bar_square_tail(0.0, 10), 1.0 - std::ldexp(1.0, -10), 1e-15);
+  EXPECT_EQ(chi_bar_square_tail(-1.0, 10), 1.0);
+  for (double tail : {0.1, 1e-3, 1e-6})
+    EXPECT_NEAR(chi_bar_square_tail(chi_bar_square_tail_quantile(tail, 10), 10), tail, 1e-9 * tail);
+  // Against sampling: 200,000 sums of max(z, 0)^2 over 10 normals; the empirical tail at the
+  // 5% and 1% quantiles within 4 binomial standard errors.
+  std::mt19937_64 random(5);
+  std::normal_distribution<double> normal;
+  std::vector<double> sums(200000);
+  for (double& s : sums) {
+    s = 0.0;
+    for (int k = 0; k < 10; ++k) s += std::pow(std::max(normal(random), 0.0), 2);
+  }
+  for (double tail : {0.05, 0.01}) {
+    const double q = chi_bar_square_tail_quantile(tail, 10);
+    const double above = static_cast<double>(std::count_if(sums.begin(), sums.end(), [q](double s) { return s > q; }));
+    const double n = static_cast<double>(sums.size());
+    EXPECT_NEAR(above / n, tail, 4.0 * std::sqrt(tail * (1 - tail) / n)) << "tail " << tail;
+  }
 }
 
 }  // namespace

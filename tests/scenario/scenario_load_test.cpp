@@ -165,6 +165,8 @@ TEST_F(ScenarioLoadTest, GivenOptionalFieldsAreRead) {
   EXPECT_FALSE(options.roukf.adaptive_noise.enabled);
   EXPECT_EQ(options.roukf.adaptive_noise.window, 7);
   EXPECT_EQ(options.roukf.adaptive_noise.false_alarm, 1e-3);
+  j["filter"]["change_detection"] = {{"max_catch_up", 0}};
+  EXPECT_EQ(estimation_options(load_scenario(write(j, "catch_up.json"))).detector.max_catch_up, 0);
 }
 
 TEST_F(ScenarioLoadTest, ControlStartIsTheCentroidOfTheControlNodes) {
@@ -358,6 +360,9 @@ TEST_F(ScenarioLoadTest, BadFieldsAreNamed) {
       {"adaptive noise enabled not a boolean",
        [](json& j) { j["filter"]["adaptive_noise"] = {{"enabled", "yes"}}; },
        {"filter.adaptive_noise.enabled", "expected true or false"}},
+      {"negative catch-up",
+       [](json& j) { j["filter"]["change_detection"] = {{"max_catch_up", -1}}; },
+       {"filter.change_detection.max_catch_up", "must not be negative"}},
       {"change detection window out of range",
        [](json& j) { j["filter"]["change_detection"] = {{"window", 5000}}; },
        {"filter.change_detection.window", "1..1000"}},
