@@ -119,6 +119,9 @@ json write_diagnosis_report(const Scenario& scenario, const Diagnosis& d, const 
   j["scenario"] = scenario.path;
   j["data"] = report.data_dir;
   j["backend"] = report.backend;
+  const std::string sigma_points =
+      options.sigma_points ? to_string(*options.sigma_points) : scenario.filter->sigma_points;
+  j["sigma_points"] = sigma_points;
   j["outcome"] = to_string(d.outcome);
   j["conclusion"] = d.conclusion;
   j["penalty"] = "BIC: 0.5 k log N, k the candidate's parameters, N the observed scalars";
@@ -189,7 +192,7 @@ json write_diagnosis_report(const Scenario& scenario, const Diagnosis& d, const 
   std::ostringstream md;
   md << "# sigmafem diagnose: " << scenario.name << "\n\n"
      << "Scenario `" << scenario.path << "`, data `" << report.data_dir << "`, back end " << report.backend
-     << ".\n\n**Outcome: " << to_string(d.outcome) << ".** " << d.conclusion << "\n\n";
+     << ", " << sigma_points << " sigma points.\n\n**Outcome: " << to_string(d.outcome) << ".** " << d.conclusion << "\n\n";
   if (!report.truth_effects.is_null()) md << "Effects in the data (truth.json): `" << report.truth_effects.dump() << "`\n\n";
   md << "## Before and after\n\n| | before (" << model_name(d.before()) << ") | after (" << model_name(d.after())
      << ") |\n|---|---|---|\n"

@@ -109,7 +109,8 @@ void print_estimation_summary(std::ostream& out, const json& summary, const std:
     out << "  adaptive noise: engaged on " << summary["adaptive_noise"]["steps"].get<int>() << " steps from step "
         << summary["adaptive_noise"]["first_step"].get<int>() << ", noise variance scaled by up to "
         << format_number(summary["adaptive_noise"]["max_scale"].get<double>())
-        << " (the model does not explain the data)\n";
+        << " (innovations beyond what the parameters explain: a model error, or a change in the steps "
+           "before the detector fired)\n";
   if (summary["catch_up_steps"].get<int>() > 0)
     out << "  changes detected at steps " << summary["changes_detected_at_steps"].dump() << "; "
         << summary["catch_up_steps"].get<int>()

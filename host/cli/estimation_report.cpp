@@ -40,7 +40,7 @@ json adaptive_noise_json(const EstimationRun& run) {
                     ? "the innovations stayed within what the parameters and the stated noise explain: "
                       "every correction used the nominal observation noise"
                     : "the innovations held more than the parameters and the stated noise explain (a model "
-                      "error): on " + std::to_string(run.noise_scaled_steps) + " steps the correction used the "
+                      "error, or a change in the steps before the detector fired): on " + std::to_string(run.noise_scaled_steps) + " steps the correction used the "
                       "observation noise variance scaled by up to " + format_number(run.max_noise_scale) +
                       " so that the parameters are not driven by it; the residual tests use the nominal noise";
   return j;
