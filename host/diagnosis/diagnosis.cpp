@@ -282,7 +282,8 @@ Diagnosis diagnose(const Scenario& scenario, const ObservationTable& data,
     for (CandidateScore& c : r.candidates) {
       const ModelFit& candidate = d.fits[static_cast<std::size_t>(c.fit)];
       c.log_likelihood = log_likelihood_outside(candidate, left_out);
-      c.compared_steps = static_cast<int>(candidate.run.steps.size() - std::count(left_out.begin(), left_out.end(), true));
+      c.compared_steps = c.complete ? c.steps - static_cast<int>(std::count(left_out.begin(), left_out.end(), true))
+                                    : c.steps;
       if (!c.complete) {
         c.gain = c.score = NAN;
       } else if (base_complete) {

@@ -8,7 +8,9 @@
 //      the innovations (prediction-error decomposition, sum over steps of
 //      -0.5 (z^T S^-1 z + log det S + m log 2 pi), S with the nominal R) with the candidate's
 //      parameters estimated, minus the current model's, minus the BIC penalty 0.5 k log N (k
-//      the candidate's parameters, N the observed scalars). Only fits that ran over every step
+//      the candidate's parameters, N the observed scalars), all on the same steps: every step
+//      but those where the round's model or a complete candidate was catching up after a
+//      detected change (EstimationStep::catching_up). Only fits that ran over every step
 //      are compared (a fit that stopped early is listed with its steps and reason, never ranked
 //      by a partial sum); when the round's model itself stopped early, the complete candidates
 //      are ranked by their own log-likelihood minus the penalty. The best positive score is
