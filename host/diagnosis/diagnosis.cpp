@@ -200,10 +200,6 @@ ModelFit fit_model(const Scenario& scenario, const ObservationTable& data,
   return fit;
 }
 
-namespace {
-
-// Steps (filter step indices) where any of `fits` that completed was catching up after a
-// detected change: the steps the comparison of their likelihoods leaves out.
 std::vector<bool> catch_up_union(const std::vector<const ModelFit*>& fits) {
   std::vector<bool> left_out;
   for (const ModelFit* fit : fits) {
@@ -221,8 +217,6 @@ double log_likelihood_outside(const ModelFit& fit, const std::vector<bool>& left
     if (k >= left_out.size() || !left_out[k]) sum += fit.step_log_likelihood[k];
   return sum;
 }
-
-}  // namespace
 
 Diagnosis diagnose(const Scenario& scenario, const ObservationTable& data,
                    const std::optional<TruthTable>& truth, const DiagnoseOptions& options) {

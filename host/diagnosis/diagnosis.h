@@ -151,6 +151,12 @@ ModelFit fit_model(const Scenario& scenario, const ObservationTable& data,
                    const DiagnoseOptions& options, const Eigen::VectorXd& start = {},
                    const Eigen::VectorXd& start_std = {});
 
+// The steps (filter step indices) where any of `fits` that completed was catching up after a
+// detected change, and a fit's log-likelihood summed over the other steps: how diagnose
+// compares fits on the same steps.
+std::vector<bool> catch_up_union(const std::vector<const ModelFit*>& fits);
+double log_likelihood_outside(const ModelFit& fit, const std::vector<bool>& left_out);
+
 // The candidates `names` stand for (empty: every candidate of the library), a regional family
 // (extra_ligament) once per candidate region of the scenario. Throws InputError for a name
 // outside the library or a region the scenario lacks.

@@ -105,6 +105,29 @@ BoxData box_data(const std::vector<EffectValue>& inject, std::uint64_t seed = 1,
   return box;
 }
 
+TEST(DiagnoseLikelihood, FitsAreComparedOnTheStepsNoneIsCatchingUp) {
+  // Two complete fits of 6 steps, catching up on steps 1-2 and 2-3, and one that stopped after
+  // 2 steps while catching up on step 0: the union leaves out 1-3 (the stopped fit adds
+  // nothing), and each sum skips them.
+  auto fit = [](std::vector<double> ll, std::vector<int> catching_up, bool complete) {
+    ModelFit f;
+    f.run.complete = complete;
+    f.step_log_likelihood = ll;
+    f.run.steps.resize(ll.size());
+    for (int k : catching_up) f.run.steps[static_cast<std::size_t>(k)].catching_up = true;
+    return f;
+  };
+  const ModelFit a = fit({1, 2, 4, 8, 16, 32}, {1, 2}, true);
+  const ModelFit b = fit({-1, -2, -4, -8, -16, -32}, {2, 3}, true);
+  const ModelFit stopped = fit({100, 200}, {0}, false);
+  const std::vector<bool> left_out = catch_up_union({&a, &b, &stopped});
+  EXPECT_EQ(left_out, std::vector<bool>({false, true, true, true, false, false}));
+  EXPECT_EQ(log_likelihood_outside(a, left_out), 1 + 16 + 32);
+  EXPECT_EQ(log_likelihood_outside(b, left_out), -(1 + 16 + 32));
+  EXPECT_EQ(log_likelihood_outside(stopped, left_out), 100);
+  EXPECT_EQ(log_likelihood_outside(a, {}), 63) << "nothing left out";
+}
+
 std::string describe_residual(const ModelFit& fit) {
   std::ostringstream out;
   for (const DiagnosticTest& test : fit.residual.verdict.tests)
