@@ -61,8 +61,8 @@ struct EstimationStep {
   // filter corrects the state only along the parameters' sensitivities, so after a cut the
   // state it carries needs time to meet the organ's new motion even with the right parameters
   // (measured on the liver under 9.81 m/s^2 with the true model: mean NIS about 2000 against
-  // 36 over the 100 steps after the cut). The residual tests leave these steps out, and the
-  // reports say how many; the likelihood keeps them.
+  // 36 over the 100 steps after the cut). The residual tests leave these steps out, diagnose
+  // compares fits' likelihoods without them (catch_up_union), and the reports say how many.
   bool catching_up = false;
   int max_cg_iterations = 0;       // over the sigma points
   int unconverged_sigma_points = 0;

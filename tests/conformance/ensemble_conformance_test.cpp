@@ -283,17 +283,18 @@ TEST_P(EnsembleConformance, RecenteringMatchesTheFormula) {
   r.factor = Eigen::MatrixXd::Identity(p, p) * 0.8;
   r.factor(0, p - 1) = 0.1;
   device->recenter(r);
-  const Eigen::MatrixXd L = r.alpha * X * r.directions.transpose();
-  const Eigen::VectorXd x_hat = r.alpha * X.rowwise().sum() + L * r.correction;
-  const Eigen::MatrixXd Lv = r.alpha * V * r.directions.transpose();
-  const Eigen::VectorXd v_hat = r.alpha * V.rowwise().sum() + Lv * r.correction;
+  // The formula (filter/ensemble.h, Recentering), the same for positions and velocities.
+  auto resampled = [&](const Eigen::MatrixXd& Y) {
+    const Eigen::MatrixXd L = r.alpha * Y * r.directions.transpose();
+    const Eigen::VectorXd y_hat = r.alpha * Y.rowwise().sum() + L * r.correction;
+    return Eigen::MatrixXd(y_hat.replicate(1, S_) + L * r.factor * r.directions);
+  };
+  const Eigen::MatrixXd X_expected = resampled(X), V_expected = resampled(V);
   for (int s = 0; s < S_; ++s) {
-    const Eigen::VectorXd expected = x_hat + L * r.factor * r.directions.col(s);
     // float32: positions to ~2e-8 m; the spread terms are far smaller than the positions.
-    EXPECT_LT((device->positions(s) - expected).cwiseAbs().maxCoeff(), tolerance(1e-7, 1e-14))
+    EXPECT_LT((device->positions(s) - X_expected.col(s)).cwiseAbs().maxCoeff(), tolerance(1e-7, 1e-14))
         << "sigma point " << s;
-    const Eigen::VectorXd expected_velocity = v_hat + Lv * r.factor * r.directions.col(s);
-    EXPECT_LT((device->velocities(s) - expected_velocity).cwiseAbs().maxCoeff(), tolerance(1e-7, 1e-14));
+    EXPECT_LT((device->velocities(s) - V_expected.col(s)).cwiseAbs().maxCoeff(), tolerance(1e-7, 1e-14));
   }
 }
 
