@@ -88,6 +88,8 @@ EstimationRun run_estimation(Ensemble& ensemble, const EstimationOptions& option
         ++run.catch_up_steps;
       }
     }
+    // While the state catches up, its innovations are not evidence about the constants.
+    filter.hold_constants(catch_up_start >= 0);
     step.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
     run.steps.push_back(step);
     if (on_step) on_step(step);

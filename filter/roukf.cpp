@@ -39,6 +39,15 @@ Roukf::Roukf(const RoukfOptions& options, Ensemble& ensemble)
                         ? Eigen::VectorXd(options.drift_std.array().square())
                         : Eigen::VectorXd::Constant(p, options.parameter_drift_log_std *
                                                            options.parameter_drift_log_std);
+  if (!options.constant.empty() && options.constant.size() != static_cast<std::size_t>(p))
+    throw std::invalid_argument("Roukf: constant has " + std::to_string(options.constant.size()) +
+                                " flags for " + std::to_string(p) + " parameters");
+  inflatable_ = Eigen::VectorXd::Ones(p);
+  std::vector<int> constants;
+  for (int j = 0; j < static_cast<int>(options.constant.size()); ++j)
+    if (options.constant[static_cast<std::size_t>(j)]) inflatable_[j] = 0.0, constants.push_back(j);
+  constant_rows_ = Eigen::MatrixXd::Zero(static_cast<Eigen::Index>(constants.size()), p);
+  for (std::size_t i = 0; i < constants.size(); ++i) constant_rows_(static_cast<Eigen::Index>(i), constants[i]) = 1.0;
   theta_ = options.initial_theta;
   // L = [0; I_p], U^-1 = diag(sigma^2): the state is known, the parameters are not.
   L_theta_ = Eigen::MatrixXd::Identity(p, p);
@@ -69,7 +78,7 @@ RoukfStep Roukf::step(const Eigen::Vector3d& so_position, const Eigen::VectorXd&
                                 " observation values, got " + std::to_string(y.size()));
 
   if (drift_variance_.maxCoeff() > 0.0 || pending_variance_ > 0.0)
-    add_theta_variance(drift_variance_.array() + pending_variance_);
+    add_theta_variance(drift_variance_ + pending_variance_ * inflatable_);
   pending_variance_ = 0.0;
 
   // Sampling.
@@ -127,6 +136,13 @@ RoukfStep Roukf::step(const Eigen::Vector3d& so_position, const Eigen::VectorXd&
     // diag(S) = row norms of HL plus R's diagonal: what standardises each row's innovation
     // for the residual diagnostics (nominal R: the diagnostics judge the model as declared).
     result.innovation_variance = HL.rowwise().squaredNorm().array() + variance;
+    if (hold_constants_ && constant_rows_.rows() > 0) {
+      // The smallest change of the correction k (in sigma coordinates) that leaves the
+      // constants' theta as they are: remove its component along the rows A = E_c L_theta,
+      // k -= A^T (A A^T)^-1 A k. The state follows, as it takes L_x k at the next re-sampling.
+      const Eigen::MatrixXd A = constant_rows_ * L_theta_;
+      correction_ -= A.transpose() * (A * A.transpose()).ldlt().solve(A * correction_);
+    }
     theta_ += L_theta_ * correction_;
   }
   result.theta = theta_;

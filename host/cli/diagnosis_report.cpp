@@ -203,8 +203,9 @@ json write_diagnosis_report(const Scenario& scenario, const Diagnosis& d, const 
      << "| log-likelihood | " << fixed(d.before().log_likelihood, 1) << " | " << fixed(d.after().log_likelihood, 1) << " |\n";
   if (d.before().stiffness_error && d.after().stiffness_error)
     md << "| stiffness error, mean over ligaments and the last 20% of steps (N/m) | "
-       << fixed(*d.before().stiffness_error, 2) << " | " << fixed(*d.after().stiffness_error, 2) << " |\n"
-       << "| relative stiffness error | " << fixed(100.0 * *d.before().stiffness_relative_error, 1) << "% | "
+       << fixed(*d.before().stiffness_error, 2) << " | " << fixed(*d.after().stiffness_error, 2) << " |\n";
+  if (d.before().stiffness_relative_error && d.after().stiffness_relative_error)
+    md << "| stiffness error over the sum of the true stiffnesses | " << fixed(100.0 * *d.before().stiffness_relative_error, 1) << "% | "
        << fixed(100.0 * *d.after().stiffness_relative_error, 1) << "% |\n";
   for (std::size_t l = 0; l < d.before().ligaments.size(); ++l) {
     const auto ll = static_cast<Eigen::Index>(l);

@@ -98,6 +98,8 @@ ModelFit fit_model(const Scenario& scenario, const ObservationTable& data,
   roukf.initial_std.head(p0).setConstant(spec.initial_log_std);
   roukf.drift_std = Eigen::VectorXd::Zero(p);
   roukf.drift_std.head(p0).setConstant(spec.parameter_drift_log_std);
+  roukf.constant.assign(static_cast<std::size_t>(p), true);
+  std::fill_n(roukf.constant.begin(), p0, false);
   if (start.size() == p && start_std.size() == p) {
     roukf.initial_std = start_std.cwiseMin(roukf.initial_std);
     roukf.initial_theta = start;
@@ -175,7 +177,7 @@ ModelFit fit_model(const Scenario& scenario, const ObservationTable& data,
   if (truth) {
     const std::size_t n = fit.run.steps.size();
     const std::size_t first = n - std::max<std::size_t>(1, n / 5);
-    double absolute = 0.0, relative = 0.0;
+    double absolute = 0.0, truth_sum = 0.0;
     int terms = 0;
     bool ok = true;
     for (std::size_t k = first; k < n && ok; ++k) {
@@ -188,13 +190,13 @@ ModelFit fit_model(const Scenario& scenario, const ObservationTable& data,
         }
         const double t = truth->stiffness(step.step, column);
         absolute += std::abs(step.stiffness[j] - t);
-        relative += std::abs(step.stiffness[j] - t) / std::max(t, 1e-12);
+        truth_sum += t;
         ++terms;
       }
     }
     if (ok && terms > 0) {
       fit.stiffness_error = absolute / terms;
-      fit.stiffness_relative_error = relative / terms;
+      if (truth_sum > 0.0) fit.stiffness_relative_error = absolute / truth_sum;
     }
   }
   return fit;

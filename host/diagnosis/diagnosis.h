@@ -92,8 +92,9 @@ struct ModelFit {
   Eigen::VectorXd theta;                    // final: log-stiffnesses, then the effect coordinates
   Eigen::VectorXd theta_std;                // their standard deviations
   bool refined = false;                     // a second pass started at the first pass's estimate
-  // Against truth.csv when given: mean over the last 20% of the steps and over the estimated
-  // ligaments of |estimate - truth| (N/m) and of |estimate - truth| / truth.
+  // Against truth.csv when given, over the last 20% of the steps and the estimated ligaments:
+  // the mean of |estimate - truth| (N/m), and its sum over the sum of the truths (a cut
+  // ligament's truth is near 0, so a per-ligament ratio would measure nothing but that).
   std::optional<double> stiffness_error;
   std::optional<double> stiffness_relative_error;
 };

@@ -138,6 +138,58 @@ TEST_P(RoukfExactTest, DriftAddsItsVarianceToTheParameters) {
       << to_string(GetParam()) << ": P_theta after a drift step without data";
 }
 
+TEST_P(RoukfExactTest, InflationLeavesTheConstantsAlone) {
+  const int n = 4, p = 3, m = 3;
+  const LinearModel model = make_linear_model(n, p, m, 7);
+  const SigmaPoints points = make_sigma_points(GetParam(), p);
+  testing::LinearGaussianEnsemble ensemble(model.A, model.B, model.c, model.H, model.x0,
+                                           points.count());
+  RoukfOptions options;
+  options.sigma_points = GetParam();
+  options.initial_theta = Eigen::VectorXd::Zero(p);
+  options.initial_log_std = 0.5;
+  options.observation_std = 0.1;
+  options.constant = {false, true, false};
+  Roukf filter(options, ensemble);
+  const Eigen::MatrixXd before = filter.theta_covariance();
+  filter.inflate(0.3);
+  const RoukfStep result = filter.step(Eigen::Vector3d::Zero(), Eigen::VectorXd::Constant(m, NAN));
+  const Eigen::MatrixXd expected = before + Eigen::Vector3d(0.09, 0.0, 0.09).asDiagonal().toDenseMatrix();
+  EXPECT_LT((result.theta_covariance - expected).norm(), kExact)
+      << to_string(GetParam()) << ": only the parameters that are not constants open";
+}
+
+TEST_P(RoukfExactTest, HeldConstantsStayWhileTheOthersAreCorrected) {
+  const int n = 6, p = 3, m = 4;
+  const LinearModel model = make_linear_model(n, p, m, 11);
+  const SigmaPoints points = make_sigma_points(GetParam(), p);
+  testing::LinearGaussianEnsemble ensemble(model.A, model.B, model.c, model.H, model.x0,
+                                           points.count());
+  testing::LinearGaussianEnsemble truth(model.A, model.B, model.c, model.H, model.x0, 1);
+  RoukfOptions options;
+  options.sigma_points = GetParam();
+  options.initial_theta = Eigen::VectorXd::Zero(p);
+  options.initial_log_std = 0.7;
+  options.observation_std = 0.05;
+  options.constant = {false, false, true};
+  Roukf filter(options, ensemble);
+  truth.set_parameters(model.theta_true);
+  filter.hold_constants(true);
+  for (int k = 1; k <= 10; ++k) {
+    truth.advance(Eigen::Vector3d::Zero());
+    Eigen::MatrixXd y;
+    truth.predicted_observations(y);
+    const RoukfStep result = filter.step(Eigen::Vector3d::Zero(), y.col(0));
+    EXPECT_NEAR(result.theta[2], 0.0, 1e-12) << to_string(GetParam()) << ": the held constant moved at step " << k;
+  }
+  EXPECT_GT(filter.theta().head(2).norm(), 0.1) << "the other parameters were not corrected";
+  filter.hold_constants(false);
+  truth.advance(Eigen::Vector3d::Zero());
+  Eigen::MatrixXd y;
+  truth.predicted_observations(y);
+  EXPECT_GT(std::abs(filter.step(Eigen::Vector3d::Zero(), y.col(0)).theta[2]), 1e-6) << "released, it is corrected again";
+}
+
 TEST_P(RoukfExactTest, MissingRowsAreDropped) {
   // A step where some rows are missing equals the exact filter with those rows removed:
   // compare against a second filter fed a model whose H lacks the rows.
