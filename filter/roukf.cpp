@@ -2,6 +2,7 @@
 
 #include <Eigen/Cholesky>
 #include <Eigen/LU>
+#include <algorithm>
 #include <cmath>
 #include <limits>
 #include <stdexcept>
@@ -42,12 +43,10 @@ Roukf::Roukf(const RoukfOptions& options, Ensemble& ensemble)
   if (!options.constant.empty() && options.constant.size() != static_cast<std::size_t>(p))
     throw std::invalid_argument("Roukf: constant has " + std::to_string(options.constant.size()) +
                                 " flags for " + std::to_string(p) + " parameters");
-  inflatable_ = Eigen::VectorXd::Ones(p);
-  std::vector<int> constants;
-  for (int j = 0; j < static_cast<int>(options.constant.size()); ++j)
-    if (options.constant[static_cast<std::size_t>(j)]) inflatable_[j] = 0.0, constants.push_back(j);
-  constant_rows_ = Eigen::MatrixXd::Zero(static_cast<Eigen::Index>(constants.size()), p);
-  for (std::size_t i = 0; i < constants.size(); ++i) constant_rows_(static_cast<Eigen::Index>(i), constants[i]) = 1.0;
+  const auto constants = static_cast<Eigen::Index>(std::count(options.constant.begin(), options.constant.end(), true));
+  constant_rows_ = Eigen::MatrixXd::Zero(constants, p);
+  for (int j = 0, i = 0; j < static_cast<int>(options.constant.size()); ++j)
+    if (options.constant[static_cast<std::size_t>(j)]) constant_rows_(i++, j) = 1.0;
   theta_ = options.initial_theta;
   // L = [0; I_p], U^-1 = diag(sigma^2): the state is known, the parameters are not.
   L_theta_ = Eigen::MatrixXd::Identity(p, p);
@@ -78,7 +77,8 @@ RoukfStep Roukf::step(const Eigen::Vector3d& so_position, const Eigen::VectorXd&
                                 " observation values, got " + std::to_string(y.size()));
 
   if (drift_variance_.maxCoeff() > 0.0 || pending_variance_ > 0.0)
-    add_theta_variance(drift_variance_ + pending_variance_ * inflatable_);
+    add_theta_variance(drift_variance_ +
+                       pending_variance_ * (1.0 - constant_rows_.colwise().sum().transpose().array()).matrix());
   pending_variance_ = 0.0;
 
   // Sampling.

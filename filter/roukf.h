@@ -112,7 +112,6 @@ class Roukf {
   Eigen::MatrixXd U_inv_;               // p x p
   Eigen::VectorXd correction_;          // k of the last correction, applied at re-sampling
   double pending_variance_ = 0.0;       // inflation to add before the next sampling
-  Eigen::VectorXd inflatable_;          // p: 1 where inflate() applies, 0 for a constant
   Eigen::MatrixXd constant_rows_;       // the rows of the identity that pick the constants
   bool hold_constants_ = false;
   Eigen::VectorXd drift_variance_;      // p: q_j^2

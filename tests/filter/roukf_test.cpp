@@ -41,7 +41,18 @@ LinearModel make_linear_model(int n, int p, int m, unsigned seed) {
   return model;
 }
 
-class RoukfExactTest : public ::testing::TestWithParam<SigmaPointSet> {};
+class RoukfExactTest : public ::testing::TestWithParam<SigmaPointSet> {
+ protected:
+  // What every test's filter starts from: the set under test, theta_hat = 0.
+  RoukfOptions options(int p, double prior_std, double observation_std) const {
+    RoukfOptions o;
+    o.sigma_points = GetParam();
+    o.initial_theta = Eigen::VectorXd::Zero(p);
+    o.initial_log_std = prior_std;
+    o.observation_std = observation_std;
+    return o;
+  }
+};
 
 TEST_P(RoukfExactTest, MatchesTheExactKalmanFilterStepAfterStep) {
   const int n = 6, p = 3, m = 4, steps = 40;
@@ -50,11 +61,7 @@ TEST_P(RoukfExactTest, MatchesTheExactKalmanFilterStepAfterStep) {
   const SigmaPoints points = make_sigma_points(GetParam(), p);
   testing::LinearGaussianEnsemble ensemble(model.A, model.B, model.c, model.H, model.x0,
                                            points.count());
-  RoukfOptions options;
-  options.sigma_points = GetParam();
-  options.initial_theta = Eigen::VectorXd::Zero(p);
-  options.initial_log_std = sigma0;
-  options.observation_std = obs_std;
+  const RoukfOptions options = this->options(p, sigma0, obs_std);
   Roukf filter(options, ensemble);
 
   // The exact filter on z = [x; theta]: F = [A B; 0 I], observation [H 0].
@@ -120,11 +127,7 @@ TEST_P(RoukfExactTest, DriftAddsItsVarianceToTheParameters) {
   const SigmaPoints points = make_sigma_points(GetParam(), p);
   testing::LinearGaussianEnsemble ensemble(model.A, model.B, model.c, model.H, model.x0,
                                            points.count());
-  RoukfOptions options;
-  options.sigma_points = GetParam();
-  options.initial_theta = Eigen::VectorXd::Zero(p);
-  options.initial_log_std = 0.5;
-  options.observation_std = 0.1;
+  RoukfOptions options = this->options(p, 0.5, 0.1);
   options.parameter_drift_log_std = 0.2;
   Roukf filter(options, ensemble);
   const Eigen::MatrixXd before = filter.theta_covariance();
@@ -144,11 +147,7 @@ TEST_P(RoukfExactTest, InflationLeavesTheConstantsAlone) {
   const SigmaPoints points = make_sigma_points(GetParam(), p);
   testing::LinearGaussianEnsemble ensemble(model.A, model.B, model.c, model.H, model.x0,
                                            points.count());
-  RoukfOptions options;
-  options.sigma_points = GetParam();
-  options.initial_theta = Eigen::VectorXd::Zero(p);
-  options.initial_log_std = 0.5;
-  options.observation_std = 0.1;
+  RoukfOptions options = this->options(p, 0.5, 0.1);
   options.constant = {false, true, false};
   Roukf filter(options, ensemble);
   const Eigen::MatrixXd before = filter.theta_covariance();
@@ -166,11 +165,7 @@ TEST_P(RoukfExactTest, HeldConstantsStayWhileTheOthersAreCorrected) {
   testing::LinearGaussianEnsemble ensemble(model.A, model.B, model.c, model.H, model.x0,
                                            points.count());
   testing::LinearGaussianEnsemble truth(model.A, model.B, model.c, model.H, model.x0, 1);
-  RoukfOptions options;
-  options.sigma_points = GetParam();
-  options.initial_theta = Eigen::VectorXd::Zero(p);
-  options.initial_log_std = 0.7;
-  options.observation_std = 0.05;
+  RoukfOptions options = this->options(p, 0.7, 0.05);
   options.constant = {false, false, true};
   Roukf filter(options, ensemble);
   truth.set_parameters(model.theta_true);
