@@ -1,52 +1,42 @@
 #include "filter/change_detector.h"
 
+#include "filter/statistical_distributions.h"
+
+#include <algorithm>
 #include <cmath>
 #include <numeric>
 
 namespace sigmafem {
-namespace {
-
-// The standard normal quantile of probability 1 - tail (Acklam's rational approximation,
-// relative error below 1.2e-9 for the tails used here).
-double normal_upper_quantile(double tail) {
-  const double q = std::sqrt(-2.0 * std::log(tail));
-  static const double c[] = {-7.784894002430293e-03, -3.223964580411365e-01, -2.400758277161838e+00,
-                             -2.549732539343734e+00, 4.374664141464968e+00,  2.938163982698783e+00};
-  static const double d[] = {7.784695709041462e-03, 3.224671290700398e-01, 2.445134137142996e+00,
-                             3.754408661907416e+00};
-  const double x = (((((c[0] * q + c[1]) * q + c[2]) * q + c[3]) * q + c[4]) * q + c[5]) /
-                   ((((d[0] * q + d[1]) * q + d[2]) * q + d[3]) * q + 1.0);
-  return -x;
-}
-
-}  // namespace
-
-double chi_square_upper_quantile(int k, double tail) {
-  const double kd = static_cast<double>(k);
-  const double z = normal_upper_quantile(tail);
-  const double a = 2.0 / (9.0 * kd);
-  const double cube = 1.0 - a + z * std::sqrt(a);
-  return kd * cube * cube * cube;
-}
-
 bool ChangeDetector::update(double normalised_innovation, int degrees_of_freedom) {
   if (!options_.enabled || degrees_of_freedom <= 0 || !std::isfinite(normalised_innovation))
     return false;
   nis_.push_back(normalised_innovation);
   dof_.push_back(degrees_of_freedom);
-  while (static_cast<int>(nis_.size()) > options_.window) {
+  const auto W = static_cast<std::size_t>(options_.window);
+  const std::size_t kept = W * static_cast<std::size_t>(1 + options_.reference_windows);
+  while (nis_.size() > kept) {
     nis_.pop_front();
     dof_.pop_front();
   }
-  statistic_ = std::accumulate(nis_.begin(), nis_.end(), 0.0);
-  threshold_ = chi_square_upper_quantile(std::accumulate(dof_.begin(), dof_.end(), 0),
-                                         options_.false_alarm);
+  // The tested window is the last W steps; the reference, the steps before them.
+  const auto tested = static_cast<std::ptrdiff_t>(nis_.size() - std::min(nis_.size(), W));
+  statistic_ = std::accumulate(nis_.begin() + tested, nis_.end(), 0.0);
+  const int dof = std::accumulate(dof_.begin() + tested, dof_.end(), 0);
+  const double reference = std::accumulate(nis_.begin(), nis_.begin() + tested, 0.0);
+  const int reference_dof = std::accumulate(dof_.begin(), dof_.begin() + tested, 0);
+  const bool model_error = reference_dof > 0 &&
+      reference > chi_square_tail_quantile(options_.model_error_false_alarm, reference_dof);
+  reference_level_ = model_error ? reference / reference_dof : 1.0;
+  threshold_ = model_error ? reference_level_ * dof * f_tail_quantile(options_.false_alarm, dof, reference_dof)
+                           : chi_square_tail_quantile(options_.false_alarm, dof);
   if (silent_for_ > 0) {
     --silent_for_;
     return false;
   }
-  if (static_cast<int>(nis_.size()) < options_.window || statistic_ <= threshold_) return false;
+  // Tested only with a full reference: a level is not known from fewer steps.
+  if (nis_.size() < kept || statistic_ <= threshold_) return false;
   silent_for_ = options_.hold_off;
+  threshold_per_dof_at_firing_ = threshold_ / dof;
   nis_.clear();
   dof_.clear();
   return true;

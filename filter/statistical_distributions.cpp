@@ -106,6 +106,13 @@ double chi_square_density(double x, double dof) {
   return std::exp((k - 1.0) * std::log(x) - 0.5 * x - k * std::log(2.0) - std::lgamma(k));
 }
 
+double f_density(double x, double d1, double d2) {
+  if (x <= 0.0) return 0.0;
+  const double a = 0.5 * d1, b = 0.5 * d2;
+  return std::exp(a * std::log(d1) + b * std::log(d2) + (a - 1.0) * std::log(x) -
+                  (a + b) * std::log(d1 * x + d2) - std::lgamma(a) - std::lgamma(b) + std::lgamma(a + b));
+}
+
 // Wilson-Hilferty: (X/k)^(1/3) is nearly normal with mean 1 - 2/(9k) and variance 2/(9k).
 double wilson_hilferty(double upper_z, double dof) {
   const double a = 2.0 / (9.0 * dof);
@@ -224,6 +231,22 @@ double chi_bar_square_tail_quantile(double tail, int L) {
     (chi_bar_square_tail(mid, L) > tail ? low : high) = mid;
   }
   return 0.5 * (low + high);
+}
+
+double f_tail(double x, double d1, double d2) {
+  require(d1 > 0.0 && d2 > 0.0, "f_tail", "the degrees of freedom must be positive");
+  if (x <= 0.0) return 1.0;
+  // P(F > x) = I_{d2 / (d2 + d1 x)}(d2 / 2, d1 / 2): small for large x, computed directly.
+  return regularized_beta(d2 / (d2 + d1 * x), 0.5 * d2, 0.5 * d1);
+}
+
+double f_tail_quantile(double tail, double d1, double d2) {
+  require(d1 > 0.0 && d2 > 0.0, "f_tail_quantile", "the degrees of freedom must be positive");
+  require(tail > 0.0 && tail < 1.0, "f_tail_quantile", "tail must be in (0, 1)");
+  // log F is nearly normal with variance 2/d1 + 2/d2 for large d: the start.
+  const double start = std::exp(normal_quantile(1.0 - tail) * std::sqrt(2.0 / d1 + 2.0 / d2));
+  return solve_tail([d1, d2](double x) { return f_tail(x, d1, d2); },
+                    [d1, d2](double x) { return f_density(x, d1, d2); }, tail, start);
 }
 
 double student_t_two_sided_tail(double t, double dof) {

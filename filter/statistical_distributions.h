@@ -1,5 +1,5 @@
 // The distribution functions the residual diagnostics test against: standard normal,
-// chi-square, Student's t and binomial tails and quantiles. Written here rather than taken from
+// chi-square, F, Student's t and binomial tails and quantiles. Written here rather than taken from
 // a statistics library because sigmafem needs only these few, in double precision, with
 // tails far out (Bonferroni thresholds near 1e-5).
 //
@@ -36,6 +36,11 @@ double chi_square_tail_quantile(double tail, double dof);
 // (tail < 1 - 2^-L).
 double chi_bar_square_tail(double x, int L);
 double chi_bar_square_tail_quantile(double tail, int L);
+
+// Snedecor's F with d1 and d2 degrees of freedom (the ratio of two independent chi-squares,
+// each over its degrees of freedom): P(X > x), and the x with P(X > x) = tail.
+double f_tail(double x, double d1, double d2);
+double f_tail_quantile(double tail, double d1, double d2);
 
 // Student's t with `dof` degrees of freedom: P(|T| > t) and the t > 0 with P(|T| > t) = tail.
 double student_t_two_sided_tail(double t, double dof);

@@ -42,6 +42,20 @@ TEST(StatisticalDistributions, ChiSquareQuantileInvertsTheDistributionFarOut) {
   EXPECT_NEAR(chi_square_cdf(7.0, 2.0) + chi_square_tail(7.0, 2.0), 1.0, 1e-15);
 }
 
+TEST(StatisticalDistributions, FQuantilesMatchTheTablesAndTheIdentities) {
+  // Upper 5% and 1% points (Abramowitz and Stegun table 26.9).
+  EXPECT_NEAR(f_tail_quantile(0.05, 5, 10), 3.326, 1e-3);
+  EXPECT_NEAR(f_tail_quantile(0.01, 10, 20), 3.368, 1e-3);
+  EXPECT_NEAR(f_tail_quantile(0.05, 2, 30), 3.316, 1e-3);
+  // F(1, d) is t(d)^2; d1 F(d1, d2 -> infinity) is chi-square(d1).
+  const double t = student_t_two_sided_quantile(0.05, 10);
+  EXPECT_NEAR(f_tail_quantile(0.05, 1, 10), t * t, 1e-9);
+  EXPECT_NEAR(360 * f_tail_quantile(1e-9, 360, 1e9) / chi_square_tail_quantile(1e-9, 360), 1.0, 1e-5);
+  // Inverts the tail far out, where the change detector reads it.
+  for (double tail : {0.3, 1e-3, 1e-9})
+    EXPECT_NEAR(f_tail(f_tail_quantile(tail, 360, 360), 360, 360) / tail, 1.0, 1e-8) << tail;
+}
+
 TEST(StatisticalDistributions, NormalAndStudentTMatchTheTables) {
   EXPECT_NEAR(normal_quantile(0.975), 1.959964, 1e-6);
   EXPECT_NEAR(normal_quantile(0.005), -2.575829, 1e-6);
