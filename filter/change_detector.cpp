@@ -21,22 +21,23 @@ bool ChangeDetector::update(double normalised_innovation, int degrees_of_freedom
   // The tested window is the last W steps; the reference, the steps before them.
   const auto tested = static_cast<std::ptrdiff_t>(nis_.size() - std::min(nis_.size(), W));
   statistic_ = std::accumulate(nis_.begin() + tested, nis_.end(), 0.0);
-  const int dof = std::accumulate(dof_.begin() + tested, dof_.end(), 0);
-  const double reference = std::accumulate(nis_.begin(), nis_.begin() + tested, 0.0);
-  const int reference_dof = std::accumulate(dof_.begin(), dof_.begin() + tested, 0);
-  const bool model_error = reference_dof > 0 &&
-      reference > chi_square_tail_quantile(options_.model_error_false_alarm, reference_dof);
-  reference_level_ = model_error ? reference / reference_dof : 1.0;
-  threshold_ = model_error ? reference_level_ * dof * f_tail_quantile(options_.false_alarm, dof, reference_dof)
-                           : chi_square_tail_quantile(options_.false_alarm, dof);
+  tested_dof_ = std::accumulate(dof_.begin() + tested, dof_.end(), 0);
   if (silent_for_ > 0) {
     --silent_for_;
     return false;
   }
   // Tested only with a full reference: a level is not known from fewer steps.
-  if (nis_.size() < kept || statistic_ <= threshold_) return false;
+  if (nis_.size() < kept) return false;
+  const double reference = std::accumulate(nis_.begin(), nis_.begin() + tested, 0.0);
+  const int reference_dof = std::accumulate(dof_.begin(), dof_.begin() + tested, 0);
+  const bool model_error = reference_dof > 0 &&
+      reference > chi_square_tail_quantile(options_.model_error_false_alarm, reference_dof);
+  reference_level_ = model_error ? reference / reference_dof : 1.0;
+  threshold_ = model_error ? reference_level_ * tested_dof_ * f_tail_quantile(options_.false_alarm, tested_dof_, reference_dof)
+                           : chi_square_tail_quantile(options_.false_alarm, tested_dof_);
+  if (statistic_ <= threshold_) return false;
   silent_for_ = options_.hold_off;
-  threshold_per_dof_at_firing_ = threshold_ / dof;
+  threshold_per_dof_at_firing_ = threshold_ / tested_dof_;
   nis_.clear();
   dof_.clear();
   return true;

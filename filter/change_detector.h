@@ -22,7 +22,6 @@
 #pragma once
 
 #include <deque>
-#include <numeric>
 
 namespace sigmafem {
 
@@ -46,7 +45,8 @@ class ChangeDetector {
   explicit ChangeDetector(const ChangeDetectorOptions& options) : options_(options) {}
   // Adds one step's NIS with its degrees of freedom; returns true when the test fires.
   bool update(double normalised_innovation, int degrees_of_freedom);
-  // The statistic of the last update and the threshold it was compared with.
+  // The statistic of the last update, and the threshold and reference level of the last test
+  // (made once the reference is full and the hold-off is over).
   double statistic() const { return statistic_; }
   double threshold() const { return threshold_; }
   // The reference window's NIS per degree of freedom when it showed a model error, else 1.
@@ -56,8 +56,7 @@ class ChangeDetector {
   // model explained before the change (ends a catch-up).
   bool settled() const {
     return static_cast<int>(nis_.size()) >= options_.window &&
-           statistic_ <= threshold_per_dof_at_firing_ *
-                              std::accumulate(dof_.end() - options_.window, dof_.end(), 0);
+           statistic_ <= threshold_per_dof_at_firing_ * tested_dof_;
   }
 
  private:
@@ -66,6 +65,7 @@ class ChangeDetector {
   std::deque<int> dof_;
   int silent_for_ = 0;
   double statistic_ = 0.0, threshold_ = 0.0;
+  int tested_dof_ = 0;   // the degrees of freedom of the tested window (its last W steps)
   double reference_level_ = 1.0, threshold_per_dof_at_firing_ = 0.0;
 };
 
