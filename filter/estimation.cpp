@@ -15,6 +15,7 @@ EstimationRun run_estimation(Ensemble& ensemble, const EstimationOptions& option
                              const std::function<void(const EstimationStep&)>& on_step) {
   Roukf filter(options.roukf, ensemble);
   ChangeDetector detector(options.detector);
+  RecoveryCheck recovery(options.recovery);
   EstimationRun run;
   std::deque<bool> scaled;   // the last 2W steps: did the correction use lambda > 1?
   int catch_up_start = -1;   // index into run.steps of the firing that began the catch-up; -1: none
@@ -54,6 +55,7 @@ EstimationRun run_estimation(Ensemble& ensemble, const EstimationOptions& option
     for (std::size_t s = 0; s < result.ensemble.cg_iterations.size(); ++s)
       step.max_cg_iterations = std::max(step.max_cg_iterations, result.ensemble.cg_iterations[s]);
     step.unconverged_sigma_points = result.ensemble.unconverged_count();
+    recovery.update(step.innovation, step.innovation_std);
     // One mechanism with the adaptive noise (filter/adaptive_noise.h): a jump of the NIS is a
     // change of the parameters only if the model explained the data before it, i.e. lambda
     // stayed 1 over the W steps before the detector's window of W (the adaptive noise, on a
@@ -81,7 +83,9 @@ EstimationRun run_estimation(Ensemble& ensemble, const EstimationOptions& option
     }
     if (catch_up_start >= 0) {
       const int since = static_cast<int>(run.steps.size()) - catch_up_start;   // 0: the firing step
-      if ((since > options.detector.hold_off && detector.settled()) || since >= options.detector.max_catch_up) {
+      // Over when the NIS is back (settled) and the innovations' mean too (RecoveryCheck).
+      if ((since > options.detector.hold_off && detector.settled() && recovery.recovered()) ||
+          since >= options.detector.max_catch_up) {
         catch_up_start = -1;
       } else {
         step.catching_up = true;

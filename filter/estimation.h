@@ -12,6 +12,7 @@
 
 #include "filter/change_detector.h"
 #include "filter/ensemble.h"
+#include "filter/recovery_check.h"
 #include "filter/roukf.h"
 
 namespace sigmafem {
@@ -19,6 +20,7 @@ namespace sigmafem {
 struct EstimationOptions {
   RoukfOptions roukf;
   ChangeDetectorOptions detector;
+  RecoveryCheckOptions recovery;   // with the detector, ends a catch-up
   // N/m: below or above this range the filter has diverged. No floor by default: a cut
   // ligament (truth 0.01 N/m) is zero to the data below about 1 N/m and its log-estimate may
   // go on down (a spring of 1e-30 N/m, or exp underflowing to 0, is harmless); measured, the
@@ -57,7 +59,8 @@ struct EstimationStep {
   bool change_detected = false;
   // The step lies in the catch-up after a detected change: from the first step of the
   // detector's window that fired until the innovations are back within the detector's
-  // threshold after its hold-off (at most detector.max_catch_up steps). The reduced-order
+  // threshold after its hold-off and their mean is back at zero (RecoveryCheck; at most
+  // detector.max_catch_up steps). The reduced-order
   // filter corrects the state only along the parameters' sensitivities, so after a cut the
   // state it carries needs time to meet the organ's new motion even with the right parameters
   // (measured on the liver under 9.81 m/s^2 with the true model: mean NIS about 2000 against
