@@ -1,5 +1,6 @@
 #include "host/cli/diagnosis_report.h"
 
+#include <algorithm>
 #include <cmath>
 #include <filesystem>
 #include <fstream>
@@ -26,7 +27,8 @@ std::string model_name(const ModelFit& fit) {
 }
 
 json estimate_json(const EffectEstimate& e) {
-  return {{"name", e.name}, {"parameters", e.parameters}, {"units", e.units}, {"value", e.value}, {"std", e.std}};
+  return {{"name", e.name}, {"parameters", e.parameters}, {"units", e.units}, {"value", e.value}, {"std", e.std},
+          {"first_order_std", e.first_order_std}, {"path_ratio", e.path_ratio}};
 }
 
 // The failed tests of a fit, each with its one-line detail.
@@ -84,6 +86,11 @@ std::string estimate_text(const EffectEstimate& e) {
   for (std::size_t j = 0; j < e.std.size(); ++j) out << (j ? ", " : "") << general(e.std[j]);
   out << ")";
   if (!e.units.empty() && !e.units[0].empty()) out << " " << e.units[0];
+  if (std::any_of(e.path_ratio.begin(), e.path_ratio.end(), [](double r) { return r > 1.0; })) {
+    out << ", std x path ratio (";
+    for (std::size_t j = 0; j < e.path_ratio.size(); ++j) out << (j ? ", " : "") << general(std::max(1.0, e.path_ratio[j]));
+    out << ")";
+  }
   return out.str();
 }
 
@@ -218,7 +225,9 @@ json write_diagnosis_report(const Scenario& scenario, const Diagnosis& d, const 
   if (files.contains("residual_before"))
     md << "![residual before](residual_before.png)\n\n![residual after](residual_after.png)\n\n";
   md << "## Rounds\n\nScore = log-likelihood gain of the innovations over every step with the candidate's "
-        "parameters estimated, minus the BIC penalty 0.5 k log N. A fit that stopped early is not ranked.\n\n";
+        "parameters estimated, minus the BIC penalty 0.5 k log N. A fit that stopped early is not ranked. An estimate's +- is "
+        "its first-order standard deviation, times the path ratio where the estimate moved more than its "
+        "covariance allows (docs/ROUKF.md, \"Stated standard deviations\").\n\n";
 
   for (std::size_t r = 0; r < d.rounds.size(); ++r) {
     const DiagnosisRound& round = d.rounds[r];

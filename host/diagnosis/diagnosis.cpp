@@ -4,6 +4,7 @@
 #include <cmath>
 #include <sstream>
 
+#include "filter/path_consistency.h"
 #include "host/common/input_error.h"
 #include "host/ensemble/effect_ensemble.h"
 #include "host/model/effects.h"
@@ -170,7 +171,17 @@ ModelFit fit_model(const Scenario& scenario, const ObservationTable& data,
       estimate.units.push_back(parameter.unit);
     }
     EffectEnsemble::effect_estimate(definition, last.theta.segment(row, k), last.log_std.segment(row, k),
-                                    estimate.value, estimate.std);
+                                    estimate.value, estimate.first_order_std);
+    // The stated std: the first-order one, widened where the estimate's path moved more than
+    // its covariance allows (after the residual tests' burn-in, the sigma points' spread).
+    Eigen::VectorXd stated_std = last.log_std.segment(row, k);
+    for (int j = 0; j < k; ++j) {
+      const PathConsistency path = path_consistency(fit.run.steps, row + j, residual.burn_in_steps);
+      estimate.path_ratio.push_back(path.ratio);
+      stated_std[j] *= std::max(1.0, path.ratio);
+    }
+    std::vector<double> value;
+    EffectEnsemble::effect_estimate(definition, last.theta.segment(row, k), stated_std, value, estimate.std);
     fit.estimates.push_back(estimate);
     row += k;
   }

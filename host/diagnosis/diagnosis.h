@@ -72,7 +72,11 @@ struct EffectEstimate {
   std::vector<std::string> parameters;      // e.g. gx, gy, gz
   std::vector<std::string> units;
   std::vector<double> value;                // natural units (median for a log parameter)
-  std::vector<double> std;                  // first-order standard deviation
+  // The stated standard deviation: the first-order one times max(1, path_ratio), the Birge
+  // ratio of the estimate's path (filter/path_consistency.h).
+  std::vector<double> std;
+  std::vector<double> first_order_std;
+  std::vector<double> path_ratio;
 };
 
 // One filter run of the declared model plus `effects`.
