@@ -6,11 +6,12 @@
 // over consecutive intervals are N(0, 1), and r = sqrt(mean d_i^2) (the Birge ratio) is
 // about 1. A path that moves more than its covariance allows (r well above 1) says the
 // first-order std is too small: something the filter does not model pulls the estimate
-// (measured on liver.json with an undeclared oblique 9.81 m/s^2, seeds 1-4: after the cut
-// the gravity moved 6 std in 50 steps while the cut ligament's estimate came down; r 3.1-3.4
-// for g_y, the final g off by 4.5-8.3 of its first-order std, 1.3-2.4 of the std times r).
-// The stated std of an effect is the first-order std times max(1, r), the convention of the
-// Particle Data Group's scale factor. It cannot reveal a bias the path does not show.
+// (measured on liver.json with an undeclared oblique 9.81 m/s^2, seeds 1-5, before the
+// catch-up waited for the innovations' mean: after the cut the gravity moved 6 std in 50
+// steps while the cut ligament's estimate came down; r 3.0-3.4 for g_y, the final g off by
+// 2.8-8.3 of its first-order std, 1.1-2.6 of the std times r; docs/ROUKF.md has the figures
+// since). The stated std of an effect is the first-order std times max(1, r), the convention
+// of the Particle Data Group's scale factor. It cannot reveal a bias the path does not show.
 #pragma once
 
 #include <vector>
@@ -28,7 +29,7 @@ struct PathConsistency {
 // `interval_count` equal intervals; one over which P did not shrink is left out. Intervals
 // with catch-up steps count: the constants are held there (Roukf::hold_constants), and the
 // pull comes in the steps right after the release (leaving those intervals out, r was
-// 1.0-1.7 on the liver above instead of 2.3-3.6).
+// 1.0-1.7 on the liver above instead of 2.3-3.6, from the filter's path printed every 10 steps).
 PathConsistency path_consistency(const std::vector<EstimationStep>& steps, int parameter, int first,
                                  int interval_count = 20);
 
