@@ -31,7 +31,7 @@ class RecoveryCheck {
   void update(const Eigen::VectorXd& innovation, const Eigen::VectorXd& innovation_std);
   // True when the window is full and no axis's mean standardised innovation is significant.
   bool recovered() const;
-  // The largest |t| over the axes in the last test (0 before the window is full).
+  // The largest |t| over the axes in the window (0 before it is full).
   double largest_t() const;
 
  private:

@@ -174,14 +174,11 @@ ModelFit fit_model(const Scenario& scenario, const ObservationTable& data,
                                     estimate.value, estimate.first_order_std);
     // The stated std: the first-order one, widened where the estimate's path moved more than
     // its covariance allows (after the residual tests' burn-in, the sigma points' spread).
-    Eigen::VectorXd stated_std = last.log_std.segment(row, k);
     for (int j = 0; j < k; ++j) {
       const PathConsistency path = path_consistency(fit.run.steps, row + j, residual.burn_in_steps);
       estimate.path_ratio.push_back(path.ratio);
-      stated_std[j] *= std::max(1.0, path.ratio);
+      estimate.std.push_back(estimate.first_order_std[static_cast<std::size_t>(j)] * std::max(1.0, path.ratio));
     }
-    std::vector<double> value;
-    EffectEnsemble::effect_estimate(definition, last.theta.segment(row, k), stated_std, value, estimate.std);
     fit.estimates.push_back(estimate);
     row += k;
   }
