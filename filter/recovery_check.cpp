@@ -7,6 +7,11 @@
 
 namespace sigmafem {
 
+// Every axis is tested with the window's full dof - 1 (a step without the axis is rare).
+RecoveryCheck::RecoveryCheck(const RecoveryCheckOptions& options)
+    : options_(options),
+      threshold_(student_t_two_sided_quantile(options.false_alarm / 3.0, options.window - 1.0)) {}
+
 void RecoveryCheck::update(const Eigen::VectorXd& innovation, const Eigen::VectorXd& innovation_std) {
   std::array<double, 3> sum{0.0, 0.0, 0.0};
   std::array<int, 3> count{0, 0, 0};
@@ -40,10 +45,7 @@ double RecoveryCheck::largest_t() const {
 }
 
 bool RecoveryCheck::recovered() const {
-  if (static_cast<int>(means_.size()) < options_.window) return false;
-  // Every axis is tested with the window's full dof - 1 (a step without the axis is rare).
-  const double threshold = student_t_two_sided_quantile(options_.false_alarm / 3.0, options_.window - 1.0);
-  return largest_t() <= threshold;
+  return static_cast<int>(means_.size()) >= options_.window && largest_t() <= threshold_;
 }
 
 }  // namespace sigmafem

@@ -26,7 +26,7 @@ struct RecoveryCheckOptions {
 
 class RecoveryCheck {
  public:
-  explicit RecoveryCheck(const RecoveryCheckOptions& options) : options_(options) {}
+  explicit RecoveryCheck(const RecoveryCheckOptions& options);
   // One step's innovations and their std (3m rows, x y z per point; NaN = missing).
   void update(const Eigen::VectorXd& innovation, const Eigen::VectorXd& innovation_std);
   // True when the window is full and no axis's mean standardised innovation is significant.
@@ -36,6 +36,7 @@ class RecoveryCheck {
 
  private:
   RecoveryCheckOptions options_;
+  double threshold_;                          // |t| above which an axis is biased
   std::deque<std::array<double, 3>> means_;   // a_k per axis (NaN where the axis was not seen)
 };
 
