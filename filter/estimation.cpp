@@ -16,6 +16,10 @@ EstimationRun run_estimation(Ensemble& ensemble, const EstimationOptions& option
   Roukf filter(options.roukf, ensemble);
   ChangeDetector detector(options.detector);
   RecoveryCheck recovery(options.recovery);
+  const Eigen::Index parameters = options.roukf.initial_theta.size();
+  LigamentCutRule cut_rule(options.cut, static_cast<int>(options.stiffness_count >= 0
+                                                             ? std::min<Eigen::Index>(options.stiffness_count, parameters)
+                                                             : parameters));
   EstimationRun run;
   std::deque<bool> scaled;   // the last 2W steps: did the correction use lambda > 1?
   int catch_up_start = -1;   // index into run.steps of the firing that began the catch-up; -1: none
@@ -74,6 +78,12 @@ EstimationRun run_estimation(Ensemble& ensemble, const EstimationOptions& option
       // catch-up. A firing during a catch-up continues it (the cap counts from its start).
       if (catch_up_start < 0) {
         catch_up_start = static_cast<int>(run.steps.size());
+        // The estimate before the change began (the step before the window that fired) is
+        // what a cut is measured against.
+        if (!run.steps.empty()) {
+          const EstimationStep& before = run.steps[run.steps.size() - std::min(run.steps.size(), W)];
+          cut_rule.arm(before.theta, before.log_std);
+        }
         for (std::size_t i = run.steps.size() - std::min(run.steps.size(), W - 1); i < run.steps.size(); ++i)
           if (!run.steps[i].catching_up) {
             run.steps[i].catching_up = true;
@@ -91,6 +101,11 @@ EstimationRun run_estimation(Ensemble& ensemble, const EstimationOptions& option
         step.catching_up = true;
         ++run.catch_up_steps;
       }
+    }
+    for (int j : cut_rule.update(step.theta, step.log_std)) {
+      const double before = cut_rule.stiffness_before(j);
+      filter.fix(j, std::log(options.cut.remaining * before));
+      run.cuts.push_back({j, step.step, step.time, before});
     }
     // While the state catches up, its innovations are not evidence about the constants.
     filter.hold_constants(catch_up_start >= 0);

@@ -12,6 +12,7 @@
 
 #include "filter/change_detector.h"
 #include "filter/ensemble.h"
+#include "filter/ligament_cut.h"
 #include "filter/recovery_check.h"
 #include "filter/roukf.h"
 
@@ -21,6 +22,7 @@ struct EstimationOptions {
   RoukfOptions roukf;
   ChangeDetectorOptions detector;
   RecoveryCheckOptions recovery;   // with the detector, ends a catch-up
+  LigamentCutOptions cut;          // after a change: which ligament the data show cut
   // N/m: below or above this range the filter has diverged. No floor by default: a cut
   // ligament (truth 0.01 N/m) is zero to the data below about 1 N/m and its log-estimate may
   // go on down (a spring of 1e-30 N/m, or exp underflowing to 0, is harmless); measured, the
@@ -72,12 +74,22 @@ struct EstimationStep {
   double seconds = 0.0;            // wall time of the filter step
 };
 
+// A ligament the data showed cut (filter/ligament_cut.h): from `step` on its stiffness is
+// held at LigamentCutOptions::remaining of what it was before the change.
+struct LigamentCut {
+  int parameter = 0;              // index into theta (a log-stiffness)
+  int step = 0;                   // the data row at which it was found cut
+  double time = 0.0;              // s
+  double stiffness_before = 0.0;  // N/m, the estimate before the change began
+};
+
 struct EstimationRun {
   std::vector<EstimationStep> steps;   // one per data row after the first
   bool complete = true;
   std::string stop_reason;             // why it stopped early ("" when complete)
   int changes_detected = 0;
   int catch_up_steps = 0;              // steps with catching_up
+  std::vector<LigamentCut> cuts;
   // The adaptive observation noise (filter/adaptive_noise.h): the steps whose correction used
   // lambda > 1, the first of them (data row; 0: none) and the largest lambda.
   int noise_scaled_steps = 0;

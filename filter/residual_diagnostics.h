@@ -68,7 +68,7 @@ struct ResidualDiagnosticsOptions {
 // One test of the verdict: it passes when `statistic` lies in [accept_low, accept_high]
 // (NaN = no bound on that side).
 struct DiagnosticTest {
-  std::string name;            // nis_mean, nis_outside_band, whiteness, whiteness_rows, bias_rows, rigid_bias
+  std::string name;            // nis_mean, nis_above_band, whiteness, whiteness_rows, bias_rows, rigid_bias
   bool passed = true;
   double statistic = 0.0;
   double accept_low = 0.0;
@@ -96,9 +96,9 @@ struct NisDiagnostics {
   double band95_low = 0.0;        // the same band at 95%, to read the plot by
   double band95_high = 0.0;
   double p_value = 0.0;           // two-sided, of the sum
-  int steps_outside = 0;          // steps whose NIS is outside their own 95% chi^2(m_k) band
-  double fraction_outside = 0.0;  // expected 0.05
-  int max_outside = 0;            // the most steps outside that the test accepts
+  int steps_above = 0;            // steps whose NIS is above their own 95% chi^2(m_k) band
+  double fraction_above = 0.0;    // expected 0.025
+  int max_above = 0;              // the most steps above that the test accepts
   std::vector<double> step_band_low;    // per step used: the 95% chi^2(m_k) band
   std::vector<double> step_band_high;
 };

@@ -47,6 +47,7 @@ Roukf::Roukf(const RoukfOptions& options, Ensemble& ensemble)
   constant_rows_ = Eigen::MatrixXd::Zero(constants, p);
   for (int j = 0, i = 0; j < static_cast<int>(options.constant.size()); ++j)
     if (options.constant[static_cast<std::size_t>(j)]) constant_rows_(i++, j) = 1.0;
+  opens_on_change_ = (1.0 - constant_rows_.colwise().sum().transpose().array()).matrix();
   theta_ = options.initial_theta;
   // L = [0; I_p], U^-1 = diag(sigma^2): the state is known, the parameters are not.
   L_theta_ = Eigen::MatrixXd::Identity(p, p);
@@ -59,6 +60,14 @@ Eigen::MatrixXd Roukf::theta_covariance() const {
 }
 
 void Roukf::inflate(double log_std) { pending_variance_ += log_std * log_std; }
+
+void Roukf::fix(int j, double value) {
+  if (j < 0 || j >= theta_.size())
+    throw std::invalid_argument("Roukf::fix: no parameter " + std::to_string(j));
+  theta_[j] = value;
+  drift_variance_[j] = 0.0;
+  opens_on_change_[j] = 0.0;
+}
 
 void Roukf::add_theta_variance(const Eigen::VectorXd& variance) {
   // P_theta + D = L_theta (U^-1 + L_theta^-1 D L_theta^-T) L_theta^T: only U^-1 changes.
@@ -77,8 +86,7 @@ RoukfStep Roukf::step(const Eigen::Vector3d& so_position, const Eigen::VectorXd&
                                 " observation values, got " + std::to_string(y.size()));
 
   if (drift_variance_.maxCoeff() > 0.0 || pending_variance_ > 0.0)
-    add_theta_variance(drift_variance_ +
-                       pending_variance_ * (1.0 - constant_rows_.colwise().sum().transpose().array()).matrix());
+    add_theta_variance(drift_variance_ + pending_variance_ * opens_on_change_);
   pending_variance_ = 0.0;
 
   // Sampling.

@@ -83,6 +83,9 @@ class Roukf {
   // constant away and its narrow std holds it there (measured on the liver under an undeclared
   // oblique gravity: g off by 2-4% with the constants not inflated, the residual biased).
   void hold_constants(bool hold) { hold_constants_ = hold; }
+  // Sets parameter j to `value` and leaves it there: no drift, no widening on a change (a cut
+  // ligament, filter/ligament_cut.h: its log-stiffness has no sensitivity left to move it).
+  void fix(int j, double value);
   // Holds the adaptive noise at lambda = 1 for `steps` steps (AdaptiveNoise::hold).
   void hold_adaptive_noise(int steps) { adaptive_noise_.hold(steps); }
 
@@ -112,6 +115,7 @@ class Roukf {
   Eigen::MatrixXd U_inv_;               // p x p
   Eigen::VectorXd correction_;          // k of the last correction, applied at re-sampling
   double pending_variance_ = 0.0;       // inflation to add before the next sampling
+  Eigen::VectorXd opens_on_change_;     // p: 1 where inflate() widens the parameter, else 0
   Eigen::MatrixXd constant_rows_;       // the rows of the identity that pick the constants
   bool hold_constants_ = false;
   Eigen::VectorXd drift_variance_;      // p: q_j^2

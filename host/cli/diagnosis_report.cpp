@@ -48,11 +48,17 @@ json fit_json(const ModelFit& fit) {
   }
   json estimates = json::array();
   for (const EffectEstimate& e : fit.estimates) estimates.push_back(estimate_json(e));
+  json cuts = json::array();
+  for (const LigamentCut& cut : fit.run.cuts)
+    cuts.push_back({{"ligament", fit.ligaments[static_cast<std::size_t>(cut.parameter)]},
+                    {"step", cut.step},
+                    {"stiffness_before_n_per_m", cut.stiffness_before}});
   return {{"model", model_name(fit)},
           {"refined", fit.refined},
           {"effects", estimates},
           {"complete", fit.run.complete},
           {"stop_reason", fit.run.stop_reason},
+          {"cuts", cuts},
           {"verdict", to_string(fit.residual.verdict.consistency)},
           {"failed_tests", failed_details(fit)},
           {"log_likelihood", number(fit.log_likelihood)},

@@ -115,6 +115,14 @@ void print_estimation_summary(std::ostream& out, const json& summary, const std:
     out << "  changes detected at steps " << summary["changes_detected_at_steps"].dump() << "; "
         << summary["catch_up_steps"].get<int>()
         << " steps of catch-up after them are left out of the residual tests\n";
+  for (const auto& cut : summary["cuts"]) {
+    std::snprintf(line, sizeof line,
+                  "  ligament %s cut at step %d (t = %.2f s): the data show it lost nearly all of the %.4g N/m it "
+                  "had before the change; held at zero since (docs/ROUKF.md \"Cut ligaments\")\n",
+                  cut["ligament"].get<std::string>().c_str(), cut["step"].get<int>(), cut["time_s"].get<double>(),
+                  cut["stiffness_before_n_per_m"].get<double>());
+    out << line;
+  }
   if (summary["residual"].is_object()) {
     const auto& residual = summary["residual"];
     out << "  residuals: " << residual["verdict"].get<std::string>();

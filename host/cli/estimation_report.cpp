@@ -194,6 +194,13 @@ nlohmann::ordered_json write_estimation_report(const EstimationReport& report, c
   summary["cg"] = {{"max_iterations", max_cg}, {"unconverged_sigma_steps", unconverged}};
   summary["changes_detected_at_steps"] = changes;
   summary["catch_up_steps"] = run.catch_up_steps;
+  json cuts = json::array();
+  for (const LigamentCut& cut : run.cuts)
+    cuts.push_back({{"ligament", report.names[static_cast<std::size_t>(cut.parameter)]},
+                    {"step", cut.step},
+                    {"time_s", cut.time},
+                    {"stiffness_before_n_per_m", cut.stiffness_before}});
+  summary["cuts"] = cuts;
   summary["adaptive_noise"] = adaptive_noise_json(run);
   if (truth) {
     Eigen::MatrixXd estimate(static_cast<Eigen::Index>(run.steps.size()),

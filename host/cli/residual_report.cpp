@@ -49,9 +49,9 @@ json residual_json(const ResidualDiagnostics& d, const ResidualDiagnosticsOption
               {"accepted", {nis.band_low, nis.band_high}},
               {"band_95", {nis.band95_low, nis.band95_high}},
               {"p_value", nis.p_value},
-              {"steps_outside_95_band", nis.steps_outside},
-              {"fraction_outside_95_band", nis.fraction_outside},
-              {"max_outside_accepted", nis.max_outside}};
+              {"steps_above_95_band", nis.steps_above},
+              {"fraction_above_95_band", nis.fraction_above},
+              {"max_above_accepted", nis.max_above}};
 
   const WhitenessDiagnostics& w = d.whiteness;
   json flagged_white = json::array();

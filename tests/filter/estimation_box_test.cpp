@@ -4,6 +4,8 @@
 // stays silent; missing observations are handled.
 #include <gtest/gtest.h>
 
+#include <algorithm>
+
 #include <cmath>
 #include <filesystem>
 #include <random>
@@ -133,6 +135,7 @@ TEST(BoxEstimation, ChangeDetectorStaysSilentWithoutACut) {
                              data.observations.points);
   ASSERT_TRUE(box.run.complete) << box.run.stop_reason;
   EXPECT_EQ(box.run.changes_detected, 0) << "a false alarm over " << box.run.steps.size() << " steps";
+  EXPECT_TRUE(box.run.cuts.empty()) << "no change, no cut";
 }
 
 TEST(BoxEstimation, ChangeDetectorFiresOnTheCutWithASmallDrift) {
@@ -171,6 +174,21 @@ TEST(BoxEstimation, ChangeDetectorFiresOnTheCutWithASmallDrift) {
   EXPECT_GE(last, fired.front() + options.detector.hold_off);
   EXPECT_LE(last, fired.back() + options.detector.max_catch_up);
   EXPECT_LT(marked, static_cast<int>(run.steps.size()) / 4) << "the catch-up ends";
+
+  // The cut rule (filter/ligament_cut.h): the middle ligament, and only it, is found cut after
+  // the firing, and its stiffness stays next to zero from then on (truth 0.01 N/m).
+  const auto& estimated = s.filter->estimate;
+  const int middle = static_cast<int>(std::find(estimated.begin(), estimated.end(), s.ligament_index("middle")) -
+                                      estimated.begin());
+  ASSERT_EQ(run.cuts.size(), 1u) << "one ligament cut";
+  EXPECT_EQ(run.cuts[0].parameter, middle);
+  EXPECT_GE(run.cuts[0].step, fired.front());
+  EXPECT_NEAR(run.cuts[0].stiffness_before, 300.0, 15.0) << "the estimate before the cut";
+  for (const EstimationStep& step : run.steps) {
+    if (step.step > run.cuts[0].step) {
+      ASSERT_LT(step.stiffness[middle], 0.01) << "step " << step.step;
+    }
+  }
 }
 
 TEST(BoxEstimation, HandlesMissingObservations) {
