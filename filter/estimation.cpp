@@ -16,10 +16,11 @@ EstimationRun run_estimation(Ensemble& ensemble, const EstimationOptions& option
   Roukf filter(options.roukf, ensemble);
   ChangeDetector detector(options.detector);
   RecoveryCheck recovery(options.recovery);
+  // The first parameters that are log-stiffnesses (the rest are effect parameters).
   const Eigen::Index parameters = options.roukf.initial_theta.size();
-  LigamentCutRule cut_rule(options.cut, static_cast<int>(options.stiffness_count >= 0
-                                                             ? std::min<Eigen::Index>(options.stiffness_count, parameters)
-                                                             : parameters));
+  const Eigen::Index stiffnesses =
+      options.stiffness_count >= 0 ? std::min<Eigen::Index>(options.stiffness_count, parameters) : parameters;
+  LigamentCutRule cut_rule(options.cut, static_cast<int>(stiffnesses));
   EstimationRun run;
   std::deque<bool> scaled;   // the last 2W steps: did the correction use lambda > 1?
   int catch_up_start = -1;   // index into run.steps of the firing that began the catch-up; -1: none
@@ -112,10 +113,7 @@ EstimationRun run_estimation(Ensemble& ensemble, const EstimationOptions& option
     step.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
     run.steps.push_back(step);
     if (on_step) on_step(step);
-    const Eigen::Index checked = options.stiffness_count >= 0
-                                     ? std::min<Eigen::Index>(options.stiffness_count, step.stiffness.size())
-                                     : step.stiffness.size();
-    for (Eigen::Index j = 0; j < checked; ++j) {
+    for (Eigen::Index j = 0; j < stiffnesses; ++j) {
       const double k_j = step.stiffness[j];
       if (!(k_j >= options.min_stiffness && k_j <= options.max_stiffness)) {
         std::ostringstream reason;

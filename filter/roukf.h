@@ -83,8 +83,9 @@ class Roukf {
   // constant away and its narrow std holds it there (measured on the liver under an undeclared
   // oblique gravity: g off by 2-4% with the constants not inflated, the residual biased).
   void hold_constants(bool hold) { hold_constants_ = hold; }
-  // Sets parameter j to `value` and leaves it there: no drift, no widening on a change (a cut
-  // ligament, filter/ligament_cut.h: its log-stiffness has no sensitivity left to move it).
+  // Sets parameter j to `value` and stops its drift and its widening on a change (a cut
+  // ligament, filter/ligament_cut.h). Corrections may still move it along its covariance with
+  // the others, but a log-stiffness with no sensitivity left stays near where it was set.
   void fix(int j, double value);
   // Holds the adaptive noise at lambda = 1 for `steps` steps (AdaptiveNoise::hold).
   void hold_adaptive_noise(int steps) { adaptive_noise_.hold(steps); }

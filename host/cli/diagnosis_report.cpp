@@ -6,6 +6,7 @@
 #include <fstream>
 #include <sstream>
 
+#include "host/cli/estimation_report.h"
 #include "host/cli/plot.h"
 #include "host/cli/residual_report.h"
 #include "host/common/atomic_file.h"
@@ -48,17 +49,12 @@ json fit_json(const ModelFit& fit) {
   }
   json estimates = json::array();
   for (const EffectEstimate& e : fit.estimates) estimates.push_back(estimate_json(e));
-  json cuts = json::array();
-  for (const LigamentCut& cut : fit.run.cuts)
-    cuts.push_back({{"ligament", fit.ligaments[static_cast<std::size_t>(cut.parameter)]},
-                    {"step", cut.step},
-                    {"stiffness_before_n_per_m", cut.stiffness_before}});
   return {{"model", model_name(fit)},
           {"refined", fit.refined},
           {"effects", estimates},
           {"complete", fit.run.complete},
           {"stop_reason", fit.run.stop_reason},
-          {"cuts", cuts},
+          {"cuts", cuts_json(fit.run, fit.ligaments)},
           {"verdict", to_string(fit.residual.verdict.consistency)},
           {"failed_tests", failed_details(fit)},
           {"log_likelihood", number(fit.log_likelihood)},

@@ -148,6 +148,16 @@ json phase_json(const PhaseErrors& phase, const std::vector<std::string>& names)
 
 }  // namespace
 
+nlohmann::ordered_json cuts_json(const EstimationRun& run, const std::vector<std::string>& names) {
+  json cuts = json::array();
+  for (const LigamentCut& cut : run.cuts)
+    cuts.push_back({{"ligament", names[static_cast<std::size_t>(cut.parameter)]},
+                    {"step", cut.step},
+                    {"time_s", cut.time},
+                    {"stiffness_before_n_per_m", cut.stiffness_before}});
+  return cuts;
+}
+
 nlohmann::ordered_json write_estimation_report(const EstimationReport& report, const EstimationRun& run) {
   const fs::path out(report.out_dir);
   write_file_atomically((out / "estimates.csv").string(), estimates_csv(report, run));
@@ -194,13 +204,7 @@ nlohmann::ordered_json write_estimation_report(const EstimationReport& report, c
   summary["cg"] = {{"max_iterations", max_cg}, {"unconverged_sigma_steps", unconverged}};
   summary["changes_detected_at_steps"] = changes;
   summary["catch_up_steps"] = run.catch_up_steps;
-  json cuts = json::array();
-  for (const LigamentCut& cut : run.cuts)
-    cuts.push_back({{"ligament", report.names[static_cast<std::size_t>(cut.parameter)]},
-                    {"step", cut.step},
-                    {"time_s", cut.time},
-                    {"stiffness_before_n_per_m", cut.stiffness_before}});
-  summary["cuts"] = cuts;
+  summary["cuts"] = cuts_json(run, report.names);
   summary["adaptive_noise"] = adaptive_noise_json(run);
   if (truth) {
     Eigen::MatrixXd estimate(static_cast<Eigen::Index>(run.steps.size()),

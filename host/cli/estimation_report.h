@@ -41,6 +41,9 @@ std::optional<Eigen::MatrixXd> truth_at_steps(const TruthTable& truth,
 // When and how far the adaptive observation noise engaged (filter/adaptive_noise.h), for
 // summary.json and residual.json.
 nlohmann::ordered_json adaptive_noise_json(const EstimationRun& run);
+// The ligaments the run found cut (EstimationRun::cuts), named by `names` (the estimated
+// ligaments in parameter order): summary.json's and report.json's `cuts`.
+nlohmann::ordered_json cuts_json(const EstimationRun& run, const std::vector<std::string>& names);
 
 // Writes every output into report.out_dir (atomically, file by file) and returns the
 // summary. Plots are skipped with a note in the summary when gnuplot is missing.
