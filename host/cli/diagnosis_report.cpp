@@ -142,6 +142,12 @@ json write_diagnosis_report(const Scenario& scenario, const Diagnosis& d, const 
   if (d.outcome == DiagnosisOutcome::explained)
     for (const EffectEstimate& e : d.after().estimates) j["claimed_estimates"].push_back(estimate_json(e));
   j["truth_effects"] = report.truth_effects;
+  json removed = json::array();
+  for (std::size_t k = 0; k < d.misfit.removed.size(); ++k)
+    removed.push_back({{"effect", d.after().estimates[k].name}, {"share", number(d.misfit.removed[k])}});
+  j["misfit"] = {{"declared_excess_nis", number(d.misfit.declared_excess)},
+                 {"removed", removed},
+                 {"remaining_share", number(d.misfit.remaining)}};
   j["before"] = fit_json(d.before());
   j["after"] = fit_json(d.after());
   json rounds = json::array();
@@ -209,7 +215,12 @@ json write_diagnosis_report(const Scenario& scenario, const Diagnosis& d, const 
      << to_string(d.after().residual.verdict.consistency) << " |\n"
      << "| innovation RMS (mm) | " << fixed(1e3 * d.before().innovation_rms, 4) << " | "
      << fixed(1e3 * d.after().innovation_rms, 4) << " |\n"
-     << "| log-likelihood | " << fixed(d.before().log_likelihood, 1) << " | " << fixed(d.after().log_likelihood, 1) << " |\n";
+     << "| log-likelihood | " << fixed(d.before().log_likelihood, 1) << " | " << fixed(d.after().log_likelihood, 1) << " |\n"
+     << "| mean NIS (expected: the mean observed rows, " << fixed(d.before().residual.nis.mean_dof, 1) << ") | "
+     << fixed(d.before().residual.nis.mean, 2) << " | " << fixed(d.after().residual.nis.mean, 2) << " |\n";
+  for (std::size_t k = 0; k < d.misfit.removed.size(); ++k)
+    md << "| share of the declared model's excess NIS removed by " << d.after().estimates[k].name << " | | "
+       << fixed(100.0 * d.misfit.removed[k], 1) << "% |\n";
   if (d.before().stiffness_error && d.after().stiffness_error)
     md << "| stiffness error, mean over ligaments and the last 20% of steps (N/m) | "
        << fixed(*d.before().stiffness_error, 2) << " | " << fixed(*d.after().stiffness_error, 2) << " |\n";

@@ -228,6 +228,18 @@ double log_likelihood_outside(const ModelFit& fit, const std::vector<bool>& left
   return sum;
 }
 
+MisfitShares misfit_shares(const std::vector<const ModelFit*>& path) {
+  MisfitShares shares;
+  if (path.empty()) return shares;
+  auto excess = [](const ModelFit* fit) { return fit->residual.nis.mean - fit->residual.nis.mean_dof; };
+  shares.declared_excess = excess(path.front());
+  const double scale = shares.declared_excess > 0.0 ? shares.declared_excess : NAN;
+  for (std::size_t j = 1; j < path.size(); ++j)
+    shares.removed.push_back((excess(path[j - 1]) - excess(path[j])) / scale);
+  shares.remaining = excess(path.back()) / scale;
+  return shares;
+}
+
 Diagnosis diagnose(const Scenario& scenario, const ObservationTable& data,
                    const std::optional<TruthTable>& truth, const DiagnoseOptions& options) {
   Diagnosis d;
@@ -331,6 +343,9 @@ Diagnosis diagnose(const Scenario& scenario, const ObservationTable& data,
     if (!found) break;
   }
 
+  std::vector<const ModelFit*> path_fits;
+  for (int f : d.path) path_fits.push_back(&d.fits[static_cast<std::size_t>(f)]);
+  d.misfit = misfit_shares(path_fits);
   const ModelFit& after = d.after();
   std::ostringstream text;
   if (d.path.size() == 1 && after.residual.verdict.consistency == Consistency::consistent) {
@@ -368,8 +383,16 @@ Diagnosis diagnose(const Scenario& scenario, const ObservationTable& data,
       text << "the effects tried (";
       for (std::size_t j = 0; j < after.estimates.size(); ++j)
         text << (j ? ", " : "") << describe_estimate(after.estimates[j]);
-      text << ") raise the likelihood but leave the residual inconsistent, so none is claimed; "
-              "the data hold an effect outside the library (or more than one).";
+      text << ") raise the likelihood but leave the residual inconsistent, so none is claimed";
+      if (std::isfinite(d.misfit.remaining)) {
+        text << "; of the declared model's misfit (mean NIS " << format(d.before().residual.nis.mean, 4)
+             << " against " << format(d.before().residual.nis.mean_dof, 3) << " observed rows) ";
+        for (std::size_t j = 0; j < d.misfit.removed.size(); ++j)
+          text << (j ? ", then " : "") << after.estimates[j].name << " accounted for "
+               << format(100.0 * d.misfit.removed[j], 2) << "%";
+        text << ", and " << format(100.0 * d.misfit.remaining, 2) << "% remains";
+      }
+      text << ": the data hold an effect outside the library (or more than one).";
     }
     text << " Failed tests: ";
     const std::vector<std::string> failed = after.residual.verdict.failed();

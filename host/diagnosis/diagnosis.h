@@ -132,6 +132,19 @@ struct DiagnosisRound {
   std::string chosen;                       // "" when none was added
 };
 
+// How much of the declared model's misfit each effect along the path accounts for. The misfit
+// is the excess of the mean NIS over its expectation (the mean number of observed rows), near 0
+// for a consistent fit; `removed[j]` is its drop when the j-th effect was added and `remaining`
+// what the last fit leaves, both as shares of the declared model's excess (NaN when that
+// excess is not positive). On data with a model error no effect of the library removes (a
+// truth from a finer mesh) the residual stays inconsistent whatever is added; these shares
+// then say whether an effect tried accounted for most of the misfit or for a sliver of it.
+struct MisfitShares {
+  double declared_excess = 0.0;   // the declared model's mean NIS minus its mean observed rows
+  std::vector<double> removed;    // one per effect added, in the order added
+  double remaining = 0.0;
+};
+
 enum class DiagnosisOutcome { consistent, explained, unexplained };
 const char* to_string(DiagnosisOutcome outcome);
 
@@ -142,6 +155,7 @@ struct Diagnosis {
   DiagnosisOutcome outcome = DiagnosisOutcome::unexplained;
   std::vector<EffectValue> discovered;      // the effects added, at their final estimates
                                             // (empty unless the outcome is `explained`)
+  MisfitShares misfit;                      // along the path
   std::string conclusion;                   // one paragraph in words
   const ModelFit& before() const { return fits[static_cast<std::size_t>(path.front())]; }
   const ModelFit& after() const { return fits[static_cast<std::size_t>(path.back())]; }
@@ -161,6 +175,10 @@ ModelFit fit_model(const Scenario& scenario, const ObservationTable& data,
 // compares fits on the same steps.
 std::vector<bool> catch_up_union(const std::vector<const ModelFit*>& fits);
 double log_likelihood_outside(const ModelFit& fit, const std::vector<bool>& left_out);
+
+// The misfit shares (above) of `path`: the declared model's fit first, then one fit per effect
+// added.
+MisfitShares misfit_shares(const std::vector<const ModelFit*>& path);
 
 // The candidates `names` stand for (empty: every candidate of the library), a regional family
 // (extra_ligament) once per candidate region of the scenario. Throws InputError for a name

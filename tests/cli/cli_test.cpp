@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 #include <sys/wait.h>
 
+#include <cmath>
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
@@ -214,6 +215,12 @@ TEST_F(CliTest, DiagnoseFindsAnInjectedEffectAndWritesItsReport) {
   EXPECT_EQ(report["outcome"], "explained") << report["conclusion"];
   ASSERT_EQ(report["discovered_effects"].size(), 1u);
   EXPECT_EQ(report["discovered_effects"][0]["name"], "camera_offset");
+  // The offset accounts for most of the declared model's excess NIS; what remains is a
+  // consistent fit's, near 0 against that excess.
+  ASSERT_EQ(report["misfit"]["removed"].size(), 1u);
+  EXPECT_EQ(report["misfit"]["removed"][0]["effect"], "camera_offset");
+  EXPECT_GT(report["misfit"]["removed"][0]["share"].get<double>(), 0.9) << report["misfit"].dump();
+  EXPECT_LT(std::abs(report["misfit"]["remaining_share"].get<double>()), 0.1) << report["misfit"].dump();
   // The scenario it writes declares the effect and loads.
   const CommandRun info = run_sigmafem("info " + (fs::path(out) / "scenario.json").string());
   EXPECT_EQ(info.exit_code, 0) << info.output;

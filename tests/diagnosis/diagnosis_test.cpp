@@ -132,6 +132,35 @@ TEST(DiagnoseLikelihood, FitsAreComparedOnTheStepsNoneIsCatchingUp) {
   EXPECT_EQ(log_likelihood_outside(a, {}), 63) << "nothing left out";
 }
 
+TEST(DiagnoseMisfit, SharesOfTheDeclaredModelsExcessNisAlongThePath) {
+  // Mean NIS 136, 66, 61 against 36 rows: excess 100, 30, 25. The first effect removed 70% of
+  // the declared model's excess, the second 5%, and 25% remains.
+  auto fit = [](double nis_mean) {
+    ModelFit f;
+    f.residual.nis.mean = nis_mean;
+    f.residual.nis.mean_dof = 36.0;
+    return f;
+  };
+  const ModelFit declared = fit(136.0), first = fit(66.0), second = fit(61.0);
+  const MisfitShares shares = misfit_shares({&declared, &first, &second});
+  EXPECT_DOUBLE_EQ(shares.declared_excess, 100.0);
+  ASSERT_EQ(shares.removed.size(), 2u);
+  EXPECT_NEAR(shares.removed[0], 0.70, 1e-12);
+  EXPECT_NEAR(shares.removed[1], 0.05, 1e-12);
+  EXPECT_NEAR(shares.remaining, 0.25, 1e-12);
+  // An effect that raised the NIS removed a negative share; shares and remainder add to 1.
+  const ModelFit worse = fit(71.0);
+  const MisfitShares back = misfit_shares({&declared, &first, &worse});
+  EXPECT_NEAR(back.removed[1], -0.05, 1e-12);
+  EXPECT_NEAR(back.removed[0] + back.removed[1] + back.remaining, 1.0, 1e-12);
+  // A declared model with no excess has no shares to give (NaN, written as null).
+  const ModelFit consistent = fit(35.0);
+  const MisfitShares none = misfit_shares({&consistent, &first});
+  EXPECT_TRUE(std::isnan(none.removed[0]));
+  EXPECT_TRUE(std::isnan(none.remaining));
+  EXPECT_EQ(misfit_shares({}).removed.size(), 0u);
+}
+
 std::string describe_residual(const ModelFit& fit) {
   std::ostringstream out;
   for (const DiagnosticTest& test : fit.residual.verdict.tests)
@@ -233,6 +262,9 @@ TEST(DiagnoseBox, AStiffInclusionStaysUnexplained) {
   EXPECT_EQ(d.outcome, DiagnosisOutcome::unexplained) << describe(d);
   EXPECT_TRUE(d.discovered.empty()) << describe(d);
   EXPECT_NE(d.conclusion.find("unexplained"), std::string::npos) << d.conclusion;
+  // What the effects tried account for is said, and part of the misfit remains.
+  EXPECT_NE(d.conclusion.find("% remains"), std::string::npos) << d.conclusion;
+  EXPECT_GT(d.misfit.remaining, 0.0) << d.conclusion;
 }
 
 // The liver (scenarios/liver_diagnose.json: 300 steps, its six automatic surface regions) on
