@@ -23,6 +23,20 @@ std::string format(double x, int precision = 3) {
   return out.str();
 }
 
+// A share as a percentage: one decimal from 1% up (99.9%, not 1e+02%), two digits below.
+std::string percent(double share) {
+  const double p = 100.0 * share;
+  std::ostringstream out;
+  if (std::abs(p) >= 1.0) {
+    out.setf(std::ios::fixed);
+    out.precision(1);
+  } else {
+    out.precision(2);
+  }
+  out << p << '%';
+  return out.str();
+}
+
 std::string describe_estimate(const EffectEstimate& e) {
   std::ostringstream out;
   out << e.name << " = ";
@@ -388,9 +402,8 @@ Diagnosis diagnose(const Scenario& scenario, const ObservationTable& data,
         text << "; of the declared model's misfit (mean NIS " << format(d.before().residual.nis.mean, 4)
              << " against " << format(d.before().residual.nis.mean_dof, 3) << " observed rows) ";
         for (std::size_t j = 0; j < d.misfit.removed.size(); ++j)
-          text << (j ? ", then " : "") << after.estimates[j].name << " accounted for "
-               << format(100.0 * d.misfit.removed[j], 2) << "%";
-        text << ", and " << format(100.0 * d.misfit.remaining, 2) << "% remains";
+          text << (j ? ", then " : "") << after.estimates[j].name << " accounted for " << percent(d.misfit.removed[j]);
+        text << ", and " << percent(d.misfit.remaining) << " remains";
       }
       text << ": the data hold an effect outside the library (or more than one).";
     }

@@ -26,7 +26,8 @@
 // The outcome: `consistent` (the declared model explains the data; nothing added),
 // `explained` (effects were added and the last fit's residual is consistent) or
 // `unexplained` (the residual stays inconsistent: an effect that raised the likelihood is
-// then reported as tried, not as found).
+// then reported as tried, not as found, with the share of the misfit it accounts for:
+// MisfitShares below).
 //
 // Cost: one filter run per candidate per round, one after another, each on all cores (the CPU
 // ensemble's threads); a round with the three candidates on the box costs about four runs.
