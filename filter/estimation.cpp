@@ -38,6 +38,7 @@ EstimationRun run_estimation(Ensemble& ensemble, const EstimationOptions& option
       break;
     }
     step.log_std = result.theta_covariance.diagonal().cwiseSqrt();
+    run.final_theta_covariance = result.theta_covariance;
     step.theta = result.theta;
     step.stiffness = result.theta.array().exp();
     step.stiffness_std = step.stiffness.cwiseProduct(step.log_std);

@@ -95,6 +95,9 @@ struct EstimationRun {
   int noise_scaled_steps = 0;
   int first_noise_scaled_step = 0;
   double max_noise_scale = 1.0;
+  // theta's covariance after the last step (p x p): how the estimates are correlated, e.g.
+  // whether an effect's parameter is told apart from the stiffnesses (diagnose's claims).
+  Eigen::MatrixXd final_theta_covariance;
 };
 
 // `times` (rows), `so` (rows x 3) and `points` (rows x 3m, NaN = missing) are the data;

@@ -402,6 +402,7 @@ void spatial_pattern(const Eigen::MatrixXd& Z, const Eigen::MatrixX3d& positions
     s.component_t[c] = sd[c] > 0.0 ? mean[c] / (sd[c] / std::sqrt(n_effective)) : 0.0;
   }
   s.component_t_threshold = student_t_two_sided_quantile(level / 6.0, least_effective - 1.0);
+  s.least_effective_steps = least_effective;
 
   DiagnosticTest test;
   test.name = "rigid_bias";

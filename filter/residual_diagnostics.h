@@ -141,6 +141,10 @@ struct SpatialPattern {
   // Bonferroni bound over the six components.
   Eigen::Matrix<double, 6, 1> component_t = Eigen::Matrix<double, 6, 1>::Zero();
   double component_t_threshold = 0.0;
+  // The fewest effective independent steps of a rigid component (lag-1 autocorrelation rho:
+  // N (1 - rho) / (1 + rho)): N / this is how much a persisting error, one that moves every
+  // point alike over many steps, slows the averaging of noise away.
+  double least_effective_steps = 0.0;
 };
 
 struct ResidualDiagnostics {

@@ -139,15 +139,30 @@ json write_diagnosis_report(const Scenario& scenario, const Diagnosis& d, const 
   for (const EffectValue& e : d.discovered) discovered.push_back({{"name", e.name}, {"value", e.value}});
   j["discovered_effects"] = discovered;
   j["claimed_estimates"] = json::array();
-  if (d.outcome == DiagnosisOutcome::explained)
+  const bool claimed = d.outcome == DiagnosisOutcome::explained || d.outcome == DiagnosisOutcome::partly_explained;
+  if (claimed)
     for (const EffectEstimate& e : d.after().estimates) j["claimed_estimates"].push_back(estimate_json(e));
   j["truth_effects"] = report.truth_effects;
   json removed = json::array();
   for (std::size_t k = 0; k < d.misfit.removed.size(); ++k)
-    removed.push_back({{"effect", d.after().estimates[k].name}, {"share", number(d.misfit.removed[k])}});
+    removed.push_back({{"effect", d.misfit.effects[k]}, {"share", number(d.misfit.removed[k])}});
   j["misfit"] = {{"declared_excess_nis", number(d.misfit.declared_excess)},
                  {"removed", removed},
                  {"remaining_share", number(d.misfit.remaining)}};
+  json claims = json::array();
+  for (const ClaimCheck& c : d.claims)
+    claims.push_back({{"effect", c.effect},
+                      {"share_of_declared", number(c.share_of_declared)},
+                      {"share_of_remaining", number(c.share_of_remaining)},
+                      {"runner_up", c.runner_up},
+                      {"runner_up_ratio", number(c.runner_up_ratio)},
+                      {"distance_from_absence", number(c.distance)},
+                      {"distance_bound", number(c.distance_bound)},
+                      {"stiffness_r2", number(c.stiffness_r2)},
+                      {"model_form_factor", number(c.model_form_factor)},
+                      {"claimed", c.claimed},
+                      {"reason", c.reason}});
+  j["claim_checks"] = claims;
   j["before"] = fit_json(d.before());
   j["after"] = fit_json(d.after());
   json rounds = json::array();
@@ -198,7 +213,7 @@ json write_diagnosis_report(const Scenario& scenario, const Diagnosis& d, const 
   } else {
     files["plots_skipped"] = "gnuplot with PNG output is not installed";
   }
-  if (d.outcome == DiagnosisOutcome::explained) {
+  if (claimed) {
     write_file_atomically((out / "scenario.json").string(), scenario_with_effects(scenario, d.discovered));
     files["scenario"] = (out / "scenario.json").string();
   }
@@ -219,7 +234,7 @@ json write_diagnosis_report(const Scenario& scenario, const Diagnosis& d, const 
      << "| mean NIS (expected: the mean observed rows, " << fixed(d.before().residual.nis.mean_dof, 1) << ") | "
      << fixed(d.before().residual.nis.mean, 2) << " | " << fixed(d.after().residual.nis.mean, 2) << " |\n";
   for (std::size_t k = 0; k < d.misfit.removed.size(); ++k)
-    md << "| share of the declared model's excess NIS removed by " << d.after().estimates[k].name << " | | "
+    md << "| share of the declared model's excess NIS removed by " << d.misfit.effects[k] << " | | "
        << fixed(100.0 * d.misfit.removed[k], 1) << "% |\n";
   if (d.before().stiffness_error && d.after().stiffness_error)
     md << "| stiffness error, mean over ligaments and the last 20% of steps (N/m) | "
@@ -237,6 +252,24 @@ json write_diagnosis_report(const Scenario& scenario, const Diagnosis& d, const 
   md << "\n";
   if (files.contains("residual_before"))
     md << "![residual before](residual_before.png)\n\n![residual after](residual_after.png)\n\n";
+  if (!d.claims.empty()) {
+    md << "## Claims while the residual stays inconsistent\n\nAn effect is claimed when it took up at least "
+       << fixed(100.0 * options.claims.min_share_of_remaining, 0)
+       << "% of the misfit left before it, no other candidate of its round scored more than "
+       << fixed(100.0 * options.claims.max_runner_up_ratio, 0) << "% of its score, its estimate stands beyond the 3-sigma bound from the effect's absence "
+          "with its std widened by the model-form factor, and the data tell it apart from the stiffnesses "
+          "(squared multiple correlation at most "
+       << fixed(options.claims.max_stiffness_r2, 2) << "); the first that fails ends the claims.\n\n"
+       << "| effect | share of the misfit | of what was left | runner-up (score ratio) | distance from absence (bound) "
+          "| r^2 with the stiffnesses | model-form factor | claimed |\n|---|---|---|---|---|---|---|---|\n";
+    for (const ClaimCheck& c : d.claims)
+      md << "| " << c.effect << " | " << fixed(100.0 * c.share_of_declared, 1) << "% | "
+         << fixed(100.0 * c.share_of_remaining, 1) << "% | " << (c.runner_up.empty() ? std::string("none") : c.runner_up)
+         << " (" << fixed(c.runner_up_ratio, 2) << ") | " << fixed(c.distance, 1) << " ("
+         << fixed(c.distance_bound, 1) << ") | " << fixed(c.stiffness_r2, 3) << " | " << fixed(c.model_form_factor, 2)
+         << " | " << (c.claimed ? std::string("yes") : "no: " + c.reason) << " |\n";
+    md << "\n";
+  }
   md << "## Rounds\n\nScore = log-likelihood gain of the innovations over every step with the candidate's "
         "parameters estimated, minus the BIC penalty 0.5 k log N. A fit that stopped early is not ranked. An estimate's +- is "
         "its first-order standard deviation, times the path ratio where the estimate moved more than its "
@@ -277,7 +310,6 @@ json write_diagnosis_report(const Scenario& scenario, const Diagnosis& d, const 
        << (out / "scenario.json").string() << " --data " << report.data_dir << " --out DIR`).\n";
   write_file_atomically((out / "report.md").string(), md.str());
   write_file_atomically((out / "report.json").string(), j.dump(2) + "\n");
-  (void)options;
   return j;
 }
 

@@ -78,6 +78,7 @@ const char* to_string(DiagnosisOutcome outcome) {
   switch (outcome) {
     case DiagnosisOutcome::consistent: return "consistent";
     case DiagnosisOutcome::explained: return "explained";
+    case DiagnosisOutcome::partly_explained: return "partly_explained";
     case DiagnosisOutcome::unexplained: return "unexplained";
   }
   return "?";
@@ -248,8 +249,10 @@ MisfitShares misfit_shares(const std::vector<const ModelFit*>& path) {
   auto excess = [](const ModelFit* fit) { return fit->residual.nis.mean - fit->residual.nis.mean_dof; };
   shares.declared_excess = excess(path.front());
   const double scale = shares.declared_excess > 0.0 ? shares.declared_excess : NAN;
-  for (std::size_t j = 1; j < path.size(); ++j)
+  for (std::size_t j = 1; j < path.size(); ++j) {
+    shares.effects.push_back(path[j]->estimates.empty() ? std::string() : path[j]->estimates.back().name);
     shares.removed.push_back((excess(path[j - 1]) - excess(path[j])) / scale);
+  }
   shares.remaining = excess(path.back()) / scale;
   return shares;
 }
@@ -387,28 +390,72 @@ Diagnosis diagnose(const Scenario& scenario, const ObservationTable& data,
     d.outcome = DiagnosisOutcome::unexplained;
     text << "Too few filter steps to judge the residual: nothing was tested or added.";
   } else {
-    d.outcome = DiagnosisOutcome::unexplained;
-    text << "The residual stays unexplained: ";
-    if (d.path.size() == 1) {
-      text << "no candidate effect (" << (library.empty() ? "none" : "") ;
-      for (std::size_t j = 0; j < library.size(); ++j) text << (j ? ", " : "") << library[j];
-      text << ") raised the likelihood by more than its penalty.";
-    } else {
-      text << "the effects tried (";
-      for (std::size_t j = 0; j < after.estimates.size(); ++j)
-        text << (j ? ", " : "") << describe_estimate(after.estimates[j]);
-      text << ") raise the likelihood but leave the residual inconsistent, so none is claimed";
-      if (std::isfinite(d.misfit.remaining)) {
-        text << "; of the declared model's misfit (mean NIS " << format(d.before().residual.nis.mean, 4)
-             << " against " << format(d.before().residual.nis.mean_dof, 3) << " observed rows) ";
-        for (std::size_t j = 0; j < d.misfit.removed.size(); ++j)
-          text << (j ? ", then " : "") << after.estimates[j].name << " accounted for " << percent(d.misfit.removed[j]);
-        text << ", and " << percent(d.misfit.remaining) << " remains";
+    std::vector<RunnerUp> runners_up;
+    for (const DiagnosisRound& r : d.rounds) {
+      if (r.chosen.empty()) continue;
+      RunnerUp rival;
+      const CandidateScore& chosen = r.candidates[0];
+      if (std::isnan(chosen.gain)) rival.ratio = NAN;   // the round's model stopped early
+      if (r.candidates.size() > 1 && r.candidates[1].complete && r.candidates[1].score > 0.0) {
+        rival.effect = r.candidates[1].effect;
+        if (!std::isnan(rival.ratio)) rival.ratio = r.candidates[1].score / chosen.score;
       }
-      text << ": the data hold an effect outside the library (or more than one).";
+      runners_up.push_back(rival);
+    }
+    d.claims = check_claims(path_fits, d.misfit, runners_up, options.claims);
+    const int claimed = static_cast<int>(
+        std::count_if(d.claims.begin(), d.claims.end(), [](const ClaimCheck& c) { return c.claimed; }));
+    if (claimed > 0) {
+      d.outcome = DiagnosisOutcome::partly_explained;
+      d.after_position = claimed;
+      ModelFit& fit = d.fits[static_cast<std::size_t>(d.path[static_cast<std::size_t>(claimed)])];
+      const double factor = d.claims[static_cast<std::size_t>(claimed - 1)].model_form_factor;
+      for (EffectEstimate& e : fit.estimates) e = widened(e, factor);
+      text << "The residual stays inconsistent, but ";
+      for (int j = 0; j < claimed; ++j) {
+        const EffectEstimate& e = fit.estimates[static_cast<std::size_t>(j)];
+        text << (j ? ", then " : "") << describe_estimate(e) << " (" << percent(d.misfit.removed[static_cast<std::size_t>(j)])
+             << " of the declared model's misfit)";
+        d.discovered.push_back({e.name, e.value});
+      }
+      const double left = fit.residual.nis.mean - fit.residual.nis.mean_dof;
+      text << " account" << (claimed == 1 ? "s" : "") << " for most of it; "
+           << percent(left / d.misfit.declared_excess)
+           << " remains, a model error outside the library (a geometry finer than the mesh, or an effect the "
+              "library lacks). Claimed with each std widened "
+           << format(factor) << " times for the residual's dispersion and persistence.";
+      if (static_cast<std::size_t>(claimed) < d.claims.size()) {
+        const ClaimCheck& next = d.claims[static_cast<std::size_t>(claimed)];
+        text << " Not claimed: " << next.effect << " (" << next.reason << ")";
+        for (std::size_t j = static_cast<std::size_t>(claimed) + 1; j < d.misfit.effects.size(); ++j)
+          text << ", " << d.misfit.effects[j];
+        text << '.';
+      }
+    } else {
+      d.outcome = DiagnosisOutcome::unexplained;
+      text << "The residual stays unexplained: ";
+      if (d.path.size() == 1) {
+        text << "no candidate effect (" << (library.empty() ? "none" : "");
+        for (std::size_t j = 0; j < library.size(); ++j) text << (j ? ", " : "") << library[j];
+        text << ") raised the likelihood by more than its penalty.";
+      } else {
+        text << "the effects tried (";
+        for (std::size_t j = 0; j < after.estimates.size(); ++j)
+          text << (j ? ", " : "") << describe_estimate(after.estimates[j]);
+        text << ") raise the likelihood but leave the residual inconsistent, so none is claimed";
+        if (!d.claims.empty()) text << " (" << d.claims[0].effect << ": " << d.claims[0].reason << ")";
+        if (std::isfinite(d.misfit.remaining)) {
+          text << "; of the declared model's misfit (mean NIS " << format(d.before().residual.nis.mean, 4)
+               << " against " << format(d.before().residual.nis.mean_dof, 3) << " observed rows) ";
+          for (std::size_t j = 0; j < d.misfit.removed.size(); ++j)
+            text << (j ? ", then " : "") << d.misfit.effects[j] << " accounted for " << percent(d.misfit.removed[j]);
+          text << ", and " << percent(d.misfit.remaining) << " remains";
+        }
+        text << ": the data hold an effect outside the library (or more than one).";
+      }
     }
     text << " Failed tests: ";
-    const std::vector<std::string> failed = after.residual.verdict.failed();
+    const std::vector<std::string> failed = d.after().residual.verdict.failed();
     for (std::size_t j = 0; j < failed.size(); ++j) text << (j ? ", " : "") << failed[j];
     text << '.';
   }

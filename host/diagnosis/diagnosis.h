@@ -24,10 +24,13 @@
 //      on the box when the filter re-sampled positions only: g off by 1%, 4 of its std). The
 //      refined pass starts near the answer.
 // The outcome: `consistent` (the declared model explains the data; nothing added),
-// `explained` (effects were added and the last fit's residual is consistent) or
-// `unexplained` (the residual stays inconsistent: an effect that raised the likelihood is
-// then reported as tried, not as found, with the share of the misfit it accounts for:
-// MisfitShares below).
+// `explained` (effects were added and the last fit's residual is consistent),
+// `partly_explained` (the residual stays inconsistent, but the first effects added took up
+// most of the misfit, stand clear of their absence and of the stiffnesses: they are claimed
+// with widened stds and what remains is said, host/diagnosis/model_form_claim.h) or
+// `unexplained` (the residual stays inconsistent and no effect passes those checks: an effect
+// that raised the likelihood is then reported as tried, not as found, with the share of the
+// misfit it accounts for: MisfitShares below).
 //
 // Cost: one filter run per candidate per round, one after another, each on all cores (the CPU
 // ensemble's threads); a round with the three candidates on the box costs about four runs.
@@ -44,6 +47,7 @@
 #include "host/common/device_options.h"
 #include "host/data/observation_table.h"
 #include "host/data/truth_table.h"
+#include "host/diagnosis/model_form_claim.h"
 #include "host/scenario/effect_catalogue.h"
 #include "host/scenario/scenario.h"
 
@@ -65,6 +69,7 @@ struct DiagnoseOptions {
   // (measured on box_diagnose with a damping (1, 2): the mass factor went to 0.0117 with the
   // simplex, 0.53 +- 0.47 with the star set). Empty: the scenario's filter.sigma_points.
   std::optional<SigmaPointSet> sigma_points = SigmaPointSet::star;
+  ModelFormClaimOptions claims;             // when the residual stays inconsistent
   std::ostream* log = nullptr;              // a line per fit, when set
 };
 
@@ -142,11 +147,12 @@ struct DiagnosisRound {
 // then say whether an effect tried accounted for most of the misfit or for a sliver of it.
 struct MisfitShares {
   double declared_excess = 0.0;   // the declared model's mean NIS minus its mean observed rows
-  std::vector<double> removed;    // one per effect added, in the order added
+  std::vector<std::string> effects;  // the effects added, in the order added
+  std::vector<double> removed;    // one per effect added
   double remaining = 0.0;
 };
 
-enum class DiagnosisOutcome { consistent, explained, unexplained };
+enum class DiagnosisOutcome { consistent, explained, partly_explained, unexplained };
 const char* to_string(DiagnosisOutcome outcome);
 
 struct Diagnosis {
@@ -154,12 +160,20 @@ struct Diagnosis {
   std::vector<DiagnosisRound> rounds;
   std::vector<int> path;                    // the fits along the chosen effects: declared, +1st, ...
   DiagnosisOutcome outcome = DiagnosisOutcome::unexplained;
-  std::vector<EffectValue> discovered;      // the effects added, at their final estimates
-                                            // (empty unless the outcome is `explained`)
+  std::vector<EffectValue> discovered;      // the effects claimed, at their final estimates
+                                            // (empty unless `explained` or `partly_explained`)
   MisfitShares misfit;                      // along the path
+  // When the last fit's residual stays inconsistent: the checks of the effects along the path
+  // (host/diagnosis/model_form_claim.h), up to the first that failed.
+  std::vector<ClaimCheck> claims;
+  // The fit the report calls "after": the path's last, or under `partly_explained` the one
+  // with the claimed effects (an index into `path`; -1: the last).
+  int after_position = -1;
   std::string conclusion;                   // one paragraph in words
   const ModelFit& before() const { return fits[static_cast<std::size_t>(path.front())]; }
-  const ModelFit& after() const { return fits[static_cast<std::size_t>(path.back())]; }
+  const ModelFit& after() const {
+    return fits[static_cast<std::size_t>(after_position < 0 ? path.back() : path[static_cast<std::size_t>(after_position)])];
+  }
 };
 
 // One fit: the filter of `scenario` (its declared effects included) with `effects` estimated.

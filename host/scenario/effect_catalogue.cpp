@@ -20,7 +20,7 @@ const std::vector<EffectDefinition>& effect_catalogue() {
        EffectSide::physics, true, false, "gx,gy,gz (m/s^2, added to the scenario's gravity)", 3,
        {{"gx", "m/s^2", false, 0.0, 5.0}, {"gy", "m/s^2", false, 0.0, 5.0}, {"gz", "m/s^2", false, 0.0, 5.0}}},
       {"young_scale", "a global scale of Young's modulus", EffectSide::physics, true, false,
-       "s (> 0, multiplies material.young_modulus)", 1, {{"scale", "", true, 0.0, 0.5}}},
+       "s (> 0, multiplies material.young_modulus)", 1, {{"scale", "", true, 0.0, 0.5, 1.0}}},
       {"camera_offset", "a rigid translation of the observation frame (camera registration error)",
        EffectSide::observation, true, false, "tx,ty,tz (m, added to every observed position)", 3,
        {{"tx", "m", false, 0.0, 5e-3}, {"ty", "m", false, 0.0, 5e-3}, {"tz", "m", false, 0.0, 5e-3}}},
@@ -28,7 +28,7 @@ const std::vector<EffectDefinition>& effect_catalogue() {
       // priori, within a factor of e (1 std).
       {"ligament_law", "a nonlinear ligament law: force = k d (1 + (d/d0)^2), d the node's displacement",
        EffectSide::physics, true, false, "d0 (m, > 0, shared by every ligament)", 1,
-       {{"d0", "m", true, std::log(0.01), 1.0}}},
+       {{"d0", "m", true, std::log(0.01), 1.0, HUGE_VAL}}},
       // A ligament the scenario does not declare, at one of its candidate_regions; 100 N/m a
       // priori, within a factor of e^1.5 (1 std): from barely there to as stiff as the others.
       {"extra_ligament", "an unmodelled ligament at one of the scenario's candidate_regions",
@@ -42,7 +42,7 @@ const std::vector<EffectDefinition>& effect_catalogue() {
       // within a factor of e.
       {"damping_scale", "a mismatch of the Rayleigh damping: factors on its mass and stiffness coefficients",
        EffectSide::physics, true, false, "am,ak (> 0, multiply damping.rayleigh_mass and damping.rayleigh_stiffness)", 2,
-       {{"am", "", true, 0.0, 1.0}, {"ak", "", true, 0.0, 1.0}}},
+       {{"am", "", true, 0.0, 1.0, 1.0}, {"ak", "", true, 0.0, 1.0, 1.0}}},
       {"inclusion", "a stiffer (or softer) sphere inside the organ: outside the candidate library",
        EffectSide::physics, false, false, "x,y,z,radius,factor (m, m, > 0: multiplies Young's modulus of the elements whose centroid is inside)",
        5, {}},

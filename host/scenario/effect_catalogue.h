@@ -30,6 +30,9 @@ struct EffectParameter {
   bool log = false;       // log transform (positive quantity)
   double prior_mean = 0.0;  // of u
   double prior_std = 1.0;   // of u
+  // The value at which the effect is absent: 0 for an added quantity, 1 for a factor,
+  // infinity for a length beyond which a law is linear (diagnose tests a claim against it).
+  double absent = 0.0;
 };
 
 struct EffectDefinition {

@@ -10,6 +10,7 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <filesystem>
 #include <iostream>
@@ -265,6 +266,63 @@ TEST(DiagnoseBox, AStiffInclusionStaysUnexplained) {
   // What the effects tried account for is said, and part of the misfit remains.
   EXPECT_NE(d.conclusion.find("% remains"), std::string::npos) << d.conclusion;
   EXPECT_GT(d.misfit.remaining, 0.0) << d.conclusion;
+}
+
+// A truth simulated on the box refined once (8 times the tetrahedra; the observed points at
+// the same material points): the data carry a model-form error no effect of the library
+// removes, so the residual never turns consistent (host/diagnosis/model_form_claim.h). One
+// round with three candidates, to keep each case near 25 s: the claims are decided on the
+// first effect.
+Diagnosis diagnose_refined_truth(const std::vector<EffectValue>& inject) {
+  const BoxData box = box_data(inject, 1, "box_diagnose", 0, 1);
+  DiagnoseOptions options;
+  options.candidates = {"gravity", "camera_offset", "young_scale"};
+  options.max_rounds = 1;
+  return diagnose(box.scenario, box.data, box.truth, options);
+}
+
+TEST(DiagnoseBox, ATruthFromTheRefinedMeshWithAFullGravityClaimsTheGravityAlone) {
+  const std::vector<double> g = {4.005, -8.01, 4.005};   // 9.81 m/s^2, oblique, undeclared
+  const Diagnosis d = diagnose_refined_truth({{"gravity", g}});
+  ASSERT_EQ(d.outcome, DiagnosisOutcome::partly_explained) << describe(d);
+  ASSERT_EQ(d.discovered.size(), 1u) << describe(d);
+  EXPECT_EQ(d.discovered[0].name, "gravity");
+  const Eigen::Vector3d truth(g[0], g[1], g[2]);
+  const Eigen::Vector3d found(d.discovered[0].value[0], d.discovered[0].value[1], d.discovered[0].value[2]);
+  const double degrees = std::acos(std::clamp(found.normalized().dot(truth.normalized()), -1.0, 1.0)) * 180.0 / M_PI;
+  std::cout << "refined truth, gravity: found " << found.transpose() << " (" << degrees << " degrees off, |g| "
+            << found.norm() << "), stiffness error " << *d.before().stiffness_error << " -> "
+            << *d.after().stiffness_error << " N/m\n";
+  // The direction is found (measured 4.4 degrees). The size is not to 10%: measured |g| 13.0
+  // m/s^2 for 9.81, because the refined box sags more under gravity than the coarse model
+  // (as the clean data below show, an extra gravity takes that up), and the widened std does
+  // not cover that bias (model_form_claim.h: a bias constant over the run cannot show in the
+  // residual's dispersion). The bound says what is claimed: the right effect, within 50%.
+  EXPECT_LT(degrees, 10.0) << describe(d);
+  EXPECT_LT(std::abs(found.norm() / truth.norm() - 1.0), 0.5) << describe(d);
+  ASSERT_TRUE(d.before().stiffness_error && d.after().stiffness_error);
+  EXPECT_GE(*d.before().stiffness_error, 5.0 * *d.after().stiffness_error) << describe(d);
+  // The report says what remains.
+  EXPECT_GT(d.misfit.remaining, 0.0);
+  EXPECT_NE(d.conclusion.find("remains"), std::string::npos) << d.conclusion;
+}
+
+TEST(DiagnoseBox, ATruthFromTheRefinedMeshClaimsNoWrongEffect) {
+  // Clean, and with an undeclared 3.9 mm camera offset: on the refined box an extra gravity
+  // along the declared one and a softer modulus both take up the larger sag (scores 17111 and
+  // 16368 with the clean data), and with the offset a gravity scores above the offset (33612
+  // against 22475). Whatever the data cannot tell apart is not claimed.
+  for (const std::vector<EffectValue>& inject :
+       {std::vector<EffectValue>{}, std::vector<EffectValue>{{"camera_offset", {3e-3, -2e-3, 1.5e-3}}}}) {
+    const Diagnosis d = diagnose_refined_truth(inject);
+    EXPECT_NE(d.outcome, DiagnosisOutcome::consistent) << "the model-form error is there: " << describe(d);
+    for (const EffectValue& claimed : d.discovered)
+      EXPECT_TRUE(!inject.empty() && claimed.name == inject[0].name) << "claimed " << claimed.name << ": " << describe(d);
+    ASSERT_FALSE(d.claims.empty()) << describe(d);
+    std::cout << "refined truth, " << (inject.empty() ? "clean" : inject[0].name) << ": " << to_string(d.outcome)
+              << "; first checked " << d.claims[0].effect << " (" << (d.claims[0].claimed ? "claimed" : d.claims[0].reason)
+              << ")\n";
+  }
 }
 
 // The liver (scenarios/liver_diagnose.json: 300 steps, its six automatic surface regions) on

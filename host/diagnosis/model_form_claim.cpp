@@ -1,0 +1,112 @@
+#include "host/diagnosis/model_form_claim.h"
+
+#include <Eigen/Dense>
+#include <algorithm>
+#include <cmath>
+
+#include "filter/statistical_distributions.h"
+#include "host/diagnosis/diagnosis.h"
+#include "host/scenario/effect_catalogue.h"
+
+namespace sigmafem {
+namespace {
+
+// How far parameter `parameter` at `value` +- `std` (natural units) lies from its absence, in
+// stds: of the value for an added quantity, of its log for a factor; where the absence is 0 or
+// infinity on a log scale (a lag, an extra ligament's stiffness, d0), of the log's distance to
+// nothing finite, so it says whether the value is known to within a factor: value / std.
+double distance_from_absence(const EffectParameter& parameter, double value, double std) {
+  if (!(std > 0.0)) return 0.0;
+  if (!parameter.log) return std::fabs(value - parameter.absent) / std;
+  if (parameter.absent > 0.0 && std::isfinite(parameter.absent))
+    return std::fabs(std::log(value / parameter.absent)) / (std / value);
+  return value / std;
+}
+
+// 1 - var(x_i | the stiffnesses) / var(x_i) for coordinate i of the covariance C whose first
+// `stiffnesses` coordinates are the log-stiffnesses (a held, cut ligament has no variance: the
+// pseudo-inverse leaves it out).
+double stiffness_r2(const Eigen::MatrixXd& C, int stiffnesses, int i) {
+  const double variance = C(i, i);
+  if (!(variance > 0.0) || stiffnesses == 0) return 0.0;
+  const Eigen::MatrixXd S = C.topLeftCorner(stiffnesses, stiffnesses);
+  const Eigen::VectorXd c = C.block(0, i, stiffnesses, 1);
+  const Eigen::VectorXd w = Eigen::CompleteOrthogonalDecomposition<Eigen::MatrixXd>(S).solve(c);
+  return std::clamp(c.dot(w) / variance, 0.0, 1.0);
+}
+
+}  // namespace
+
+double model_form_factor(const ResidualDiagnostics& residual) {
+  if (residual.verdict.consistency != Consistency::inconsistent || residual.steps_used < 2 ||
+      !(residual.nis.mean_dof > 0.0) || !(residual.spatial.least_effective_steps > 0.0))
+    return 1.0;
+  const double dispersion = std::max(1.0, residual.nis.mean / residual.nis.mean_dof);
+  const double persistence = std::max(1.0, residual.steps_used / residual.spatial.least_effective_steps);
+  return std::sqrt(dispersion * persistence);
+}
+
+EffectEstimate widened(const EffectEstimate& estimate, double factor) {
+  EffectEstimate out = estimate;
+  for (std::size_t i = 0; i < out.std.size(); ++i)
+    out.std[i] = out.first_order_std[i] * std::max({1.0, out.path_ratio[i], factor});
+  return out;
+}
+
+std::vector<ClaimCheck> check_claims(const std::vector<const ModelFit*>& path, const MisfitShares& shares,
+                                     const std::vector<RunnerUp>& runners_up, const ModelFormClaimOptions& options) {
+  std::vector<ClaimCheck> checks;
+  for (std::size_t j = 1; j < path.size(); ++j) {
+    const ModelFit& before = *path[j - 1];
+    const ModelFit& fit = *path[j];
+    if (fit.estimates.empty()) break;
+    const EffectEstimate& raw = fit.estimates.back();
+    const EffectDefinition& definition = *find_effect(raw.name);
+    ClaimCheck check;
+    check.effect = raw.name;
+    check.share_of_declared = j - 1 < shares.removed.size() ? shares.removed[j - 1] : NAN;
+    const double excess_before = before.residual.nis.mean - before.residual.nis.mean_dof;
+    const double excess_after = fit.residual.nis.mean - fit.residual.nis.mean_dof;
+    check.share_of_remaining = excess_before > 0.0 ? (excess_before - excess_after) / excess_before : NAN;
+    if (j - 1 < runners_up.size()) {
+      check.runner_up = runners_up[j - 1].effect;
+      check.runner_up_ratio = runners_up[j - 1].ratio;
+    }
+    check.model_form_factor = model_form_factor(fit.residual);
+    const EffectEstimate estimate = widened(raw, check.model_form_factor);
+    const int k = static_cast<int>(estimate.value.size());
+    for (int i = 0; i < k; ++i) {
+      const double z = distance_from_absence(definition.parameters[static_cast<std::size_t>(i)],
+                                             estimate.value[static_cast<std::size_t>(i)],
+                                             estimate.std[static_cast<std::size_t>(i)]);
+      check.distance += z * z;
+    }
+    check.distance_bound = chi_square_tail_quantile(options.significance_tail, k);
+    const Eigen::MatrixXd& C = fit.run.final_theta_covariance;
+    const int stiffnesses = static_cast<int>(fit.ligaments.size());
+    const int first = static_cast<int>(C.rows()) - k;
+    if (first >= stiffnesses)
+      for (int i = 0; i < k; ++i) check.stiffness_r2 = std::max(check.stiffness_r2, stiffness_r2(C, stiffnesses, first + i));
+
+    if (!fit.run.complete)
+      check.reason = "its fit stopped early";
+    else if (!(check.share_of_remaining >= options.min_share_of_remaining))
+      check.reason = "it took up less than " + std::to_string(static_cast<int>(std::lround(100.0 * options.min_share_of_remaining))) +
+                     "% of the misfit left before it";
+    else if (std::isnan(check.runner_up_ratio))
+      check.reason = "its round's model stopped early, so no rival was compared on fair ground";
+    else if (check.runner_up_ratio > options.max_runner_up_ratio)
+      check.reason = check.runner_up + " scored " + std::to_string(static_cast<int>(std::lround(100.0 * check.runner_up_ratio))) +
+                     "% of its score: the data do not tell the two accounts apart";
+    else if (!(check.distance > check.distance_bound))
+      check.reason = "its estimate is within 3 std of the effect's absence";
+    else if (check.stiffness_r2 > options.max_stiffness_r2)
+      check.reason = "the data do not tell it apart from the stiffnesses";
+    check.claimed = check.reason.empty();
+    checks.push_back(check);
+    if (!check.claimed) break;
+  }
+  return checks;
+}
+
+}  // namespace sigmafem

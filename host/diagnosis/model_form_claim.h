@@ -1,0 +1,90 @@
+// Claims under a model-form floor (issue 13, item 4): measured data always hold a model error
+// that no effect of the library removes (a real geometry finer than the mesh; in the tests, a
+// truth simulated on a refined mesh), so the residual stays inconsistent whatever is added.
+// Requiring a consistent residual before claiming anything then claims nothing, even when one
+// effect plainly took up nearly all of the misfit (the box with the truth from the refined
+// mesh and an undeclared gravity: 99.86%). diagnose therefore claims the effects along its
+// path, in the order added, while each passes three checks on the fit that added it:
+//   1. it accounts for most of what was left: the drop of the excess mean NIS it brought is at
+//      least `min_share_of_remaining` of the excess before it (the misfit left after it is
+//      smaller than what it removed);
+//   2. no other candidate of its round comes near it: the runner-up's score is at most
+//      `max_runner_up_ratio` of its own. A model-form error can look like more than one effect
+//      (the box_diagnose truth from the refined mesh sags more under the declared gravity: an
+//      extra gravity along it scored 17111, a softer modulus 16368; with an undeclared camera
+//      offset there, gravity scored 33612 and the offset 22475, and gravity took up 91% of the
+//      misfit before the offset was fitted): the data do not tell such accounts apart;
+//   3. it is there: the estimate lies away from the effect's absence (EffectParameter::absent)
+//      by more than a 3-sigma chi-square bound, with the std widened by the model-form factor
+//      below (a 0.06 m/s^2 gravity that took up part of a coarse mesh's error is not a gravity);
+//   4. the data tell it apart from the stiffnesses: the squared multiple correlation of each of
+//      its coordinates with the log-stiffnesses in the final covariance is at most
+//      `max_stiffness_r2`. Without a known force a scale of Young's modulus and the ligaments
+//      scaled alike move the organ the same, so a modulus scale that improves the fit does so
+//      along that blind direction (the refined box: young_scale 6.1 with the ligaments 5x
+//      their truth).
+// The first effect that fails ends the claims (a later one was fitted on top of it). The
+// outcome is then `partly_explained`: what is claimed, with how much of the misfit it took up
+// and how much remains.
+//
+// The stated std of a claim is its first-order std times the larger of its path ratio and the
+// model-form factor F = sqrt(max(1, NIS / rows) * N / N_eff): the residual's dispersion times
+// how much its persistence slows averaging (N_eff: the fewest effective independent steps of a
+// rigid component of the residual, lag-1 autocorrelation), the variance inflation of an
+// estimate from correlated, over-dispersed errors. F is 1 for a consistent filter. It cannot
+// show a bias that stays the same over the whole run.
+#pragma once
+
+#include <string>
+#include <vector>
+
+#include "filter/residual_diagnostics.h"
+
+namespace sigmafem {
+
+struct ModelFit;
+struct MisfitShares;
+struct EffectEstimate;
+
+struct ModelFormClaimOptions {
+  double min_share_of_remaining = 0.5;
+  double max_runner_up_ratio = 0.5;
+  double significance_tail = 0.0027;   // two-sided 3 sigma
+  double max_stiffness_r2 = 0.9;
+};
+
+// One effect along the path, checked as above.
+struct ClaimCheck {
+  std::string effect;
+  double share_of_declared = 0.0;       // MisfitShares::removed
+  double share_of_remaining = 0.0;      // its drop over the excess left before it
+  std::string runner_up;                // the next candidate of its round ("" when none scored above 0)
+  double runner_up_ratio = 0.0;         // its score over the chosen one's (NaN: no fair comparison)
+  double distance = 0.0;                // chi-square of the estimate from the effect's absence
+  double distance_bound = 0.0;          // its 3-sigma quantile (k degrees of freedom)
+  double stiffness_r2 = 0.0;            // the largest over the effect's coordinates
+  double model_form_factor = 1.0;       // F of the fit that added it
+  bool claimed = false;
+  std::string reason;                   // which check failed ("" when claimed)
+};
+
+// F above, from a fit's residual tests: 1 when they are consistent or too few.
+double model_form_factor(const ResidualDiagnostics& residual);
+
+// `estimate` with its stated std widened to first-order std x max(1, path ratio, factor).
+EffectEstimate widened(const EffectEstimate& estimate, double factor);
+
+// The best rival of the effect chosen in a round: its name and score over the chosen one's.
+struct RunnerUp {
+  std::string effect;
+  double ratio = 0.0;
+};
+
+// The checks along `path` (the declared model's fit first, then one per effect added; the
+// j-th effect is the last of path[j]'s estimates), with `shares` = misfit_shares(path) and
+// `runners_up[j - 1]` the rival of the j-th effect in its round. Checks stop at the first
+// effect that fails.
+std::vector<ClaimCheck> check_claims(const std::vector<const ModelFit*>& path, const MisfitShares& shares,
+                                     const std::vector<RunnerUp>& runners_up, const ModelFormClaimOptions& options);
+
+}  // namespace sigmafem

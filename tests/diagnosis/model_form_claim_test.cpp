@@ -1,0 +1,146 @@
+// Claims under a model-form floor (host/diagnosis/model_form_claim.h) on synthetic fits: each of
+// the three checks can refuse a claim, the first refusal ends the claims, and the stated std is
+// widened by the model-form factor.
+#include <gtest/gtest.h>
+
+#include <cmath>
+
+#include "host/diagnosis/diagnosis.h"
+#include "host/diagnosis/model_form_claim.h"
+
+namespace sigmafem {
+namespace {
+
+// A fit with `nis_mean` against 36 rows, three estimated ligaments, and (unless `effect` is
+// empty) one effect last in theta with `value` +- `std` whose coordinates correlate with the
+// first ligament by `correlation`.
+ModelFit synthetic_fit(double nis_mean, const std::vector<std::string>& effects = {},
+                       const std::vector<double>& value = {}, const std::vector<double>& std = {},
+                       double correlation = 0.0) {
+  ModelFit f;
+  f.residual.nis.mean = nis_mean;
+  f.residual.nis.mean_dof = 36.0;
+  f.residual.verdict.consistency = Consistency::inconsistent;
+  f.residual.steps_used = 1000;
+  f.residual.spatial.least_effective_steps = 1000;   // persistence 1
+  f.ligaments = {"left", "middle", "right"};
+  int p = 3;
+  for (const std::string& name : effects) {
+    EffectEstimate e;
+    e.name = name;
+    const std::size_t k = find_effect(name)->parameters.size();
+    e.value = value.size() == k ? value : std::vector<double>(k, 0.0);
+    e.first_order_std = std.size() == k ? std : std::vector<double>(k, 1.0);
+    e.std = e.first_order_std;
+    e.path_ratio.assign(k, 1.0);
+    f.estimates.push_back(e);
+    p += static_cast<int>(k);
+  }
+  f.run.final_theta_covariance = Eigen::MatrixXd::Identity(p, p);
+  if (!effects.empty()) {
+    const int last = p - 1;
+    f.run.final_theta_covariance(0, last) = f.run.final_theta_covariance(last, 0) = correlation;
+  }
+  return f;
+}
+
+TEST(ModelFormClaim, FactorIsTheResidualsDispersionTimesItsPersistence) {
+  ModelFit f = synthetic_fit(144.0);   // NIS 4 times the rows
+  f.residual.spatial.least_effective_steps = 40.0;   // 1000 steps worth 40: persistence 25
+  EXPECT_NEAR(model_form_factor(f.residual), std::sqrt(4.0 * 25.0), 1e-12);
+  f.residual.nis.mean = 30.0;   // below the rows: no dispersion to widen by
+  EXPECT_NEAR(model_form_factor(f.residual), 5.0, 1e-12);
+  f.residual.verdict.consistency = Consistency::consistent;
+  EXPECT_EQ(model_form_factor(f.residual), 1.0) << "a consistent filter's std is not widened";
+
+  EffectEstimate e;
+  e.first_order_std = {1.0, 2.0};
+  e.path_ratio = {3.0, 0.5};
+  e.std = {3.0, 2.0};
+  const EffectEstimate w = widened(e, 2.0);
+  EXPECT_DOUBLE_EQ(w.std[0], 3.0) << "the path ratio when larger";
+  EXPECT_DOUBLE_EQ(w.std[1], 4.0) << "else the factor";
+}
+
+TEST(ModelFormClaim, AnEffectThatTookUpMostOfTheMisfitIsClaimedAndTheFirstRefusalEndsTheClaims) {
+  // Excess 100 -> 4 (gravity took up 96%) -> 1 (young_scale took up 75% of what was left, but
+  // along the stiffnesses: r^2 0.98).
+  const ModelFit declared = synthetic_fit(136.0);
+  const ModelFit gravity = synthetic_fit(40.0, {"gravity"}, {4.3, -7.2, 3.7}, {0.1, 0.1, 0.1}, 0.3);
+  const ModelFit both = synthetic_fit(37.0, {"gravity", "young_scale"}, {6.1}, {0.6}, 0.99);
+  const std::vector<const ModelFit*> path = {&declared, &gravity, &both};
+  const std::vector<ClaimCheck> checks = check_claims(path, misfit_shares(path), {}, {});
+  ASSERT_EQ(checks.size(), 2u);
+  EXPECT_TRUE(checks[0].claimed) << checks[0].reason;
+  EXPECT_NEAR(checks[0].share_of_declared, 0.96, 1e-12);
+  EXPECT_NEAR(checks[0].share_of_remaining, 0.96, 1e-12);
+  EXPECT_NEAR(checks[0].stiffness_r2, 0.09, 1e-12);
+  EXPECT_NEAR(checks[1].share_of_remaining, 0.75, 1e-12);
+  EXPECT_NEAR(checks[1].stiffness_r2, 0.9801, 1e-12);
+  EXPECT_FALSE(checks[1].claimed);
+  EXPECT_NE(checks[1].reason.find("stiffnesses"), std::string::npos) << checks[1].reason;
+
+  // The same young_scale told apart from the stiffnesses is claimed too.
+  const ModelFit separate = synthetic_fit(37.0, {"gravity", "young_scale"}, {6.1}, {0.6}, 0.5);
+  const std::vector<const ModelFit*> path2 = {&declared, &gravity, &separate};
+  EXPECT_TRUE(check_claims(path2, misfit_shares(path2), {}, {})[1].claimed);
+}
+
+TEST(ModelFormClaim, ASliverOfTheMisfitOrAnEstimateNearTheEffectsAbsenceIsNotClaimed) {
+  const ModelFit declared = synthetic_fit(136.0);
+  // A gravity that took up 23% of the misfit: refused on the share; nothing after it is checked.
+  const ModelFit small = synthetic_fit(113.0, {"gravity"}, {0.06, 0.0, 0.0}, {0.001, 0.001, 0.001});
+  const ModelFit lag = synthetic_fit(40.0, {"gravity", "time_lag"}, {0.11}, {0.001});
+  std::vector<const ModelFit*> path = {&declared, &small, &lag};
+  std::vector<ClaimCheck> checks = check_claims(path, misfit_shares(path), {}, {});
+  ASSERT_EQ(checks.size(), 1u);
+  EXPECT_FALSE(checks[0].claimed);
+  EXPECT_NE(checks[0].reason.find("50%"), std::string::npos) << checks[0].reason;
+
+  // Most of the misfit, but within 3 std of no gravity once the std is widened: the residual's
+  // NIS is 4 times the rows (dispersion 4) and persists over 1000 steps worth 40 (25): std x 10.
+  ModelFit faint = synthetic_fit(144.0, {"gravity"}, {0.2, 0.0, 0.0}, {0.01, 0.01, 0.01});
+  faint.residual.spatial.least_effective_steps = 40.0;
+  const ModelFit huge = synthetic_fit(36.0 + 1000.0);
+  path = {&huge, &faint};
+  checks = check_claims(path, misfit_shares(path), {}, {});
+  ASSERT_EQ(checks.size(), 1u);
+  EXPECT_NEAR(checks[0].model_form_factor, 10.0, 1e-12);
+  EXPECT_NEAR(checks[0].distance, 4.0, 1e-9) << "(0.2 / (0.01 x 10))^2";
+  EXPECT_FALSE(checks[0].claimed) << "chi^2 4 against the 3-sigma bound of 3 dof";
+  EXPECT_NE(checks[0].reason.find("absence"), std::string::npos) << checks[0].reason;
+
+  // A factor's absence is 1 (young_scale 1.02 +- 0.01 is 2 std from it); a lag's is 0, so it is
+  // there when known to within a third of itself (0.1 +- 0.02: 5 std). Both fits leave no
+  // excess NIS, so their stds are not widened.
+  const ModelFit scale = synthetic_fit(36.0, {"young_scale"}, {1.02}, {0.01});
+  path = {&declared, &scale};
+  EXPECT_NEAR(check_claims(path, misfit_shares(path), {}, {})[0].distance, std::pow(std::log(1.02) / (0.01 / 1.02), 2), 1e-9);
+  const ModelFit lag_alone = synthetic_fit(36.0, {"time_lag"}, {0.1}, {0.02});
+  path = {&declared, &lag_alone};
+  EXPECT_NEAR(check_claims(path, misfit_shares(path), {}, {})[0].distance, 25.0, 1e-9);
+  EXPECT_TRUE(check_claims(path, misfit_shares(path), {}, {})[0].claimed);
+}
+
+TEST(ModelFormClaim, ARivalThatScoredNearlyAsMuchLeavesNothingClaimed) {
+  // box_diagnose, truth from the refined mesh, no effect: an extra gravity along the declared
+  // one scored 17111, a softer modulus 16368 (ratio 0.96): both are accounts of the refined
+  // mesh's larger sag, and the data do not tell them apart.
+  const ModelFit declared = synthetic_fit(136.0);
+  const ModelFit gravity = synthetic_fit(40.0, {"gravity"}, {0.4, 0.2, -3.3}, {0.02, 0.01, 0.06});
+  const std::vector<const ModelFit*> path = {&declared, &gravity};
+  std::vector<ClaimCheck> checks = check_claims(path, misfit_shares(path), {{"young_scale", 0.96}}, {});
+  ASSERT_EQ(checks.size(), 1u);
+  EXPECT_FALSE(checks[0].claimed);
+  EXPECT_EQ(checks[0].runner_up, "young_scale");
+  EXPECT_NE(checks[0].reason.find("young_scale scored 96%"), std::string::npos) << checks[0].reason;
+  // A rival at a third of the score does not stand in the way.
+  EXPECT_TRUE(check_claims(path, misfit_shares(path), {{"young_scale", 0.33}}, {})[0].claimed);
+  // With the round's model stopped early there is no fair comparison: nothing is claimed.
+  checks = check_claims(path, misfit_shares(path), {{"", NAN}}, {});
+  EXPECT_FALSE(checks[0].claimed);
+  EXPECT_NE(checks[0].reason.find("stopped early"), std::string::npos) << checks[0].reason;
+}
+
+}  // namespace
+}  // namespace sigmafem
