@@ -71,6 +71,7 @@ std::vector<ClaimCheck> check_claims(const std::vector<const ModelFit*>& path, c
     if (j - 1 < runners_up.size()) {
       check.runner_up = runners_up[j - 1].effect;
       check.runner_up_ratio = runners_up[j - 1].ratio;
+      check.runner_up_after = runners_up[j - 1].after;
     }
     check.model_form_factor = model_form_factor(fit.residual);
     const EffectEstimate estimate = widened(raw, check.model_form_factor);
@@ -88,6 +89,21 @@ std::vector<ClaimCheck> check_claims(const std::vector<const ModelFit*>& path, c
     if (first >= stiffnesses)
       for (int i = 0; i < k; ++i) check.stiffness_r2 = std::max(check.stiffness_r2, stiffness_r2(C, stiffnesses, first + i));
 
+    if (raw.name == "young_scale" && before.stiffness.size() == fit.stiffness.size() && raw.value[0] != 1.0) {
+      // Ligaments found cut in either fit are left out: their logs say nothing about a scale.
+      auto cut = [](const ModelFit& f, int l) {
+        return std::any_of(f.run.cuts.begin(), f.run.cuts.end(), [l](const LigamentCut& c) { return c.parameter == l; });
+      };
+      double sum = 0.0;
+      int count = 0;
+      for (int l = 0; l < static_cast<int>(fit.stiffness.size()); ++l)
+        if (!cut(before, l) && !cut(fit, l) && before.stiffness[l] > 0.0 && fit.stiffness[l] > 0.0) {
+          sum += std::log(fit.stiffness[l] / before.stiffness[l]);
+          ++count;
+        }
+      if (count > 0) check.scale_follow = sum / count / std::log(raw.value[0]);
+    }
+
     if (!fit.run.complete)
       check.reason = "its fit stopped early";
     else if (!(check.share_of_remaining >= options.min_share_of_remaining))
@@ -95,13 +111,18 @@ std::vector<ClaimCheck> check_claims(const std::vector<const ModelFit*>& path, c
                      "% of the misfit left before it";
     else if (std::isnan(check.runner_up_ratio))
       check.reason = "its round's model stopped early, so no rival was compared on fair ground";
-    else if (check.runner_up_ratio > options.max_runner_up_ratio)
+    else if (check.runner_up_ratio > options.max_runner_up_ratio && !(check.runner_up_after <= 0.0))
       check.reason = check.runner_up + " scored " + std::to_string(static_cast<int>(std::lround(100.0 * check.runner_up_ratio))) +
-                     "% of its score: the data do not tell the two accounts apart";
+                     "% of its score" +
+                     (std::isnan(check.runner_up_after) ? std::string(" and was not tried beside it")
+                                                        : " and still adds beside it") +
+                     ": the data do not tell the two accounts apart";
     else if (!(check.distance > check.distance_bound))
       check.reason = "its estimate is within 3 std of the effect's absence";
     else if (check.stiffness_r2 > options.max_stiffness_r2)
       check.reason = "the data do not tell it apart from the stiffnesses";
+    else if (check.scale_follow > options.max_scale_follow)
+      check.reason = "the ligaments moved with it (a scale of every stiffness, which the data do not see)";
     check.claimed = check.reason.empty();
     checks.push_back(check);
     if (!check.claimed) break;

@@ -134,12 +134,45 @@ TEST(ModelFormClaim, ARivalThatScoredNearlyAsMuchLeavesNothingClaimed) {
   EXPECT_FALSE(checks[0].claimed);
   EXPECT_EQ(checks[0].runner_up, "young_scale");
   EXPECT_NE(checks[0].reason.find("young_scale scored 96%"), std::string::npos) << checks[0].reason;
+  EXPECT_NE(checks[0].reason.find("not tried beside it"), std::string::npos) << checks[0].reason;
+  // Tried beside it in the next round, the modulus still gained 350: two accounts.
+  checks = check_claims(path, misfit_shares(path), {{"young_scale", 0.96, 350.0}}, {});
+  EXPECT_FALSE(checks[0].claimed);
+  EXPECT_NE(checks[0].reason.find("still adds beside it"), std::string::npos) << checks[0].reason;
+  // A close rival that adds nothing once the chosen effect is in was the same account (box.json,
+  // truth from the refined mesh, a camera offset: gravity scored 92% of the offset, then -259).
+  EXPECT_TRUE(check_claims(path, misfit_shares(path), {{"young_scale", 0.92, -259.0}}, {})[0].claimed);
   // A rival at a third of the score does not stand in the way.
   EXPECT_TRUE(check_claims(path, misfit_shares(path), {{"young_scale", 0.33}}, {})[0].claimed);
   // With the round's model stopped early there is no fair comparison: nothing is claimed.
   checks = check_claims(path, misfit_shares(path), {{"", NAN}}, {});
   EXPECT_FALSE(checks[0].claimed);
   EXPECT_NE(checks[0].reason.find("stopped early"), std::string::npos) << checks[0].reason;
+}
+
+TEST(ModelFormClaim, AModulusScaleThatBroughtTheLigamentsAlongIsNotClaimed) {
+  // box.json has no known force: the modulus and every ligament scaled alike leave the organ
+  // where it is. young_scale 6.1 with the ligaments from about their truth to 5 times it is a
+  // move along that blind direction (log 5 / log 6.1 = 0.89 of it).
+  ModelFit declared = synthetic_fit(136.0);
+  declared.stiffness = Eigen::Vector3d(150.0, 300.0, 200.0);
+  ModelFit scaled = synthetic_fit(40.0, {"young_scale"}, {6.1}, {0.2});
+  scaled.stiffness = 5.0 * declared.stiffness;
+  std::vector<const ModelFit*> path = {&declared, &scaled};
+  std::vector<ClaimCheck> checks = check_claims(path, misfit_shares(path), {}, {});
+  EXPECT_NEAR(checks[0].scale_follow, std::log(5.0) / std::log(6.1), 1e-12);
+  EXPECT_FALSE(checks[0].claimed);
+  EXPECT_NE(checks[0].reason.find("ligaments moved with it"), std::string::npos) << checks[0].reason;
+  // The same scale with the ligaments where they were (a known force fixes the level) is claimed.
+  scaled.stiffness = declared.stiffness * 1.1;
+  checks = check_claims(path, misfit_shares(path), {}, {});
+  EXPECT_LT(checks[0].scale_follow, 0.1);
+  EXPECT_TRUE(checks[0].claimed) << checks[0].reason;
+  // A ligament found cut in a fit says nothing about a scale and is left out.
+  scaled.stiffness = Eigen::Vector3d(750.0, 1e-3, 1000.0);
+  scaled.run.cuts.push_back({1, 100, 1.0, 300.0});
+  checks = check_claims(path, misfit_shares(path), {}, {});
+  EXPECT_NEAR(checks[0].scale_follow, std::log(5.0) / std::log(6.1), 1e-12);
 }
 
 }  // namespace
