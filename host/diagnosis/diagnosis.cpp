@@ -390,23 +390,7 @@ Diagnosis diagnose(const Scenario& scenario, const ObservationTable& data,
     d.outcome = DiagnosisOutcome::unexplained;
     text << "Too few filter steps to judge the residual: nothing was tested or added.";
   } else {
-    std::vector<RunnerUp> runners_up;
-    for (std::size_t i = 0; i < d.rounds.size(); ++i) {
-      const DiagnosisRound& r = d.rounds[i];
-      if (r.chosen.empty()) continue;
-      RunnerUp rival;
-      const CandidateScore& chosen = r.candidates[0];
-      if (std::isnan(chosen.gain)) rival.ratio = NAN;   // the round's model stopped early
-      if (r.candidates.size() > 1 && r.candidates[1].complete && r.candidates[1].score > 0.0) {
-        rival.effect = r.candidates[1].effect;
-        if (!std::isnan(rival.ratio)) rival.ratio = r.candidates[1].score / chosen.score;
-        if (i + 1 < d.rounds.size())
-          for (const CandidateScore& c : d.rounds[i + 1].candidates)
-            if (c.effect == rival.effect && c.complete) rival.after = c.score;
-      }
-      runners_up.push_back(rival);
-    }
-    d.claims = check_claims(path_fits, d.misfit, runners_up, options.claims);
+    d.claims = check_claims(path_fits, d.misfit, runners_up(d.rounds), options.claims);
     const int claimed = static_cast<int>(
         std::count_if(d.claims.begin(), d.claims.end(), [](const ClaimCheck& c) { return c.claimed; }));
     if (claimed > 0) {

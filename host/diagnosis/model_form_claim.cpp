@@ -53,6 +53,26 @@ EffectEstimate widened(const EffectEstimate& estimate, double factor) {
   return out;
 }
 
+std::vector<RunnerUp> runners_up(const std::vector<DiagnosisRound>& rounds) {
+  std::vector<RunnerUp> rivals;
+  for (std::size_t i = 0; i < rounds.size(); ++i) {
+    const DiagnosisRound& r = rounds[i];
+    if (r.chosen.empty()) continue;
+    RunnerUp rival;
+    const CandidateScore& chosen = r.candidates[0];
+    if (std::isnan(chosen.gain)) rival.ratio = NAN;   // the round's model stopped early
+    if (r.candidates.size() > 1 && r.candidates[1].complete && r.candidates[1].score > 0.0) {
+      rival.effect = r.candidates[1].effect;
+      if (!std::isnan(rival.ratio)) rival.ratio = r.candidates[1].score / chosen.score;
+      if (i + 1 < rounds.size())
+        for (const CandidateScore& c : rounds[i + 1].candidates)
+          if (c.effect == rival.effect && c.complete) rival.after = c.score;
+    }
+    rivals.push_back(rival);
+  }
+  return rivals;
+}
+
 std::vector<ClaimCheck> check_claims(const std::vector<const ModelFit*>& path, const MisfitShares& shares,
                                      const std::vector<RunnerUp>& runners_up, const ModelFormClaimOptions& options) {
   std::vector<ClaimCheck> checks;

@@ -52,6 +52,7 @@ namespace sigmafem {
 struct ModelFit;
 struct MisfitShares;
 struct EffectEstimate;
+struct DiagnosisRound;
 
 struct ModelFormClaimOptions {
   double min_share_of_remaining = 0.5;
@@ -91,6 +92,9 @@ struct RunnerUp {
   double ratio = 0.0;
   double after = NAN;
 };
+
+// The rival of each round's chosen effect (rounds that chose none are skipped).
+std::vector<RunnerUp> runners_up(const std::vector<DiagnosisRound>& rounds);
 
 // The checks along `path` (the declared model's fit first, then one per effect added; the
 // j-th effect is the last of path[j]'s estimates), with `shares` = misfit_shares(path) and
