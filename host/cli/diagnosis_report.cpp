@@ -28,8 +28,10 @@ std::string model_name(const ModelFit& fit) {
 }
 
 json estimate_json(const EffectEstimate& e) {
-  return {{"name", e.name}, {"parameters", e.parameters}, {"units", e.units}, {"value", e.value}, {"std", e.std},
-          {"first_order_std", e.first_order_std}, {"path_ratio", e.path_ratio}};
+  json j = {{"name", e.name}, {"parameters", e.parameters}, {"units", e.units}, {"value", e.value}, {"std", e.std},
+            {"first_order_std", e.first_order_std}, {"path_ratio", e.path_ratio}};
+  if (!e.model_spread.empty()) j["model_spread"] = e.model_spread;
+  return j;
 }
 
 // The failed tests of a fit, each with its one-line detail.

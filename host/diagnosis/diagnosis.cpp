@@ -398,7 +398,12 @@ Diagnosis diagnose(const Scenario& scenario, const ObservationTable& data,
       d.after_position = claimed;
       ModelFit& fit = d.fits[static_cast<std::size_t>(d.path[static_cast<std::size_t>(claimed)])];
       const double factor = d.claims[static_cast<std::size_t>(claimed - 1)].model_form_factor;
-      for (EffectEstimate& e : fit.estimates) e = widened(e, factor);
+      for (std::size_t j = 0; j < fit.estimates.size(); ++j) {
+        std::vector<EffectEstimate> later;
+        for (std::size_t m = static_cast<std::size_t>(claimed) + 1; m < d.path.size(); ++m)
+          later.push_back(d.fits[static_cast<std::size_t>(d.path[m])].estimates[j]);
+        fit.estimates[j] = widened(fit.estimates[j], factor, later);
+      }
       text << "The residual stays inconsistent, but ";
       for (int j = 0; j < claimed; ++j) {
         const EffectEstimate& e = fit.estimates[static_cast<std::size_t>(j)];
@@ -411,7 +416,11 @@ Diagnosis diagnose(const Scenario& scenario, const ObservationTable& data,
            << percent(left / d.misfit.declared_excess)
            << " remains, a model error outside the library (a geometry finer than the mesh, or an effect the "
               "library lacks). Claimed with each std widened "
-           << format(factor) << " times for the residual's dispersion and persistence.";
+           << format(factor) << " times for the residual's dispersion and persistence"
+           << (static_cast<std::size_t>(claimed) + 1 < d.path.size()
+                   ? " and combined with how far the estimate moved in the later fits"
+                   : "")
+           << '.';
       if (static_cast<std::size_t>(claimed) < d.claims.size()) {
         const ClaimCheck& next = d.claims[static_cast<std::size_t>(claimed)];
         text << " Not claimed: " << next.effect << " (" << next.reason << ")";

@@ -83,6 +83,9 @@ struct EffectEstimate {
   std::vector<double> std;
   std::vector<double> first_order_std;
   std::vector<double> path_ratio;
+  // Under `partly_explained` only (else empty): the model-form spread, the largest move of the
+  // estimate between the claimed fit and the later fits along the path (model_form_claim.h).
+  std::vector<double> model_spread;
 };
 
 // One filter run of the declared model plus `effects`.

@@ -46,10 +46,16 @@ double model_form_factor(const ResidualDiagnostics& residual) {
   return std::sqrt(dispersion * persistence);
 }
 
-EffectEstimate widened(const EffectEstimate& estimate, double factor) {
+EffectEstimate widened(const EffectEstimate& estimate, double factor, const std::vector<EffectEstimate>& later) {
   EffectEstimate out = estimate;
-  for (std::size_t i = 0; i < out.std.size(); ++i)
+  if (!later.empty()) out.model_spread.assign(out.value.size(), 0.0);
+  for (const EffectEstimate& e : later)
+    for (std::size_t i = 0; i < out.model_spread.size() && i < e.value.size(); ++i)
+      out.model_spread[i] = std::max(out.model_spread[i], std::fabs(e.value[i] - out.value[i]));
+  for (std::size_t i = 0; i < out.std.size(); ++i) {
     out.std[i] = out.first_order_std[i] * std::max({1.0, out.path_ratio[i], factor});
+    if (i < out.model_spread.size()) out.std[i] = std::hypot(out.std[i], out.model_spread[i]);
+  }
   return out;
 }
 

@@ -60,6 +60,22 @@ TEST(ModelFormClaim, FactorIsTheResidualsDispersionTimesItsPersistence) {
   const EffectEstimate w = widened(e, 2.0);
   EXPECT_DOUBLE_EQ(w.std[0], 3.0) << "the path ratio when larger";
   EXPECT_DOUBLE_EQ(w.std[1], 4.0) << "else the factor";
+  EXPECT_TRUE(w.model_spread.empty()) << "no later fit, no spread";
+
+  // The model-form spread: the largest move to a later fit, added in quadrature (box.json, truth
+  // from the refined mesh: tx 0.63 mm claimed, 1.88 mm once a modulus scale was beside it).
+  EffectEstimate offset;
+  offset.value = {0.63e-3};
+  offset.first_order_std = {1.266e-5};
+  offset.path_ratio = {19.96};
+  offset.std = {2.53e-4};
+  EffectEstimate later = offset, back = offset;
+  later.value = {1.88e-3};
+  back.value = {0.5e-3};
+  const EffectEstimate s = widened(offset, 1.18, {later, back});
+  ASSERT_EQ(s.model_spread.size(), 1u);
+  EXPECT_NEAR(s.model_spread[0], 1.25e-3, 1e-15);
+  EXPECT_NEAR(s.std[0], std::hypot(1.266e-5 * 19.96, 1.25e-3), 1e-15);
 }
 
 TEST(ModelFormClaim, AnEffectThatTookUpMostOfTheMisfitIsClaimedAndTheFirstRefusalEndsTheClaims) {
