@@ -221,6 +221,9 @@ TEST_F(CliTest, DiagnoseFindsAnInjectedEffectAndWritesItsReport) {
   EXPECT_EQ(report["misfit"]["removed"][0]["effect"], "camera_offset");
   EXPECT_GT(report["misfit"]["removed"][0]["share"].get<double>(), 0.9) << report["misfit"].dump();
   EXPECT_LT(std::abs(report["misfit"]["remaining_share"].get<double>()), 0.1) << report["misfit"].dump();
+  // A consistent residual needs no claim checks (they are for a residual that stays inconsistent).
+  ASSERT_TRUE(report["claim_checks"].is_array());
+  EXPECT_TRUE(report["claim_checks"].empty());
   // The scenario it writes declares the effect and loads.
   const CommandRun info = run_sigmafem("info " + (fs::path(out) / "scenario.json").string());
   EXPECT_EQ(info.exit_code, 0) << info.output;
