@@ -66,6 +66,7 @@ std::vector<RunnerUp> runners_up(const std::vector<DiagnosisRound>& rounds) {
     if (r.chosen.empty()) continue;
     RunnerUp rival;
     const CandidateScore& chosen = r.candidates[0];
+    rival.chosen_score = chosen.score;
     if (std::isnan(chosen.gain)) rival.ratio = NAN;   // the round's model stopped early
     if (r.candidates.size() > 1 && r.candidates[1].complete && r.candidates[1].score > 0.0) {
       rival.effect = r.candidates[1].effect;
@@ -98,6 +99,8 @@ std::vector<ClaimCheck> check_claims(const std::vector<const ModelFit*>& path, c
       check.runner_up = runners_up[j - 1].effect;
       check.runner_up_ratio = runners_up[j - 1].ratio;
       check.runner_up_after = runners_up[j - 1].after;
+      const double unique = runners_up[j - 1].chosen_score * (1.0 - check.runner_up_ratio) + check.runner_up_after;
+      if (unique > 0.0) check.runner_up_unique_ratio = check.runner_up_after / unique;
     }
     check.model_form_factor = model_form_factor(fit.residual);
     const EffectEstimate estimate = widened(raw, check.model_form_factor);
@@ -137,11 +140,14 @@ std::vector<ClaimCheck> check_claims(const std::vector<const ModelFit*>& path, c
                      "% of the misfit left before it";
     else if (std::isnan(check.runner_up_ratio))
       check.reason = "its round's model stopped early, so no rival was compared on fair ground";
-    else if (check.runner_up_ratio > options.max_runner_up_ratio && !(check.runner_up_after <= 0.0))
+    else if (check.runner_up_ratio > options.max_runner_up_ratio &&
+             !(check.runner_up_unique_ratio <= options.max_unique_ratio))
       check.reason = check.runner_up + " scored " + std::to_string(static_cast<int>(std::lround(100.0 * check.runner_up_ratio))) +
                      "% of its score" +
                      (std::isnan(check.runner_up_after) ? std::string(" and was not tried beside it")
-                                                        : " and still adds beside it") +
+                                                        : " and still adds beside it " +
+                                                              std::to_string(static_cast<int>(std::lround(100.0 * check.runner_up_unique_ratio))) +
+                                                              "% of what it adds") +
                      ": the data do not tell the two accounts apart";
     else if (!(check.distance > check.distance_bound))
       check.reason = "its estimate is within 3 std of the effect's absence";

@@ -151,13 +151,20 @@ TEST(ModelFormClaim, ARivalThatScoredNearlyAsMuchLeavesNothingClaimed) {
   EXPECT_EQ(checks[0].runner_up, "young_scale");
   EXPECT_NE(checks[0].reason.find("young_scale scored 96%"), std::string::npos) << checks[0].reason;
   EXPECT_NE(checks[0].reason.find("not tried beside it"), std::string::npos) << checks[0].reason;
-  // Tried beside it in the next round, the modulus still gained 350: two accounts.
-  checks = check_claims(path, misfit_shares(path), {{"young_scale", 0.96, 350.0}}, {});
+  // Tried beside it in the next round, the modulus still gained 350: in the model with both it
+  // adds 350 where the gravity adds 17111 - 16368 + 350 = 1093, 32% of it: two accounts.
+  checks = check_claims(path, misfit_shares(path), {{"young_scale", 16368.0 / 17111.0, 350.0, 17111.0}}, {});
   EXPECT_FALSE(checks[0].claimed);
-  EXPECT_NE(checks[0].reason.find("still adds beside it"), std::string::npos) << checks[0].reason;
+  EXPECT_NEAR(checks[0].runner_up_unique_ratio, 350.0 / 1093.0, 1e-12);
+  EXPECT_NE(checks[0].reason.find("still adds beside it 32%"), std::string::npos) << checks[0].reason;
+  // liver.json, truth from the refined mesh, a camera offset: gravity scored 65% of the offset
+  // and then 4520 beside it, 4.6% of what the offset adds: the offset is claimed.
+  checks = check_claims(path, misfit_shares(path), {{"gravity", 174219.0 / 267663.0, 4520.0, 267663.0}}, {});
+  EXPECT_NEAR(checks[0].runner_up_unique_ratio, 4520.0 / (267663.0 - 174219.0 + 4520.0), 1e-12);
+  EXPECT_TRUE(checks[0].claimed) << checks[0].reason;
   // A close rival that adds nothing once the chosen effect is in was the same account (box.json,
   // truth from the refined mesh, a camera offset: gravity scored 92% of the offset, then -259).
-  EXPECT_TRUE(check_claims(path, misfit_shares(path), {{"young_scale", 0.92, -259.0}}, {})[0].claimed);
+  EXPECT_TRUE(check_claims(path, misfit_shares(path), {{"young_scale", 0.92, -259.0, 192968.0}}, {})[0].claimed);
   // A rival at a third of the score does not stand in the way.
   EXPECT_TRUE(check_claims(path, misfit_shares(path), {{"young_scale", 0.33}}, {})[0].claimed);
   // With the round's model stopped early there is no fair comparison: nothing is claimed.
