@@ -27,7 +27,7 @@
 //   4. the data tell it apart from the stiffnesses: the squared multiple correlation of each of
 //      its coordinates with the log-stiffnesses in the final covariance is at most
 //      `max_stiffness_r2`; and a scale of Young's modulus did not bring the ligaments along by
-//      more than `max_scale_follow` of its own log (the mean change of their log-estimates
+//      more than `max_scale_follow` of its own log (the median change of their log-estimates
 //      from the fit before it). Without a known force the modulus and the ligaments scaled
 //      alike leave a quasi-static organ where it is, so a modulus scale that improves the fit
 //      does so along that blind direction (box.json, truth from the refined mesh: young_scale
@@ -84,7 +84,7 @@ struct ClaimCheck {
   double distance = 0.0;                // chi-square of the estimate from the effect's absence
   double distance_bound = 0.0;          // its 3-sigma quantile (k degrees of freedom)
   double stiffness_r2 = 0.0;            // the largest over the effect's coordinates
-  double scale_follow = NAN;            // young_scale: mean change of the ligaments' logs over its log
+  double scale_follow = NAN;            // young_scale: median change of the ligaments' logs over its log
   double model_form_factor = 1.0;       // F of the fit that added it
   bool claimed = false;
   std::string reason;                   // which check failed ("" when claimed)
