@@ -201,6 +201,20 @@ void expect_found(const EffectValue& effect, const std::vector<std::string>& can
   const double relative = std::sqrt(error2 / norm2);
   ::testing::Test::RecordProperty("effect_relative_error", std::to_string(relative));
   EXPECT_TRUE(relative <= 0.1 || within_std) << "estimate off by " << 100 * relative << "%: " << describe(d);
+  // Each number left its prior for the truth: nearer the injected value than the prior's
+  // median, in the coordinate the filter estimates (the log for a factor, a lag, a stiffness).
+  // Every injected value but a zero component of a vector (gravity's x below) lies away from
+  // its median, so an estimate that stayed at its prior (a widened std covers that too) fails.
+  const EffectDefinition& definition = *find_effect(effect.name);
+  for (std::size_t j = 0; j < effect.value.size(); ++j) {
+    const EffectParameter& parameter = definition.parameters[j];
+    auto coordinate = [&](double v) { return parameter.log ? std::log(v) : v; };
+    const double from_truth = std::abs(coordinate(e.value[j]) - coordinate(effect.value[j]));
+    if (coordinate(effect.value[j]) == parameter.prior_mean) continue;   // a zero component of a vector
+    const double from_median = std::abs(coordinate(e.value[j]) - parameter.prior_mean);
+    EXPECT_LT(from_truth, from_median) << parameter.name << " = " << e.value[j] << " +- " << e.std[j] << " for "
+                                       << effect.value[j] << ": it stayed near its prior: " << describe(d);
+  }
   ASSERT_TRUE(d.before().stiffness_error && d.after().stiffness_error);
   const double before = *d.before().stiffness_error, after = *d.after().stiffness_error;
   ::testing::Test::RecordProperty("stiffness_error_before", std::to_string(before));
@@ -235,9 +249,11 @@ TEST(DiagnoseBox, FindsAnExtraLigamentAtItsRegion) {
 TEST(DiagnoseBox, FindsATimeLag) { expect_found({"time_lag", {0.1}}); }
 
 TEST(DiagnoseBox, FindsADampingMismatch) {
-  // The mass coefficient is barely observable on this slow pull: its estimate keeps a wide
-  // std (measured 0.67 +- 0.65), and the check per number is within 3 std.
-  expect_found({"damping_scale", {1.0, 2.0}});
+  // Both factors away from their prior median of 1, in opposite directions. The mass
+  // coefficient is weakly observable on this slow pull: measured 2.63 +- 0.66 for 3 (the
+  // stiffness one 0.503 +- 0.003 for 0.5), so the vector is 12% off and the check per number
+  // is within 3 std; that it left its prior for the truth is checked above.
+  expect_found({"damping_scale", {3.0, 0.5}});
 }
 
 TEST(DiagnoseBox, CleanDataAddNothing) {
@@ -334,7 +350,7 @@ bool opencl_missing() { return list_opencl_devices().empty(); }
 
 TEST(DiagnoseLiverOnOpenCl, FindsAnExtraLigamentAmongTheSurfaceRegions) {
   if (opencl_missing()) GTEST_SKIP() << "no OpenCL platform on this machine";
-  expect_found({"extra_ligament:surface_5", {100.0}}, {}, "liver_diagnose", "opencl");
+  expect_found({"extra_ligament:surface_5", {250.0}}, {}, "liver_diagnose", "opencl");
 }
 
 TEST(DiagnoseLiverOnOpenCl, FindsATimeLag) {
