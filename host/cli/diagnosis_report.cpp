@@ -163,6 +163,7 @@ json write_diagnosis_report(const Scenario& scenario, const Diagnosis& d, const 
                       {"scale_follow", number(c.scale_follow)},
                       {"distance_from_absence", number(c.distance)},
                       {"distance_bound", number(c.distance_bound)},
+                      {"full_size_share", number(c.size)},
                       {"stiffness_r2", number(c.stiffness_r2)},
                       {"model_form_factor", number(c.model_form_factor)},
                       {"claimed", c.claimed},
@@ -264,21 +265,23 @@ json write_diagnosis_report(const Scenario& scenario, const Diagnosis& d, const 
        << fixed(100.0 * options.claims.max_runner_up_ratio, 0)
        << "% of its score unless, in the model with both, it added at most "
        << fixed(100.0 * options.claims.max_unique_ratio, 0) << "% of what the chosen effect adds; its estimate stands beyond the 3-sigma bound "
-          "from the effect's absence with its std widened by the model-form factor; and the data tell it apart from "
+          "from the effect's absence with its std widened by the model-form factor and is at least "
+       << fixed(100.0 * options.claims.min_size, 0) << "% of the effect's full-size scale (its prior's spread); and the data tell it apart from "
           "the stiffnesses (squared multiple correlation at most "
        << fixed(options.claims.max_stiffness_r2, 2) << "; a modulus scale that brought the ligaments' logs along by more than "
        << fixed(100.0 * options.claims.max_scale_follow, 0)
        << "% of its own is not). The first that fails ends the claims (host/diagnosis/model_form_claim.h).\n\n"
        << "| effect | share of the misfit | of what was left | runner-up (score ratio; score beside it, over the chosen one's unique part) "
-          "| distance from absence (bound) | r^2 with the stiffnesses | model-form factor | claimed |\n"
-          "|---|---|---|---|---|---|---|---|\n";
+          "| distance from absence (bound) | size on the full-size scale | r^2 with the stiffnesses | model-form factor | claimed |\n"
+          "|---|---|---|---|---|---|---|---|---|\n";
     for (const ClaimCheck& c : d.claims)
       md << "| " << c.effect << " | " << fixed(100.0 * c.share_of_declared, 1) << "% | "
          << fixed(100.0 * c.share_of_remaining, 1) << "% | "
          << (c.runner_up.empty() ? std::string("none")
                                  : c.runner_up + " (" + fixed(c.runner_up_ratio, 2) + "; " + fixed(c.runner_up_after, 1) + ", " +
                                        fixed(c.runner_up_unique_ratio, 3) + ")")
-         << " | " << fixed(c.distance, 1) << " (" << fixed(c.distance_bound, 1) << ") | " << fixed(c.stiffness_r2, 3)
+         << " | " << fixed(c.distance, 1) << " (" << fixed(c.distance_bound, 1) << ") | " << fixed(c.size, 2) << " | "
+         << fixed(c.stiffness_r2, 3)
          << (std::isnan(c.scale_follow) ? std::string() : ", ligaments followed " + fixed(c.scale_follow, 2)) << " | "
          << fixed(c.model_form_factor, 2) << " | " << (c.claimed ? std::string("yes") : "no: " + c.reason) << " |\n";
     md << "\n";

@@ -23,6 +23,18 @@ double distance_from_absence(const EffectParameter& parameter, double value, dou
   return value / std;
 }
 
+// How large `value` of `parameter` is on the effect's full-size scale: its distance from the
+// effect's absence in units of the prior's std (gravity 5 m/s^2, an offset 5 mm; the log of a
+// factor); for a quantity that is absent at 0 or at infinity on a log scale (a lag, an extra
+// ligament's stiffness, d0), its ratio to (or from) the prior's median.
+double full_size_share(const EffectParameter& parameter, double value) {
+  if (!parameter.log) return std::fabs(value - parameter.absent) / parameter.prior_std;
+  if (parameter.absent > 0.0 && std::isfinite(parameter.absent))
+    return std::fabs(std::log(value / parameter.absent)) / parameter.prior_std;
+  const double median = std::exp(parameter.prior_mean);
+  return parameter.absent == 0.0 ? value / median : median / value;
+}
+
 // 1 - var(x_i | the stiffnesses) / var(x_i) for coordinate i of the covariance C whose first
 // `stiffnesses` coordinates are the log-stiffnesses (a held, cut ligament has no variance: the
 // pseudo-inverse leaves it out).
@@ -112,6 +124,10 @@ std::vector<ClaimCheck> check_claims(const std::vector<const ModelFit*>& path, c
       check.distance += z * z;
     }
     check.distance_bound = chi_square_tail_quantile(options.significance_tail, k);
+    for (int i = 0; i < k; ++i)
+      check.size += std::pow(full_size_share(definition.parameters[static_cast<std::size_t>(i)],
+                                             estimate.value[static_cast<std::size_t>(i)]), 2);
+    check.size = std::sqrt(check.size);
     const Eigen::MatrixXd& C = fit.run.final_theta_covariance;
     const int stiffnesses = static_cast<int>(fit.ligaments.size());
     const int first = static_cast<int>(C.rows()) - k;
@@ -155,6 +171,9 @@ std::vector<ClaimCheck> check_claims(const std::vector<const ModelFit*>& path, c
                      ": the data do not tell the two accounts apart";
     else if (!(check.distance > check.distance_bound))
       check.reason = "its estimate is within 3 std of the effect's absence";
+    else if (!(check.size >= options.min_size))
+      check.reason = "it is smaller than " + std::to_string(static_cast<int>(std::lround(100.0 * options.min_size))) +
+                     "% of the effect's full-size scale (its prior's spread)";
     else if (check.stiffness_r2 > options.max_stiffness_r2)
       check.reason = "the data do not tell it apart from the stiffnesses";
     else if (check.scale_follow > options.max_scale_follow)

@@ -1,5 +1,5 @@
 // Claims under a model-form floor (host/diagnosis/model_form_claim.h) on synthetic fits: each of
-// the three checks can refuse a claim, the first refusal ends the claims, and the stated std is
+// the checks can refuse a claim, the first refusal ends the claims, and the stated std is
 // widened by the model-form factor.
 #include <gtest/gtest.h>
 
@@ -135,6 +135,34 @@ TEST(ModelFormClaim, ASliverOfTheMisfitOrAnEstimateNearTheEffectsAbsenceIsNotCla
   const ModelFit lag_alone = synthetic_fit(36.0, {"time_lag"}, {0.1}, {0.02});
   path = {&declared, &lag_alone};
   EXPECT_NEAR(check_claims(path, misfit_shares(path), {}, {})[0].distance, 25.0, 1e-9);
+  EXPECT_TRUE(check_claims(path, misfit_shares(path), {}, {})[0].claimed);
+}
+
+TEST(ModelFormClaim, AnEffectFarSmallerThanItsFullSizeScaleIsNotClaimed) {
+  // box_diagnose, the truth from the refined mesh with the springs spread over it, nothing
+  // injected: a gravity of 0.16 m/s^2 took up 52.6% of the misfit, 15 std from zero. Its size
+  // is 0.032 of gravity's full-size scale (the prior's 5 m/s^2).
+  const ModelFit declared = synthetic_fit(136.0);
+  const ModelFit tilt = synthetic_fit(83.4, {"gravity"}, {0.146, 0.070, 0.0}, {0.0095, 0.0064, 0.0079});
+  std::vector<const ModelFit*> path = {&declared, &tilt};
+  std::vector<ClaimCheck> checks = check_claims(path, misfit_shares(path), {}, {});
+  ASSERT_EQ(checks.size(), 1u);
+  EXPECT_NEAR(checks[0].size, std::hypot(0.146, 0.070) / 5.0, 1e-12);
+  EXPECT_GT(checks[0].distance, checks[0].distance_bound) << "far from zero in its own std";
+  EXPECT_FALSE(checks[0].claimed);
+  EXPECT_NE(checks[0].reason.find("full-size scale"), std::string::npos) << checks[0].reason;
+  // A full-size gravity in the same fit is claimed.
+  const ModelFit full = synthetic_fit(83.4, {"gravity"}, {4.0, -8.0, 4.0}, {0.0095, 0.0064, 0.0079});
+  path = {&declared, &full};
+  EXPECT_TRUE(check_claims(path, misfit_shares(path), {}, {})[0].claimed);
+  // A lag is measured against its prior median (50 ms): 4 ms is 0.08 of it, 30 ms 0.6.
+  const ModelFit short_lag = synthetic_fit(36.0, {"time_lag"}, {0.004}, {1e-4});
+  const ModelFit lag = synthetic_fit(36.0, {"time_lag"}, {0.03}, {1e-3});
+  path = {&declared, &short_lag};
+  checks = check_claims(path, misfit_shares(path), {}, {});
+  EXPECT_NEAR(checks[0].size, 0.08, 1e-12);
+  EXPECT_FALSE(checks[0].claimed);
+  path = {&declared, &lag};
   EXPECT_TRUE(check_claims(path, misfit_shares(path), {}, {})[0].claimed);
 }
 
