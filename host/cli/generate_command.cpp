@@ -22,6 +22,7 @@ Action add_generate_command(CLI::App& app) {
     std::vector<std::string> inject;
     int truth_refine = 0;
     std::string truth_mesh;
+    std::string truth_springs = "spread";
   };
   auto options = std::make_shared<Options>();
   CLI::App* sub = app.add_subcommand(
@@ -50,6 +51,13 @@ Action add_generate_command(CLI::App& app) {
                   "the same node sets: the data then carry a discretisation error the model lacks. "
                   "Observed positions are read at the observed nodes. Recorded in truth.json")
       ->type_name("N");
+  sub->add_option("--truth-springs", options->truth_springs,
+                  "With --truth-refine: spread each spring (ligaments, the SO's grip) over the refined "
+                  "nodes of the attachment its coarse nodes stand for (spread, the default: the same "
+                  "attachment at every level), or keep it on the same nodes (nodes: a point load, softer "
+                  "with every level)")
+      ->check(CLI::IsMember({"spread", "nodes"}))
+      ->type_name("spread|nodes");
   sub->add_option("--truth-mesh", options->truth_mesh,
                   "Simulate the truth on another mesh FILE of the organ (scaled and translated as "
                   "the scenario's mesh; selections made again on it, listed nodes matched by "
@@ -62,6 +70,10 @@ Action add_generate_command(CLI::App& app) {
     // Given or not, whatever the value: --truth-refine 0 is an error, not "off".
     if (sub->count("--truth-refine") > 0) options->generate.truth_mesh.refine = options->truth_refine;
     if (sub->count("--truth-mesh") > 0) options->generate.truth_mesh.file = options->truth_mesh;
+    if (sub->count("--truth-springs") > 0 && sub->count("--truth-refine") == 0)
+      throw InputError("--truth-springs " + options->truth_springs + ": only with --truth-refine (on --truth-mesh the "
+                       "node sets are selected again on the other mesh)");
+    options->generate.truth_mesh.spread_springs = options->truth_springs == "spread";
     Scenario scenario = load_scenario(options->scenario);
     for (const std::string& text : options->inject) {
       options->generate.inject.push_back(parse_effect_assignment(text, "--inject"));

@@ -4,6 +4,7 @@
 #include <cmath>
 #include <stdexcept>
 
+#include "host/common/input_error.h"
 #include "step_constants.h"
 
 namespace sigmafem {
@@ -26,6 +27,13 @@ void check_ensemble_arguments(const Model& model, const std::vector<int>& estima
   for (int node : observed)
     if (node < 0 || node >= model.node_count())
       throw std::invalid_argument(name + ": no node " + std::to_string(node));
+  // The kernels give every node of a ligament the same part of its stiffness (one number per
+  // ligament and sigma point); the control's parts are per node and need no check.
+  for (const SpringSet& ligament : model.ligaments)
+    if (!ligament.shares.empty())
+      throw InputError(name + ": ligament " + ligament.name +
+                       " gives its nodes unequal parts of its stiffness (generate --truth-refine spreads each "
+                       "spring over the refined mesh), which the device back ends do not hold: use --backend cpu");
 }
 
 EnsembleTables make_ensemble_tables(const Model& model, int S) {
@@ -66,8 +74,8 @@ EnsembleTables make_ensemble_tables(const Model& model, int S) {
     for (int s = 0; s < S; ++s) t.ligament_k[static_cast<std::size_t>(l) * S + s] = per_node;
   }
   t.control_k.assign(nodes, 0.0);
-  for (int node : model.control.nodes)
-    t.control_k[node] += model.control.stiffness / static_cast<double>(model.control.nodes.size());
+  for (std::size_t j = 0; j < model.control.nodes.size(); ++j)
+    t.control_k[model.control.nodes[j]] += model.control.node_part(j, model.control.stiffness);
   t.mass.assign(model.mass.data(), model.mass.data() + nodes);
   t.rest_positions.resize(3 * static_cast<std::size_t>(nodes));
   for (int n = 0; n < nodes; ++n)

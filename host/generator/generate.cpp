@@ -33,6 +33,7 @@ nlohmann::ordered_json truth_mesh_json(const TruthMesh& truth, const TruthMeshOp
     j["file"] = *options.file;
   } else {
     j["refine"] = options.refine.value_or(0);   // levels beyond the scenario's mesh
+    if (options.refine) j["springs"] = options.spread_springs ? "spread" : "nodes";
   }
   j["nodes"] = truth.scenario.mesh.node_count();
   j["tetrahedra"] = truth.scenario.mesh.tetrahedron_count();
@@ -47,11 +48,15 @@ GenerateResult generate(const Scenario& scenario, const GenerateOptions& options
   const auto start = std::chrono::steady_clock::now();
   // Before the output folder: bad truth mesh options leave nothing behind.
   const TruthMesh truth_mesh = make_truth_mesh(scenario, options.truth_mesh);
+  if (!truth_mesh.ligament_spread.empty() && options.backend != "cpu")
+    throw InputError("--truth-refine with --backend " + options.backend +
+                     ": the springs spread over the refined mesh give each node its own part of a ligament, which the "
+                     "device back ends do not hold; use --backend cpu, or --truth-springs nodes");
   std::error_code error;
   fs::create_directories(options.out_dir, error);
   if (error) throw InputError(options.out_dir + ": cannot create output folder: " + error.message());
 
-  Model truth_model = make_model(truth_mesh.scenario);   // declared effects included
+  Model truth_model = truth_mesh.model();   // declared effects included
   apply_effects(options.inject, truth_model);
   // What a camera adds to every observed position: declared and injected registration errors.
   const Eigen::Vector3d offset = camera_offset(scenario.effects) + camera_offset(options.inject);

@@ -31,6 +31,9 @@ namespace sigmafem {
 struct TruthMeshOptions {
   std::optional<int> refine;        // --truth-refine: the scenario's mesh refined 1..3 more levels
   std::optional<std::string> file;  // --truth-mesh: another mesh file of the organ (mesh.file units)
+  // --truth-springs: with refine, spread each spring over the refined nodes of the attachment
+  // its coarse nodes stand for (host/generator/spring_spread.h), or keep it on the same nodes.
+  bool spread_springs = true;
 };
 
 struct GenerateOptions {

@@ -40,7 +40,26 @@ double bounding_diagonal(const Mesh& mesh) {
   return (high - low).norm();
 }
 
+// Puts `spread` (nodes and parts) into `set`; nothing when it is empty.
+void apply_spread(const std::vector<SpringShare>& spread, SpringSet& set) {
+  if (spread.empty()) return;
+  set.nodes.clear();
+  set.shares.clear();
+  for (const SpringShare& s : spread) {
+    set.nodes.push_back(s.node);
+    set.shares.push_back(s.share);
+  }
+}
+
 }  // namespace
+
+Model TruthMesh::model() const {
+  Model model = make_model(scenario);
+  for (std::size_t l = 0; l < ligament_spread.size(); ++l) apply_spread(ligament_spread[l], model.ligaments[l]);
+  for (std::size_t r = 0; r < region_spread.size(); ++r) apply_spread(region_spread[r], model.candidate_regions[r]);
+  apply_spread(control_spread, model.control);
+  return model;
+}
 
 Eigen::Vector3d TruthMesh::observed_position(std::size_t p, const Eigen::VectorXd& x) const {
   if (observed.empty()) return x.segment<3>(3 * observed_nodes[p]);
@@ -82,6 +101,15 @@ TruthMesh make_truth_mesh(const Scenario& scenario, const TruthMeshOptions& opti
         truth.scenario.mesh = refine_uniform(truth.scenario.mesh);
       orient_and_check(truth.scenario.mesh, "--truth-refine " + std::to_string(*options.refine));
       truth.description = "the scenario's mesh refined " + levels(*options.refine);
+      if (options.spread_springs) {
+        const Mesh& fine = truth.scenario.mesh;
+        for (const Ligament& ligament : scenario.ligaments)
+          truth.ligament_spread.push_back(spread_spring(scenario.mesh, ligament.nodes, fine));
+        for (const Ligament& region : scenario.candidate_regions)
+          truth.region_spread.push_back(spread_spring(scenario.mesh, region.nodes, fine));
+        if (!scenario.control.nodes.empty()) truth.control_spread = spread_spring(scenario.mesh, scenario.control.nodes, fine);
+        truth.description += ", the springs spread over it";
+      }
     } else {
       truth.description = "the scenario's mesh";
     }

@@ -4,11 +4,14 @@
 // always has (issue 13):
 //   --truth-refine N   the scenario's mesh refined N more levels (refine_uniform: its nodes keep
 //                      their indices, so every node set, ligaments, control, candidate regions,
-//                      observed nodes, keeps its indices: the same springs at the same material
-//                      points, only the discretisation differs). Selections are NOT made again
-//                      on the refined mesh: a "near" selection would catch more nodes there, with
-//                      another centroid (on the liver the SO's would move 7.3 mm, see
-//                      scenarios/liver_fine.json).
+//                      observed nodes, keeps its indices). Each spring is spread over the
+//                      refined nodes of the attachment its coarse nodes stand for
+//                      (host/generator/spring_spread.h: the same attachment at every level, so
+//                      the truth converges), or with --truth-springs nodes kept on the same
+//                      nodes (a point load, which grows softer with every level). Selections
+//                      are NOT made again on the refined mesh: a "near" selection would catch
+//                      more nodes there, with another centroid (on the liver the SO's would
+//                      move 7.3 mm, see scenarios/liver_fine.json).
 //   --truth-mesh FILE  another mesh file, transformed, oriented and checked like the scenario's
 //                      mesh (mesh.scale, mesh.translate; not mesh.refine), with the node sets
 //                      resolved again on it (host/scenario/scenario_on_mesh.h).
@@ -21,7 +24,9 @@
 #include <vector>
 
 #include "host/generator/generate.h"
+#include "host/generator/spring_spread.h"
 #include "host/mesh/mesh_locate.h"
+#include "host/model/model.h"
 #include "host/scenario/scenario.h"
 
 namespace sigmafem {
@@ -40,6 +45,13 @@ struct TruthMesh {
   std::vector<MeshLocation> observed;
   double max_outside_distance = 0.0;    // m, the farthest observed point outside the truth mesh
   std::string description;              // "the scenario's mesh", "the scenario's mesh refined 1 more level", "FILE"
+  // With --truth-refine and spread springs: each ligament's, the control's and each candidate
+  // region's nodes and parts on the refined mesh (empty: the scenario's node sets as they are).
+  std::vector<std::vector<SpringShare>> ligament_spread, region_spread;
+  std::vector<SpringShare> control_spread;
+
+  // The truth's model: make_model(scenario) with the springs spread as above.
+  Model model() const;
 
   // Observed point p at the truth positions x (3 per truth node).
   Eigen::Vector3d observed_position(std::size_t p, const Eigen::VectorXd& x) const;

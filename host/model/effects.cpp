@@ -49,7 +49,7 @@ int add_extra_ligament(Model& model, const std::string& effect_name, double stif
   std::string names;
   for (const SpringSet& candidate : model.candidate_regions) {
     if (candidate.name == region) {
-      model.ligaments.push_back({effect_name, candidate.nodes, stiffness});
+      model.ligaments.push_back({effect_name, candidate.nodes, stiffness, candidate.shares});
       return static_cast<int>(model.ligaments.size()) - 1;
     }
     names += (names.empty() ? "" : ", ") + candidate.name;

@@ -102,10 +102,10 @@ Model make_model(const Scenario& scenario) {
   model.dt = scenario.time.dt;
   model.solver = scenario.solver;
   for (const Ligament& ligament : scenario.ligaments)
-    model.ligaments.push_back({ligament.name, ligament.nodes, ligament.stiffness});
+    model.ligaments.push_back({ligament.name, ligament.nodes, ligament.stiffness, {}});
   for (const Ligament& region : scenario.candidate_regions)
-    model.candidate_regions.push_back({region.name, region.nodes, 0.0});
-  model.control = {"control", scenario.control.nodes, scenario.control.stiffness};
+    model.candidate_regions.push_back({region.name, region.nodes, 0.0, {}});
+  model.control = {"control", scenario.control.nodes, scenario.control.stiffness, {}};
   model.control_start = scenario.control.start;
   // Effects the scenario declares part of the model (the observation-side ones act on the
   // data instead: the estimation subtracts a declared camera offset).

@@ -26,11 +26,18 @@ struct ElementRest {
   double vmu = 0.0;                     // volume * Lame mu (shear modulus), N m
 };
 
-// A set of nodes held by one spring law: each node gets stiffness / nodes.size().
+// A set of nodes held by one spring law: each node gets an equal part of the total stiffness
+// unless `shares` says otherwise (generate --truth-refine spreads a spring over a refined
+// mesh: host/generator/spring_spread.h).
 struct SpringSet {
   std::string name;
   std::vector<int> nodes;
   double stiffness = 0.0;               // N/m, total over the nodes
+  std::vector<double> shares;           // per node, in `nodes` order, summing to 1; empty: equal
+  // Node k's part of a total `total` (the set's stiffness, or a sigma point's estimate of it).
+  double node_part(std::size_t k, double total) const {
+    return shares.empty() ? total / static_cast<double>(nodes.size()) : total * shares[k];
+  }
 };
 
 struct Model {

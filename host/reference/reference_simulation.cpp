@@ -60,11 +60,12 @@ void ReferenceSimulation::set_state(const Eigen::VectorXd& positions,
 Eigen::VectorXd ReferenceSimulation::spring_stiffness() const {
   Eigen::VectorXd k = Eigen::VectorXd::Zero(model_.node_count());
   for (std::size_t l = 0; l < model_.ligaments.size(); ++l) {
-    const auto& nodes = model_.ligaments[l].nodes;
-    for (int node : nodes) k[node] += ligament_stiffness_[l] / static_cast<double>(nodes.size());
+    const SpringSet& ligament = model_.ligaments[l];
+    for (std::size_t j = 0; j < ligament.nodes.size(); ++j)
+      k[ligament.nodes[j]] += ligament.node_part(j, ligament_stiffness_[l]);
   }
-  const auto& control = model_.control.nodes;
-  for (int node : control) k[node] += model_.control.stiffness / static_cast<double>(control.size());
+  const SpringSet& control = model_.control;
+  for (std::size_t j = 0; j < control.nodes.size(); ++j) k[control.nodes[j]] += control.node_part(j, control.stiffness);
   return k;
 }
 
@@ -74,22 +75,22 @@ Eigen::VectorXd ReferenceSimulation::forces(const Eigen::VectorXd& x,
   Eigen::VectorXd f = Eigen::VectorXd::Zero(x.size());
   add_element_forces(model_, frames, x, f);
   for (std::size_t l = 0; l < model_.ligaments.size(); ++l) {
-    const auto& nodes = model_.ligaments[l].nodes;
-    const double k = ligament_stiffness_[l] / static_cast<double>(nodes.size());
-    for (int node : nodes) {
+    const SpringSet& ligament = model_.ligaments[l];
+    for (std::size_t j = 0; j < ligament.nodes.size(); ++j) {
+      const int node = ligament.nodes[j];
+      const double k = ligament.node_part(j, ligament_stiffness_[l]);
       const Eigen::Vector3d u = x.segment<3>(3 * node) - model_.rest_positions[node];
       // The ligament law: k u (1 + |u|^2/d0^2); 1/d0^2 = 0 for the linear law (infinite d0).
       const double inverse_d0_squared = 1.0 / (model_.ligament_d0 * model_.ligament_d0);
       f.segment<3>(3 * node) -= k * (1.0 + u.squaredNorm() * inverse_d0_squared) * u;
     }
   }
-  const auto& control = model_.control.nodes;
-  if (!control.empty()) {
-    const double k = model_.control.stiffness / static_cast<double>(control.size());
-    const Eigen::Vector3d shift = so_position - model_.control_start;
-    for (int node : control)
-      f.segment<3>(3 * node) -=
-          k * (x.segment<3>(3 * node) - (model_.rest_positions[node] + shift));
+  const SpringSet& control = model_.control;
+  const Eigen::Vector3d shift = so_position - model_.control_start;
+  for (std::size_t j = 0; j < control.nodes.size(); ++j) {
+    const int node = control.nodes[j];
+    f.segment<3>(3 * node) -=
+        control.node_part(j, control.stiffness) * (x.segment<3>(3 * node) - (model_.rest_positions[node] + shift));
   }
   if (!model_.gravity.isZero()) {
     for (int i = 0; i < model_.node_count(); ++i)

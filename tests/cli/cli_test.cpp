@@ -171,7 +171,14 @@ TEST_F(CliTest, GenerateSimulatesTheTruthOnARefinedMesh) {
   EXPECT_NE(run.output.find("truth simulated on the scenario's mesh refined 1 more level"), std::string::npos)
       << "the summary says which mesh the truth ran on: " << run.output;
   std::ifstream truth_file(dir_ / "out" / "truth.json");
-  EXPECT_EQ(json::parse(truth_file)["truth_mesh"]["refine"], 1);
+  const json record = json::parse(truth_file)["truth_mesh"];
+  EXPECT_EQ(record["refine"], 1);
+  EXPECT_EQ(record["springs"], "spread") << "the springs spread over the refined mesh by default";
+  fs::remove_all(dir_ / "out");
+  const CommandRun nodes = generate_five_steps(" --truth-refine 1 --truth-springs nodes");
+  ASSERT_EQ(nodes.exit_code, 0) << nodes.output;
+  std::ifstream nodes_file(dir_ / "out" / "truth.json");
+  EXPECT_EQ(json::parse(nodes_file)["truth_mesh"]["springs"], "nodes");
 }
 
 // Bad truth mesh options: exit 2, a message naming `option`, no output folder.
@@ -190,6 +197,9 @@ TEST_F(CliTest, RejectsInvalidTruthMeshOptions) {
   expect_rejected_options("--truth-refine 0", {"--truth-refine 0"});
   expect_rejected_options("--truth-refine 4", {"--truth-refine 4"});
   expect_rejected_options("--truth-mesh " + (dir_ / "absent.msh").string(), {"--truth-mesh", "absent.msh"});
+  expect_rejected_options("--truth-springs nodes", {"--truth-springs", "--truth-refine"});
+  expect_rejected_options("--truth-refine 1 --truth-springs everywhere", {"--truth-springs"});
+  expect_rejected_options("--truth-refine 1 --backend opencl", {"--truth-refine", "--backend cpu"});
 }
 
 TEST_F(CliTest, DiagnoseFindsAnInjectedEffectAndWritesItsReport) {

@@ -287,7 +287,8 @@ TEST(DiagnoseBox, AStiffInclusionStaysUnexplained) {
 }
 
 // A truth simulated on the box refined once (8 times the tetrahedra; the observed points at
-// the same material points): the data carry a model-form error no effect of the library
+// the same material points, the springs spread over the refined nodes of their attachments,
+// host/generator/spring_spread.h): the data carry a model-form error no effect of the library
 // removes, so the residual never turns consistent (host/diagnosis/model_form_claim.h). One
 // round with three candidates, to keep each case near 25 s: the claims are decided on the
 // first effect.
@@ -311,13 +312,12 @@ TEST(DiagnoseBox, ATruthFromTheRefinedMeshWithAFullGravityClaimsTheGravityAlone)
   std::cout << "refined truth, gravity: found " << found.transpose() << " (" << degrees << " degrees off, |g| "
             << found.norm() << "), stiffness error " << *d.before().stiffness_error << " -> "
             << *d.after().stiffness_error << " N/m\n";
-  // The direction is found (measured 4.4 degrees). The size is not to 10%: measured |g| 13.0
-  // m/s^2 for 9.81, because the refined box sags more under gravity than the coarse model
-  // (as the clean data below show, an extra gravity takes that up), and the widened std does
-  // not cover that bias (model_form_claim.h: a bias constant over the run cannot show in the
-  // residual's dispersion). The bound says what is claimed: the right effect, within 50%.
-  EXPECT_LT(degrees, 10.0) << describe(d);
-  EXPECT_LT(std::abs(found.norm() / truth.norm() - 1.0), 0.5) << describe(d);
+  // Within 10% as a vector (measured (4.21, -8.26, 3.95): 3.4%, 1.1 degrees, |g| 2.7% high,
+  // the refined box sagging a little more than the coarse model). With the springs kept on the
+  // coarse nodes (--truth-springs nodes: point loads that the refined mesh makes softer, and
+  // softer again at each level) |g| came out at 13.0 m/s^2, 33% high.
+  EXPECT_LT((found - truth).norm(), 0.1 * truth.norm()) << describe(d);
+  EXPECT_LT(degrees, 5.0) << describe(d);
   ASSERT_TRUE(d.before().stiffness_error && d.after().stiffness_error);
   EXPECT_GE(*d.before().stiffness_error, 5.0 * *d.after().stiffness_error) << describe(d);
   // The report says what remains.
@@ -326,10 +326,12 @@ TEST(DiagnoseBox, ATruthFromTheRefinedMeshWithAFullGravityClaimsTheGravityAlone)
 }
 
 TEST(DiagnoseBox, ATruthFromTheRefinedMeshClaimsNoWrongEffect) {
-  // Clean, and with an undeclared 3.9 mm camera offset: on the refined box an extra gravity
-  // along the declared one and a softer modulus both take up the larger sag (scores 17111 and
-  // 16368 with the clean data), and with the offset a gravity scores above the offset (33612
-  // against 22475). Whatever the data cannot tell apart is not claimed.
+  // Clean, and with an undeclared 3.9 mm camera offset. Clean, a gravity of 0.16 m/s^2 takes up
+  // 52.6% of the refined mesh's misfit, far from zero in its own std but a small part of a
+  // gravity's full size, so it is not claimed; with the offset a gravity scores 90% of the
+  // offset's score and is not tried beside it (one round). Whatever the data cannot tell apart
+  // is not claimed. (With --truth-springs nodes a gravity along the declared one and a softer
+  // modulus took up the point loads' larger sag, scores 17111 and 16368.)
   for (const std::vector<EffectValue>& inject :
        {std::vector<EffectValue>{}, std::vector<EffectValue>{{"camera_offset", {3e-3, -2e-3, 1.5e-3}}}}) {
     const Diagnosis d = diagnose_refined_truth(inject);

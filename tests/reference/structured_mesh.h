@@ -197,8 +197,8 @@ inline HeldBox held_box() {
   model.damping = Damping{0.01, 0.5};
   model.gravity = Eigen::Vector3d(0.0, 0.0, -9.81);
   model.dt = 0.01;
-  SpringSet ligament{"x0_face", {}, 100.0};
-  SpringSet control{"control", {}, 50.0};
+  SpringSet ligament{"x0_face", {}, 100.0, {}};
+  SpringSet control{"control", {}, 50.0, {}};
   Eigen::Vector3d centroid = Eigen::Vector3d::Zero();
   for (int n = 0; n < held.box.mesh.node_count(); ++n) {
     if (held.box.on_face(n, 0, 0)) ligament.nodes.push_back(n);
