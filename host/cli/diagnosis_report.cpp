@@ -165,7 +165,6 @@ json write_diagnosis_report(const Scenario& scenario, const Diagnosis& d, const 
                       {"distance_bound", number(c.distance_bound)},
                       {"full_size_share", number(c.size)},
                       {"stiffness_r2", number(c.stiffness_r2)},
-                      {"model_form_factor", number(c.model_form_factor)},
                       {"claimed", c.claimed},
                       {"reason", c.reason}});
   j["claim_checks"] = claims;
@@ -265,15 +264,16 @@ json write_diagnosis_report(const Scenario& scenario, const Diagnosis& d, const 
        << fixed(100.0 * options.claims.max_runner_up_ratio, 0)
        << "% of its score unless, in the model with both, it added at most "
        << fixed(100.0 * options.claims.max_unique_ratio, 0) << "% of what the chosen effect adds; its estimate stands beyond the 3-sigma bound "
-          "from the effect's absence with its std widened by the model-form factor and is at least "
+          "from the effect's absence in its stated std and is at least "
        << fixed(100.0 * options.claims.min_size, 0) << "% of the effect's full-size scale (its prior's spread); and the data tell it apart from "
           "the stiffnesses (squared multiple correlation at most "
        << fixed(options.claims.max_stiffness_r2, 2) << "; a modulus scale that brought the ligaments' logs along by more than "
        << fixed(100.0 * options.claims.max_scale_follow, 0)
-       << "% of its own is not). The first that fails ends the claims (host/diagnosis/model_form_claim.h).\n\n"
+       << "% of its own is not). The first that fails ends the claims (host/diagnosis/model_form_claim.h). A claimed "
+          "value's std includes how far it moved in the later fits, not the bias the model error gives every fit alike.\n\n"
        << "| effect | share of the misfit | of what was left | runner-up (score ratio; score beside it, over the chosen one's unique part) "
-          "| distance from absence (bound) | size on the full-size scale | r^2 with the stiffnesses | model-form factor | claimed |\n"
-          "|---|---|---|---|---|---|---|---|---|\n";
+          "| distance from absence (bound) | size on the full-size scale | r^2 with the stiffnesses | claimed |\n"
+          "|---|---|---|---|---|---|---|---|\n";
     for (const ClaimCheck& c : d.claims)
       md << "| " << c.effect << " | " << fixed(100.0 * c.share_of_declared, 1) << "% | "
          << fixed(100.0 * c.share_of_remaining, 1) << "% | "
@@ -283,7 +283,7 @@ json write_diagnosis_report(const Scenario& scenario, const Diagnosis& d, const 
          << " | " << fixed(c.distance, 1) << " (" << fixed(c.distance_bound, 1) << ") | " << fixed(c.size, 2) << " | "
          << fixed(c.stiffness_r2, 3)
          << (std::isnan(c.scale_follow) ? std::string() : ", ligaments followed " + fixed(c.scale_follow, 2)) << " | "
-         << fixed(c.model_form_factor, 2) << " | " << (c.claimed ? std::string("yes") : "no: " + c.reason) << " |\n";
+         << (c.claimed ? std::string("yes") : "no: " + c.reason) << " |\n";
     md << "\n";
   }
   md << "## Rounds\n\nScore = log-likelihood gain of the innovations over every step with the candidate's "

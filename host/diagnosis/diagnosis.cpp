@@ -397,12 +397,11 @@ Diagnosis diagnose(const Scenario& scenario, const ObservationTable& data,
       d.outcome = DiagnosisOutcome::partly_explained;
       d.after_position = claimed;
       ModelFit& fit = d.fits[static_cast<std::size_t>(d.path[static_cast<std::size_t>(claimed)])];
-      const double factor = d.claims[static_cast<std::size_t>(claimed - 1)].model_form_factor;
       for (std::size_t j = 0; j < fit.estimates.size(); ++j) {
         std::vector<EffectEstimate> later;
         for (std::size_t m = static_cast<std::size_t>(claimed) + 1; m < d.path.size(); ++m)
           later.push_back(d.fits[static_cast<std::size_t>(d.path[m])].estimates[j]);
-        fit.estimates[j] = widened(fit.estimates[j], factor, later);
+        fit.estimates[j] = widened(fit.estimates[j], later);
       }
       text << "The residual stays inconsistent, but ";
       for (int j = 0; j < claimed; ++j) {
@@ -415,12 +414,12 @@ Diagnosis diagnose(const Scenario& scenario, const ObservationTable& data,
       text << " account" << (claimed == 1 ? "s" : "") << " for most of it; "
            << percent(left / d.misfit.declared_excess)
            << " remains, a model error outside the library (a geometry finer than the mesh, or an effect the "
-              "library lacks). Claimed with each std widened "
-           << format(factor) << " times for the residual's dispersion and persistence"
+              "library lacks). The stated std"
            << (static_cast<std::size_t>(claimed) + 1 < d.path.size()
-                   ? " and combined with how far the estimate moved in the later fits"
+                   ? " includes how far the estimate moved in the later fits, but"
                    : "")
-           << '.';
+           << " cannot include the bias such an error gives every fit alike: the value is the effect that "
+              "best mimics the data in this model (on truths from a finer mesh, 3-30% off).";
       if (static_cast<std::size_t>(claimed) < d.claims.size()) {
         const ClaimCheck& next = d.claims[static_cast<std::size_t>(claimed)];
         text << " Not claimed: " << next.effect << " (" << next.reason << ")";

@@ -49,25 +49,15 @@ double stiffness_r2(const Eigen::MatrixXd& C, int stiffnesses, int i) {
 
 }  // namespace
 
-double model_form_factor(const ResidualDiagnostics& residual) {
-  if (residual.verdict.consistency != Consistency::inconsistent || residual.steps_used < 2 ||
-      !(residual.nis.mean_dof > 0.0) || !(residual.spatial.least_effective_steps > 0.0))
-    return 1.0;
-  const double dispersion = std::max(1.0, residual.nis.mean / residual.nis.mean_dof);
-  const double persistence = std::max(1.0, residual.steps_used / residual.spatial.least_effective_steps);
-  return std::sqrt(dispersion * persistence);
-}
-
-EffectEstimate widened(const EffectEstimate& estimate, double factor, const std::vector<EffectEstimate>& later) {
+EffectEstimate widened(const EffectEstimate& estimate, const std::vector<EffectEstimate>& later) {
   EffectEstimate out = estimate;
-  if (!later.empty()) out.model_spread.assign(out.value.size(), 0.0);
+  if (later.empty()) return out;
+  out.model_spread.assign(out.value.size(), 0.0);
   for (const EffectEstimate& e : later)
     for (std::size_t i = 0; i < out.model_spread.size() && i < e.value.size(); ++i)
       out.model_spread[i] = std::max(out.model_spread[i], std::fabs(e.value[i] - out.value[i]));
-  for (std::size_t i = 0; i < out.std.size(); ++i) {
-    out.std[i] = out.first_order_std[i] * std::max({1.0, out.path_ratio[i], factor});
-    if (i < out.model_spread.size()) out.std[i] = std::hypot(out.std[i], out.model_spread[i]);
-  }
+  for (std::size_t i = 0; i < out.std.size(); ++i)
+    out.std[i] = std::hypot(out.first_order_std[i] * std::max(1.0, out.path_ratio[i]), out.model_spread[i]);
   return out;
 }
 
@@ -114,8 +104,7 @@ std::vector<ClaimCheck> check_claims(const std::vector<const ModelFit*>& path, c
       const double unique = runners_up[j - 1].chosen_score * (1.0 - check.runner_up_ratio) + check.runner_up_after;
       if (unique > 0.0) check.runner_up_unique_ratio = check.runner_up_after / unique;
     }
-    check.model_form_factor = model_form_factor(fit.residual);
-    const EffectEstimate estimate = widened(raw, check.model_form_factor);
+    const EffectEstimate& estimate = raw;
     const int k = static_cast<int>(estimate.value.size());
     for (int i = 0; i < k; ++i) {
       const double z = distance_from_absence(definition.parameters[static_cast<std::size_t>(i)],
