@@ -419,7 +419,7 @@ Diagnosis diagnose(const Scenario& scenario, const ObservationTable& data,
                    ? " includes how far the estimate moved in the later fits, but"
                    : "")
            << " cannot include the bias such an error gives every fit alike: the value is the effect that "
-              "best mimics the data in this model (on truths from a finer mesh, 3-30% off).";
+              "best mimics the data in this model (on truths from a finer mesh, 2-31% off).";
       if (static_cast<std::size_t>(claimed) < d.claims.size()) {
         const ClaimCheck& next = d.claims[static_cast<std::size_t>(claimed)];
         text << " Not claimed: " << next.effect << " (" << next.reason << ")";

@@ -55,7 +55,7 @@
 // fit: a model that lacks the organ's true form converges to the value of the effect that best
 // mimics the data, not to the effect's true value, and no statistic of the data can tell how
 // far apart the two are. Measured on truths from a finer mesh (README), the claimed values were
-// 3-30% off. Until stop 27 the std was also widened by the residual's whole dispersion and
+// 2-31% off. Until stop 27 the std was also widened by the residual's whole dispersion and
 // persistence, sqrt(NIS / rows x N / N_eff); that counts the misfit in every direction, not
 // along the effect's sensitivity: on the liver with a full-size gravity and the truth from the
 // refined mesh it came to 154, and a gravity that took up 98% of the misfit, 1.8 times its
