@@ -89,10 +89,10 @@ std::vector<ClaimCheck> check_claims(const std::vector<const ModelFit*>& path, c
     const ModelFit& before = *path[j - 1];
     const ModelFit& fit = *path[j];
     if (fit.estimates.empty()) break;
-    const EffectEstimate& raw = fit.estimates.back();
-    const EffectDefinition& definition = *find_effect(raw.name);
+    const EffectEstimate& estimate = fit.estimates.back();
+    const EffectDefinition& definition = *find_effect(estimate.name);
     ClaimCheck check;
-    check.effect = raw.name;
+    check.effect = estimate.name;
     check.share_of_declared = j - 1 < shares.removed.size() ? shares.removed[j - 1] : NAN;
     const double excess_before = before.residual.nis.mean - before.residual.nis.mean_dof;
     const double excess_after = fit.residual.nis.mean - fit.residual.nis.mean_dof;
@@ -104,7 +104,6 @@ std::vector<ClaimCheck> check_claims(const std::vector<const ModelFit*>& path, c
       const double unique = runners_up[j - 1].chosen_score * (1.0 - check.runner_up_ratio) + check.runner_up_after;
       if (unique > 0.0) check.runner_up_unique_ratio = check.runner_up_after / unique;
     }
-    const EffectEstimate& estimate = raw;
     const int k = static_cast<int>(estimate.value.size());
     for (int i = 0; i < k; ++i) {
       const double z = distance_from_absence(definition.parameters[static_cast<std::size_t>(i)],
@@ -123,7 +122,7 @@ std::vector<ClaimCheck> check_claims(const std::vector<const ModelFit*>& path, c
     if (first >= stiffnesses)
       for (int i = 0; i < k; ++i) check.stiffness_r2 = std::max(check.stiffness_r2, stiffness_r2(C, stiffnesses, first + i));
 
-    if (raw.name == "young_scale" && before.stiffness.size() == fit.stiffness.size() && raw.value[0] != 1.0) {
+    if (estimate.name == "young_scale" && before.stiffness.size() == fit.stiffness.size() && estimate.value[0] != 1.0) {
       // Ligaments found cut in either fit are left out: their logs say nothing about a scale.
       auto cut = [](const ModelFit& f, int l) {
         return std::any_of(f.run.cuts.begin(), f.run.cuts.end(), [l](const LigamentCut& c) { return c.parameter == l; });
@@ -138,7 +137,7 @@ std::vector<ClaimCheck> check_claims(const std::vector<const ModelFit*>& path, c
         std::sort(changes.begin(), changes.end());
         const std::size_t n = changes.size();
         const double median = n % 2 ? changes[n / 2] : 0.5 * (changes[n / 2 - 1] + changes[n / 2]);
-        check.scale_follow = median / std::log(raw.value[0]);
+        check.scale_follow = median / std::log(estimate.value[0]);
       }
     }
 

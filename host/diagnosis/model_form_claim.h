@@ -66,7 +66,6 @@
 #include <string>
 #include <vector>
 
-
 namespace sigmafem {
 
 struct ModelFit;
