@@ -1,5 +1,5 @@
-// `sigmafem generate SCENARIO --out DIR [--seed N] [--vtk-every K] [--truth-refine N |
-// --truth-mesh FILE]`: synthetic data.
+// `sigmafem generate SCENARIO --out DIR [--seed N] [--vtk-every K] [--truth-refine N
+// [--truth-springs spread|nodes] | --truth-mesh FILE]`: synthetic data.
 #include <iostream>
 #include <memory>
 
