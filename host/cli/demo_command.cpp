@@ -8,6 +8,7 @@
 
 #include "host/cli/backend_options.h"
 #include "host/cli/commands.h"
+#include "host/cli/option_checks.h"
 #include "host/cli/estimation_job.h"
 #include "host/cli/report.h"
 #include "host/common/input_error.h"
@@ -52,7 +53,9 @@ Action add_demo_command(CLI::App& app) {
       ->check(CLI::IsMember({"box", "liver"}))
       ->capture_default_str();
   sub->add_option("--out", options->out_dir, "Output folder (default: sigmafem-demo/<scenario>)");
-  sub->add_option("--seed", options->seed, "Seed of the observation noise")->capture_default_str();
+  sub->add_option("--seed", options->seed, "Seed of the observation noise")
+      ->check(whole_number())
+      ->capture_default_str();
   add_backend_options(sub, options->backend);
   sub->add_option("--sigma", options->sigma_points, "Sigma-point set (default: the scenario's)")
       ->check(CLI::IsMember(std::vector<std::string>{"simplex", "star"}));

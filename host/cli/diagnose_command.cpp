@@ -9,8 +9,10 @@
 
 #include "host/cli/backend_options.h"
 #include "host/cli/commands.h"
+#include "host/cli/option_checks.h"
 #include "host/cli/diagnosis_report.h"
 #include "host/common/input_error.h"
+#include "host/common/input_file.h"
 #include "host/diagnosis/diagnosis.h"
 #include "host/scenario/scenario.h"
 
@@ -46,7 +48,7 @@ Action add_diagnose_command(CLI::App& app) {
       ->capture_default_str();
   sub->add_option("--burn-in", options->burn_in,
                   "Share of the steps the residual tests leave out at the start while the filter settles")
-      ->check(CLI::Range(0.0, 0.9))
+      ->check(finite_between(0.0, 0.9))
       ->capture_default_str();
   add_backend_options(sub, options->backend);
   sub->add_option("--sigma", options->sigma_points,
@@ -66,19 +68,22 @@ Action add_diagnose_command(CLI::App& app) {
       throw InputError("observations " + (data / "observations.csv").string() +
                        ": needs at least two rows (the rest state and one step)");
     std::optional<TruthTable> truth;
-    if (fs::exists(data / "truth.csv")) truth = read_truth_csv((data / "truth.csv").string());
+    truth = read_optional_truth_csv((data / "truth.csv").string(), scenario.ligament_names(), table.row_count(), std::cerr);
     DiagnosisReport report;
     report.data_dir = options->data_dir;
     report.out_dir = options->out_dir;
     report.backend = options->backend.backend;
+    // truth.json is optional like truth.csv: unusable, it is a warning and left out.
     if (fs::exists(data / "truth.json")) {
-      std::ifstream in(data / "truth.json");
+      const std::string path = (data / "truth.json").string();
       try {
-        const nlohmann::ordered_json t = nlohmann::ordered_json::parse(in);
+        const nlohmann::ordered_json t = nlohmann::ordered_json::parse(read_input_file(path, "truth " + path, kMaxJsonBytes));
         report.truth_effects = {{"declared", t.value("declared_effects", nlohmann::ordered_json::array())},
                                 {"injected", t.value("injected_effects", nlohmann::ordered_json::array())}};
       } catch (const std::exception& e) {
-        throw InputError((data / "truth.json").string() + ": invalid JSON: " + e.what());
+        std::cerr << "warning: truth " << path << ": " << e.what()
+                  << "; it is optional, so the report goes on without the effects in the data\n";
+        report.truth_effects = nullptr;
       }
     }
     DiagnoseOptions diagnose_options;

@@ -5,6 +5,8 @@
 
 #include "host/cli/backend_options.h"
 #include "host/cli/commands.h"
+#include "host/cli/option_checks.h"
+#include "host/common/physical_limits.h"
 #include "host/cli/estimation_job.h"
 #include "host/scenario/scenario.h"
 
@@ -33,7 +35,7 @@ Action add_estimate_command(CLI::App& app) {
   sub->add_option("--observation-std", options->observation_std,
                   "Observation noise std the filter assumes, metres (default: the scenario's "
                   "filter.observation_std)")
-      ->check(CLI::PositiveNumber);
+      ->check(finite_between(0.0, kMaxNoiseStd, true));
   sub->add_flag("--quiet", options->quiet, "No progress line and no summary");
   return [options]() {
     Scenario scenario = load_scenario(options->scenario);

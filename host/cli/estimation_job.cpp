@@ -4,6 +4,7 @@
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
+#include <iostream>
 #include <memory>
 #include <optional>
 
@@ -43,7 +44,7 @@ json run_estimation_job(const Scenario& scenario, const EstimationJob& job) {
   for (Eigen::Index c = 0; c + 2 < table.points.cols(); c += 3)
     table.points.middleCols(c, 3).rowwise() -= offset.transpose();
   std::optional<TruthTable> truth;
-  if (fs::exists(data / "truth.csv")) truth = read_truth_csv((data / "truth.csv").string());
+  truth = read_optional_truth_csv((data / "truth.csv").string(), scenario.ligament_names(), table.row_count(), std::cerr);
 
   EstimationOptions options = estimation_options(scenario);
   if (!job.sigma_points.empty()) options.roukf.sigma_points = parse_sigma_point_set(job.sigma_points);

@@ -6,6 +6,8 @@
 #include "host/common/input_error.h"
 #include "host/cli/backend_options.h"
 #include "host/cli/commands.h"
+#include "host/cli/option_checks.h"
+#include "host/common/physical_limits.h"
 #include "host/cli/report.h"
 #include "host/generator/generate.h"
 #include "host/scenario/scenario.h"
@@ -32,13 +34,14 @@ Action add_generate_command(CLI::App& app) {
   sub->add_option("--out", options->generate.out_dir, "Output folder (created if missing)")
       ->required();
   sub->add_option("--seed", options->generate.seed, "Seed of the observation noise")
+      ->check(whole_number())
       ->capture_default_str();
   sub->add_option("--vtk-every", options->generate.vtk_every,
                   "Write a VTK frame every K steps (0: none; default: the scenario's)")
       ->check(CLI::NonNegativeNumber);
   sub->add_option("--noise-std", options->noise_std,
                   "Observation noise std in metres (default: the scenario's observations.noise_std)")
-      ->check(CLI::NonNegativeNumber);
+      ->check(finite_between(0.0, kMaxNoiseStd));
   sub->add_option("--inject", options->inject,
                   "Put an effect into the data without declaring it in the scenario, NAME=VALUE "
                   "(repeatable), e.g. gravity=0,-9.81,0, young_scale=1.5, camera_offset=0.5e-3,0,0, "

@@ -1,6 +1,9 @@
 #include "host/common/atomic_file.h"
 
+#include <cerrno>
 #include <cstdio>
+#include <cstring>
+#include <stdexcept>
 #include <utility>
 
 #include "host/common/input_error.h"
@@ -20,13 +23,15 @@ AtomicFile::~AtomicFile() {
   }
 }
 
+// A failure to write is the machine's (a full disk, a lost mount), not the input's: a
+// runtime_error (exit 1), where a path that cannot be opened is an InputError (exit 2).
 void AtomicFile::commit() {
   out_.flush();
-  const bool ok = static_cast<bool>(out_);
-  out_.close();
-  if (!ok) throw InputError(path_ + ": write failed (disk full?)");
+  out_.close();   // close flushes the last buffer: its failure counts too
+  if (out_.fail()) throw std::runtime_error(path_ + ": write failed (disk full?)");
   if (std::rename(temporary_path_.c_str(), path_.c_str()) != 0)
-    throw InputError(path_ + ": cannot rename " + temporary_path_ + " into place");
+    throw std::runtime_error(path_ + ": cannot rename " + temporary_path_ + " into place: " +
+                             std::strerror(errno));
   committed_ = true;
 }
 

@@ -9,7 +9,8 @@ namespace sigmafem {
 
 class AtomicFile {
  public:
-  // Opens `path + ".partial"` for writing; throws InputError if it cannot.
+  // Opens `path + ".partial"` for writing; throws InputError if it cannot (a path problem).
+  // commit() throws std::runtime_error when writing or renaming fails (a full disk).
   explicit AtomicFile(std::string path);
   // Removes the temporary file if commit() was not called.
   ~AtomicFile();

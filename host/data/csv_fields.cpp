@@ -7,6 +7,7 @@
 #include <system_error>
 
 #include "host/common/input_error.h"
+#include "host/common/input_file.h"
 
 namespace sigmafem {
 
@@ -37,13 +38,14 @@ bool parse_double(const std::string& text, double& value) {
 std::vector<std::string> read_csv_file(
     const std::string& path, const std::string& where,
     const std::function<void(const std::vector<std::string>&, const std::string&, bool)>& on_line) {
+  check_input_file(path, where, kMaxTableBytes);
   std::ifstream in(path);
-  if (!in) throw InputError(where + ": cannot open the file (missing or unreadable)");
+  if (!in) throw InputError(where + ": cannot open the file (unreadable)");
   std::vector<std::string> comments;
   bool header_seen = false, row_seen = false;
   std::string raw;
   for (int line_number = 1; std::getline(in, raw); ++line_number) {
-    const std::string line = trim(raw);
+    const std::string line = trim(std::string(line_number == 1 ? without_byte_order_mark(raw) : raw));
     if (line.empty()) continue;
     if (line[0] == '#') {
       if (!header_seen) comments.push_back(trim(line.substr(1)));

@@ -1,11 +1,12 @@
 #include "host/data/observation_table.h"
 
+#include <algorithm>
 #include <cmath>
+#include <limits>
 #include <sstream>
 
-#include <limits>
-
 #include "host/common/input_error.h"
+#include "host/common/physical_limits.h"
 #include "host/data/csv_fields.h"
 #include "host/data/csv_format.h"
 
@@ -26,13 +27,16 @@ ObservationTable read_observations_csv(const std::string& path, int point_count,
   auto on_line = [&](const std::vector<std::string>& fields, const std::string& at, bool is_header) {
     if (is_header) {
       if (fields == columns) return;
-      std::string expected;
-      for (std::size_t k = 0; k < std::min<std::size_t>(columns.size(), 8); ++k)
-        expected += (k ? "," : "") + columns[k];
-      throw InputError(at + "the header does not match the scenario: expected " +
-                       std::to_string(columns.size()) + " columns (" + expected + ",... for " +
-                       std::to_string(point_count) + " observed points), found " +
-                       std::to_string(fields.size()));
+      // Name the first column that differs, so a user sees which one to fix.
+      std::size_t k = 0;
+      while (k < fields.size() && k < columns.size() && fields[k] == columns[k]) ++k;
+      const std::string wrong =
+          k < fields.size() && k < columns.size()
+              ? "column " + std::to_string(k + 1) + " is \"" + fields[k] + "\", expected \"" + columns[k] + "\""
+              : "found " + std::to_string(fields.size()) + " columns, expected " + std::to_string(columns.size());
+      throw InputError(at + "the header does not match the scenario's " + std::to_string(point_count) +
+                       " observed points (step,time,so_x,so_y,so_z,p0_x,...,p" +
+                       std::to_string(point_count - 1) + "_z): " + wrong);
     }
     if (fields.size() != columns.size())
       throw InputError(at + "expected " + std::to_string(columns.size()) + " fields, found " +
@@ -47,6 +51,12 @@ ObservationTable read_observations_csv(const std::string& path, int point_count,
                               : "is not a finite number: \"" + fields[k] + "\"";
         throw InputError(at + "column " + columns[k] + " " + problem);
       }
+      // Positions are in metres: far beyond any organ is a unit slip or a corrupt value,
+      // and squared in the filter it would overflow.
+      if (k >= 2 && std::fabs(values[k]) > kMaxPositionMagnitude)
+        throw InputError(at + "column " + columns[k] + " is " + fields[k] +
+                         " m, farther than " + format_number(kMaxPositionMagnitude) +
+                         " m from the origin; positions are in metres");
     }
     const int expected_step = static_cast<int>(table.steps.size());
     if (values[0] != static_cast<double>(expected_step))
@@ -63,6 +73,11 @@ ObservationTable read_observations_csv(const std::string& path, int point_count,
     point_rows.emplace_back(values.begin() + 5, values.end());
   };
   table.comments = read_csv_file(path, "observations " + path, on_line);
+  const bool any_point = std::any_of(point_rows.begin(), point_rows.end(), [](const std::vector<double>& row) {
+    return std::any_of(row.begin(), row.end(), [](double v) { return !std::isnan(v); });
+  });
+  if (point_count > 0 && !any_point)
+    throw InputError("observations " + path + ": no observed point has a value in any row; nothing to compare the model with");
   const Eigen::Index rows = static_cast<Eigen::Index>(table.steps.size());
   table.so.resize(rows, 3);
   table.points.resize(rows, 3 * point_count);

@@ -1,5 +1,7 @@
 #include "host/data/truth_table.h"
 
+#include <algorithm>
+#include <filesystem>
 #include <sstream>
 
 #include "host/common/input_error.h"
@@ -61,6 +63,36 @@ TruthTable read_truth_csv(const std::string& path) {
     for (std::size_t c = 0; c < table.names.size(); ++c)
       table.stiffness(static_cast<Eigen::Index>(k), static_cast<Eigen::Index>(c)) = rows[k][c];
   return table;
+}
+
+std::optional<TruthTable> read_optional_truth_csv(const std::string& path,
+                                                  const std::vector<std::string>& ligament_names,
+                                                  int row_count, std::ostream& warnings) {
+  std::error_code error;
+  if (!std::filesystem::exists(path, error)) return std::nullopt;
+  const std::string ignored = "; it is optional, so the run goes on without the truth figures\n";
+  try {
+    TruthTable table = read_truth_csv(path);
+    std::vector<std::string> sorted_names = table.names, expected = ligament_names;
+    std::sort(sorted_names.begin(), sorted_names.end());
+    std::sort(expected.begin(), expected.end());
+    if (sorted_names != expected) {
+      std::string listed;
+      for (const std::string& name : ligament_names) listed += (listed.empty() ? "" : ",") + name;
+      warnings << "warning: truth " << path << ": the ligament columns are not the scenario's (" << listed << ")"
+               << ignored;
+      return std::nullopt;
+    }
+    if (static_cast<int>(table.steps.size()) != row_count) {
+      warnings << "warning: truth " << path << ": " << table.steps.size() << " rows, the observations have "
+               << row_count << ignored;
+      return std::nullopt;
+    }
+    return table;
+  } catch (const InputError& e) {
+    warnings << "warning: " << e.what() << ignored;
+    return std::nullopt;
+  }
 }
 
 }  // namespace sigmafem

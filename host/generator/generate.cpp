@@ -2,10 +2,13 @@
 
 #include <algorithm>
 #include <chrono>
+#include <cmath>
 #include <filesystem>
 #include <memory>
 #include <ostream>
 #include <vector>
+
+#include <unistd.h>
 
 #include "host/common/atomic_file.h"
 #include "host/common/input_error.h"
@@ -41,12 +44,34 @@ nlohmann::ordered_json truth_mesh_json(const TruthMesh& truth, const TruthMeshOp
   return j;
 }
 
+// generate keeps the whole observation and truth tables in memory, then their text: refuse a
+// run whose tables could not fit before any allocation, naming the field that sets their size.
+void check_table_memory(const Scenario& scenario) {
+  const double columns = 5.0 + 3.0 * static_cast<double>(scenario.observations.nodes.size()) +
+                         static_cast<double>(scenario.ligaments.size());
+  constexpr double kBytesPerValue = 8.0 + 24.0;   // the double and its text
+  const double needed = (scenario.time.steps + 1.0) * columns * kBytesPerValue;
+  const double available = static_cast<double>(::sysconf(_SC_PHYS_PAGES)) * static_cast<double>(::sysconf(_SC_PAGE_SIZE));
+  if (available > 0.0 && needed > 0.5 * available)
+    throw InputError("scenario " + scenario.path + ": time.steps: " + std::to_string(scenario.time.steps) +
+                     " steps of " + std::to_string(scenario.observations.nodes.size()) +
+                     " observed points need about " + format_number(std::ceil(needed / 1e9)) +
+                     " GB for the tables, more than half of this machine's " +
+                     format_number(std::floor(available / 1e9)) + " GB; generate fewer steps per run");
+}
+
+// The start of the message when the truth simulation fails at step k.
+std::string diverged_at(int k, double t) {
+  return "the truth simulation diverged at step " + std::to_string(k) + " (t = " + format_number(t) + " s): ";
+}
+
 }  // namespace
 
 GenerateResult generate(const Scenario& scenario, const GenerateOptions& options,
                         std::ostream& log) {
   const auto start = std::chrono::steady_clock::now();
   // Before the output folder: bad truth mesh options leave nothing behind.
+  check_table_memory(scenario);
   const TruthMesh truth_mesh = make_truth_mesh(scenario, options.truth_mesh);
   if (!truth_mesh.ligament_spread.empty() && options.backend != "cpu")
     throw InputError("--truth-refine with --backend " + options.backend +
@@ -123,7 +148,16 @@ GenerateResult generate(const Scenario& scenario, const GenerateOptions& options
   for (int k = 1; k <= steps; ++k) {
     const double t = k * dt;
     simulation.set_ligament_stiffness(stiffness_at(t));
-    const CgResult cg = simulation.step(scenario.control.trajectory.position(t, scenario.control.start));
+    CgResult cg;
+    try {
+      cg = simulation.step(scenario.control.trajectory.position(t, scenario.control.start));
+    } catch (const std::runtime_error& e) {
+      throw std::runtime_error(diverged_at(k, t) + e.what());
+    }
+    // A residual that is not finite is no solve at all: the state would be garbage from here.
+    if (!std::isfinite(cg.relative_residual))
+      throw std::runtime_error(diverged_at(k, t) + "the solve's residual is not finite (the load or the stiffness "
+                               "overflowed, or the system is not positive definite); nothing is written");
     result.cg_iterations += cg.iterations;
     result.max_cg_iterations = std::max(result.max_cg_iterations, cg.iterations);
     if (!cg.converged) {

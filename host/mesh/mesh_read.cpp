@@ -17,6 +17,7 @@
 #include <string_view>
 
 #include "host/common/input_error.h"
+#include "host/common/input_file.h"
 #include "host/mesh/mesh.h"
 #include "host/mesh/mesh_formats.h"
 #include "host/mesh/text_cursor.h"
@@ -24,22 +25,6 @@
 namespace sigmafem {
 
 namespace {
-
-std::string load_file(const std::string& path) {
-  std::error_code error;
-  if (std::filesystem::is_directory(path, error)) {
-    throw_mesh_error(path, "is a directory, not a mesh file");
-  }
-  const std::unique_ptr<std::FILE, int (*)(std::FILE*)> file(std::fopen(path.c_str(), "rb"),
-                                                             &std::fclose);
-  if (!file) throw_mesh_error(path, std::string("cannot open: ") + std::strerror(errno));
-  std::string content;
-  char buffer[1 << 16];
-  std::size_t got = 0;
-  while ((got = std::fread(buffer, 1, sizeof buffer, file.get())) > 0) content.append(buffer, got);
-  if (std::ferror(file.get())) throw_mesh_error(path, "read error");
-  return content;
-}
 
 bool starts_with(std::string_view text, std::string_view prefix) {
   return text.substr(0, prefix.size()) == prefix;
@@ -54,10 +39,9 @@ std::string_view first_line(std::string_view text) {
 }  // namespace
 
 Mesh read_mesh(const std::string& path) {
-  const std::string content = load_file(path);
-  std::string_view text = content;
+  const std::string content = read_input_file(path, "mesh " + path, kMaxMeshBytes);
   // A UTF-8 byte order mark, as some Windows editors save, is not part of either format.
-  if (starts_with(text, "\xEF\xBB\xBF")) text.remove_prefix(3);
+  const std::string_view text = without_byte_order_mark(content);
 
   const std::size_t first = text.find_first_not_of(" \t\r\n");
   if (first == std::string_view::npos) throw_mesh_error(path, "the file is empty");

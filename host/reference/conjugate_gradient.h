@@ -25,6 +25,12 @@ CgResult conjugate_gradient(const Apply& apply, const Eigen::VectorXd& inverse_d
                             double tolerance) {
   CgResult result;
   const double b_norm = b.norm();
+  // An overflowed load would make the stop test tol * |b| infinite and pass at once with
+  // nothing solved: report it as a breakdown (not converged, residual NaN) instead.
+  if (!std::isfinite(b_norm)) {
+    result.relative_residual = std::nan("");
+    return result;
+  }
   if (b_norm == 0.0) {  // the exact solution is zero; no iteration can improve on it
     x.setZero(b.size());
     result.converged = true;

@@ -6,6 +6,7 @@
 #include <sstream>
 
 #include "host/common/input_error.h"
+#include "host/common/physical_limits.h"
 
 namespace sigmafem {
 
@@ -77,7 +78,8 @@ std::string effect_value_problem(const EffectDefinition& definition, const std::
            (definition.value_count == 1 ? "" : "s") + " (" + definition.value_syntax + "), found " +
            std::to_string(value.size());
   for (double x : value)
-    if (!std::isfinite(x)) return "every number must be finite";
+    if (!std::isfinite(x) || std::fabs(x) > kMaxScenarioMagnitude)
+      return "every number must be finite and within +-1e12 (SI units)";
   if ((definition.name == "young_scale" || definition.name == "ligament_law" || definition.name == "damping_scale") &&
       !(*std::min_element(value.begin(), value.end()) > 0.0))
     return "must be > 0 (" + definition.value_syntax + ")";

@@ -11,6 +11,12 @@ namespace {
 constexpr double kEventTimeSlack = 1e-9;
 }  // namespace
 
+std::vector<std::string> Scenario::ligament_names() const {
+  std::vector<std::string> names;
+  for (const Ligament& ligament : ligaments) names.push_back(ligament.name);
+  return names;
+}
+
 int Scenario::ligament_index(const std::string& ligament_name) const {
   for (size_t i = 0; i < ligaments.size(); ++i) {
     if (ligaments[i].name == ligament_name) return static_cast<int>(i);

@@ -169,6 +169,8 @@ struct Scenario {
 
   // Index of the ligament called `name`, or -1.
   int ligament_index(const std::string& name) const;
+  // The ligaments' names, in order.
+  std::vector<std::string> ligament_names() const;
   // Index of the candidate region called `name`, or -1.
   int candidate_region_index(const std::string& name) const;
   // "" when the region of a regional effect (FAMILY:REGION) is one of candidate_regions,

@@ -7,6 +7,7 @@
 // fields are errors at every level: in a hand-written file a typo ("stifness") would
 // otherwise silently fall back to a default. Units are SI throughout.
 #include <algorithm>
+#include <cctype>
 #include <climits>
 #include <cmath>
 #include <cstdint>
@@ -17,6 +18,9 @@
 #include <sstream>
 
 #include "host/common/input_error.h"
+#include "host/common/input_file.h"
+#include "host/common/physical_limits.h"
+#include "host/mesh/text_cursor.h"
 #include "host/scenario/scenario.h"
 #include "host/scenario/surface_regions.h"
 
@@ -240,6 +244,9 @@ class Checker {
     const double x = value.get<double>();
     // A literal such as 1e999 parses to infinity; no scenario quantity may be infinite.
     require(std::isfinite(x), path, "expected a finite number, found " + value.dump());
+    require(std::fabs(x) <= kMaxScenarioMagnitude, path,
+            value.dump() + " is beyond +-" + format_number(kMaxScenarioMagnitude) +
+                ", more than any quantity of a scenario in SI units (a unit slip?)");
     return x;
   }
 
@@ -296,10 +303,21 @@ class Checker {
   std::string file_;
 };
 
+// Which nodes some tetrahedron uses. The mesh keeps the others (file indices stay valid), but
+// such a node is no part of the body: it never moves, so it can be no ligament, grip or
+// observed point.
+std::vector<bool> nodes_of_the_body(const Mesh& mesh) {
+  std::vector<bool> used(static_cast<size_t>(mesh.node_count()), false);
+  for (const std::array<int, 4>& tetrahedron : mesh.tetrahedra)
+    for (int node : tetrahedron) used[static_cast<size_t>(node)] = true;
+  return used;
+}
+
 // A list of node indices: integers in range, each once. Keeps the order written.
 std::vector<int> node_indices(const Checker& c, const json& value, const std::string& path,
                               const Mesh& mesh) {
   c.array(value, path);
+  const std::vector<bool> of_the_body = nodes_of_the_body(mesh);
   std::vector<int> nodes;
   std::set<int> seen;
   for (size_t i = 0; i < value.size(); ++i) {
@@ -311,6 +329,8 @@ std::vector<int> node_indices(const Checker& c, const json& value, const std::st
                   std::to_string(mesh.node_count() - 1) + ")");
     // A repeat is a slip, and it would also change n in the per-node stiffness k/n.
     c.require(seen.insert(node).second, at, "node " + std::to_string(node) + " is listed twice");
+    c.require(of_the_body[static_cast<size_t>(node)], at,
+              "node " + std::to_string(node) + " belongs to no tetrahedron of the mesh, so it never moves");
     nodes.push_back(node);
   }
   return nodes;
@@ -377,8 +397,25 @@ std::vector<int> node_set(const Checker& c, const json& owner, const std::string
     // With a mesh scale set, a selection written in file units is the usual cause.
     advice += " (selections are in metres, after mesh scale and translate)";
   }
+  if (has_select) {   // a selection takes the body's nodes only
+    const std::vector<bool> of_the_body = nodes_of_the_body(mesh);
+    nodes.erase(std::remove_if(nodes.begin(), nodes.end(), [&](int node) { return !of_the_body[static_cast<size_t>(node)]; }),
+                nodes.end());
+  }
   c.require(!nodes.empty(), path, "node set is empty (" + asked + "); " + advice);
   return nodes;
+}
+
+// The scenario's name becomes part of output file names (NAME.pvd, vtk/NAME_000000.vtu) and
+// of plot titles: no folder separators, no "..", no quotes or control characters.
+constexpr const char* kFileNameRule =
+    "1 to 64 letters, digits, '_', '-' or '.', starting with a letter or digit";
+
+bool is_file_name_safe(const std::string& name) {
+  if (name.empty() || name.size() > 64 || !std::isalnum(static_cast<unsigned char>(name[0]))) return false;
+  return std::all_of(name.begin(), name.end(), [](char ch) {
+    return std::isalnum(static_cast<unsigned char>(ch)) || ch == '_' || ch == '-' || ch == '.';
+  });
 }
 
 // A ligament name becomes a CSV column header (truth and estimates files) and is looked
@@ -403,16 +440,6 @@ int ligament_by_name(const Checker& c, const std::vector<Ligament>& ligaments, c
                    "; ligaments: " + (names.empty() ? "(none)" : join(names)));
 }
 
-std::string read_text(const Checker& c, const std::string& path) {
-  std::error_code error;
-  if (!fs::exists(path, error)) c.fail_file("file not found");
-  if (fs::is_directory(path, error)) c.fail_file("is a folder, expected a JSON file");
-  std::ifstream in(path, std::ios::binary);
-  if (!in) c.fail_file("file cannot be opened for reading");
-  std::ostringstream text;
-  text << in.rdbuf();
-  return text.str();
-}
 
 json parse_json(const Checker& c, const std::string& text) {
   DuplicateKeyCheck duplicates;
@@ -426,6 +453,15 @@ json parse_json(const Checker& c, const std::string& text) {
     return json::parse(text, callback);
   } catch (const json::parse_error& e) {
     c.fail(line_and_column(text, e.byte), "invalid JSON: " + parse_problem(e.what()));
+  } catch (const json::out_of_range& e) {
+    // A literal beyond double range (1e400): nlohmann names the literal but not where it is.
+    const std::string what = e.what();
+    const size_t open = what.find('\''), close = what.rfind('\'');
+    const std::string literal = open < close ? what.substr(open + 1, close - open - 1) : "";
+    const size_t at = literal.empty() ? std::string::npos : text.find(literal);
+    c.fail(at == std::string::npos ? "(a number)" : line_and_column(text, at + 1),
+           "number " + (literal.empty() ? std::string("literal") : literal) +
+               " is beyond the range of a double (about 1.8e308)");
   }
 }
 
@@ -508,7 +544,8 @@ void read_physics(const Checker& c, const json& root, Scenario& s) {
   s.time.dt = c.number(time.at("dt"), "time.dt");
   c.positive(s.time.dt, "time.dt");
   s.time.steps = c.integer(time.at("steps"), "time.steps");
-  c.require(s.time.steps >= 1, "time.steps", "must be >= 1, found " + std::to_string(s.time.steps));
+  c.require(s.time.steps >= 1 && s.time.steps <= kMaxSteps, "time.steps",
+            "must be 1 to " + std::to_string(kMaxSteps) + ", found " + std::to_string(s.time.steps));
 
   if (root.contains("solver")) {
     const json& solver = root.at("solver");
@@ -685,7 +722,9 @@ void read_observations(const Checker& c, const json& root, Scenario& s) {
     s.observations.nodes = node_indices(c, observations.at("nodes"), "observations.nodes", s.mesh);
   }
   s.observations.noise_std = c.number_or(observations, "observations", "noise_std", 0.0);
-  c.non_negative(s.observations.noise_std, "observations.noise_std");
+  c.require(s.observations.noise_std >= 0.0 && s.observations.noise_std <= kMaxNoiseStd,
+            "observations.noise_std",
+            "must be 0 to " + format_number(kMaxNoiseStd) + " m, found " + format_number(s.observations.noise_std));
 }
 
 // The fields the filter's windowed tests share (filter.change_detection,
@@ -745,7 +784,8 @@ void read_filter(const Checker& c, const json& root, Scenario& s) {
   c.non_negative(spec.parameter_drift_log_std, "filter.parameter_drift_log_std");
   // The filter divides by this variance: zero would claim perfect measurements.
   spec.observation_std = c.number(filter.at("observation_std"), "filter.observation_std");
-  c.positive(spec.observation_std, "filter.observation_std");
+  c.require(spec.observation_std > 0.0 && spec.observation_std <= kMaxNoiseStd, "filter.observation_std",
+            "must be > 0 and at most " + format_number(kMaxNoiseStd) + " m, found " + format_number(spec.observation_std));
   if (filter.contains("sigma_points")) {
     spec.sigma_points = c.string(filter.at("sigma_points"), "filter.sigma_points");
     c.require(spec.sigma_points == "simplex" || spec.sigma_points == "star", "filter.sigma_points",
@@ -823,7 +863,7 @@ void read_output(const Checker& c, const json& root, Scenario& s) {
 
 Scenario load_scenario(const std::string& path) {
   const Checker c(path);
-  const json root = parse_json(c, read_text(c, path));
+  const json root = parse_json(c, read_input_file(path, "scenario " + path, kMaxJsonBytes));
   c.require(root.is_object(), "(top level)",
             "expected a JSON object {...}, found " + describe(root));
 
@@ -846,6 +886,9 @@ Scenario load_scenario(const std::string& path) {
   s.name =
       root.contains("name") ? c.string(root.at("name"), "name") : fs::path(path).stem().string();
   c.require(!s.name.empty(), "name", "empty; leave the field out to use the file name");
+  c.require(is_file_name_safe(s.name), root.contains("name") ? "name" : "name (from the file name)",
+            quote_for_message(s.name) + " cannot name output files (" + kFileNameRule +
+                ")" + (root.contains("name") ? "" : "; give a \"name\" field"));
   if (root.contains("description")) s.description = c.string(root.at("description"), "description");
 
   read_mesh_section(c, root, path, s);

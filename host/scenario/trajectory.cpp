@@ -8,7 +8,9 @@
 #include <sstream>
 
 #include "host/common/input_error.h"
+#include "host/common/physical_limits.h"
 #include "host/data/csv_fields.h"
+#include "host/data/csv_format.h"
 #include "host/scenario/scenario.h"
 
 namespace sigmafem {
@@ -54,6 +56,10 @@ Trajectory read_trajectory_csv(const std::string& path) {
       if (!parse_double(fields[k], values[k]))
         throw InputError(at + "column " + kColumns[k] + " is not a finite number: \"" + fields[k] +
                          "\"");
+      const double bound = k == 0 ? kMaxScenarioMagnitude : kMaxPositionMagnitude;
+      if (std::fabs(values[k]) > bound)
+        throw InputError(at + "column " + kColumns[k] + " is " + fields[k] + ", beyond +-" +
+                         format_number(bound) + (k == 0 ? " s" : " m; positions are in metres"));
     }
     if (!trajectory.times.empty() && !(values[0] > trajectory.times.back())) {
       std::ostringstream what;

@@ -1,7 +1,6 @@
 // The sigmafem program as a user meets it: exit codes, error messages that name the file and
 // the field, and no output file after bad input.
 #include <gtest/gtest.h>
-#include <sys/wait.h>
 
 #include <cmath>
 #include <cstdio>
@@ -13,6 +12,7 @@
 #include <string>
 #include <vector>
 
+#include "cli/sigmafem_command.h"
 #include "temp_path.h"
 
 namespace sigmafem {
@@ -20,31 +20,9 @@ namespace {
 namespace fs = std::filesystem;
 using nlohmann::json;
 
-struct CommandRun {
-  int exit_code = -1;
-  std::string output;   // stdout and stderr together
-};
-
-CommandRun run_sigmafem_command(const std::string& command_line) {
-  const std::string command = command_line + " 2>&1";
-  CommandRun run;
-  FILE* pipe = popen(command.c_str(), "r");
-  if (!pipe) return run;
-  char buffer[4096];
-  while (std::fgets(buffer, sizeof buffer, pipe)) run.output += buffer;
-  const int status = pclose(pipe);
-  run.exit_code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
-  return run;
-}
-
-CommandRun run_sigmafem(const std::string& arguments) {
-  return run_sigmafem_command(std::string(SIGMAFEM_BINARY) + " " + arguments);
-}
-
-// The same with environment assignments ("NAME=value ...") before the program.
-CommandRun run_sigmafem_with_env(const std::string& environment, const std::string& arguments) {
-  return run_sigmafem_command(environment + " " + std::string(SIGMAFEM_BINARY) + " " + arguments);
-}
+using test::CommandRun;
+using test::run_sigmafem;
+using test::run_sigmafem_with_env;
 
 class CliTest : public ::testing::Test {
  protected:

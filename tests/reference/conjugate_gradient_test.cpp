@@ -147,5 +147,22 @@ TEST_F(ConjugateGradientTest, StopsOnNonFiniteNumbersInsteadOfSpinning) {
   EXPECT_LE(result.iterations, 1) << "iterations with a non-finite operator (must stop at the first)";
 }
 
+// An overflowed load made the stop test tol * |b| infinite, which every residual passes: the
+// solve "converged" after 0 iterations with nothing solved (issue 14).
+TEST_F(ConjugateGradientTest, AnInfiniteLoadIsABreakdownNotAConvergence) {
+  int products = 0;
+  const auto counting = [&](const Eigen::VectorXd& d, Eigen::VectorXd& y) {
+    ++products;
+    y = d;
+  };
+  Eigen::VectorXd b = b_;
+  b[0] = std::numeric_limits<double>::infinity();
+  Eigen::VectorXd x = Eigen::VectorXd::Zero(b.size());
+  const CgResult result = conjugate_gradient(counting, Eigen::VectorXd::Ones(b.size()), b, x, 1000, kLooseTolerance);
+  EXPECT_FALSE(result.converged);
+  EXPECT_TRUE(std::isnan(result.relative_residual)) << "the caller can tell a breakdown from a cap";
+  EXPECT_EQ(products, 0);
+}
+
 }  // namespace
 }  // namespace sigmafem

@@ -573,8 +573,8 @@ TEST_F(ScenarioLoadTest, BadFieldsAreNamed) {
        {"time.dt:", "must be > 0, found -0.01"}},
       {"steps zero",
        [](json& j) { j["time"]["steps"] = 0; },
-       {"time.steps:", "must be >= 1, found 0"}},
-      {"steps negative", [](json& j) { j["time"]["steps"] = -5; }, {"time.steps:", "must be >= 1"}},
+       {"time.steps:", "must be 1 to 10000000, found 0"}},
+      {"steps negative", [](json& j) { j["time"]["steps"] = -5; }, {"time.steps:", "must be 1 to 10000000, found -5"}},
       {"steps huge", [](json& j) { j["time"]["steps"] = 1e12; }, {"time.steps:", "out of range"}},
       {"cg iterations zero",
        [](json& j) {
@@ -635,7 +635,7 @@ TEST_F(ScenarioLoadTest, BadFieldsAreNamed) {
        {"damping.rayleigh_mass:", "must be >= 0"}},
       {"noise negative",
        [](json& j) { j["observations"]["noise_std"] = -0.0005; },
-       {"observations.noise_std:", "must be >= 0"}},
+       {"observations.noise_std:", "must be 0 to 1 m, found -0.0005"}},
       // trajectories
       {"trajectory type unknown",
        [](json& j) { j["control"]["trajectory"]["type"] = "linaer"; },
