@@ -10,6 +10,7 @@
 #include "host/cli/plot.h"
 #include "host/cli/residual_report.h"
 #include "host/common/atomic_file.h"
+#include "host/common/output_set.h"
 #include "host/common/input_error.h"
 
 namespace sigmafem::cli {
@@ -121,10 +122,10 @@ std::string scenario_with_effects(const Scenario& scenario, const std::vector<Ef
 
 json write_diagnosis_report(const Scenario& scenario, const Diagnosis& d, const DiagnoseOptions& options,
                             const DiagnosisReport& report) {
-  const fs::path out(report.out_dir);
-  std::error_code error;
-  fs::create_directories(out, error);
-  if (error) throw InputError(report.out_dir + ": cannot create output folder: " + error.message());
+  // report.json, what a reader opens first, is the set's marker: published last.
+  OutputSet output(report.out_dir,
+                   {"report.md", "report.json", "residual_before.png", "residual_after.png", "scenario.json"},
+                   "report.json");
 
   json j;
   j["scenario"] = scenario.path;
@@ -203,15 +204,15 @@ json write_diagnosis_report(const Scenario& scenario, const Diagnosis& d, const 
 
   // Plots of the residual before and after.
   json files;
-  files["report_md"] = (out / "report.md").string();
+  files["report_md"] = output.final_path("report.md");
   if (gnuplot_available()) {
     try {
       plot_residuals(d.before().residual, d.before().series, scenario.name + ", declared model",
-                     (out / "residual_before.png").string());
+                     output.staged("residual_before.png"));
       plot_residuals(d.after().residual, d.after().series, scenario.name + ", " + model_name(d.after()),
-                     (out / "residual_after.png").string());
-      files["residual_before"] = (out / "residual_before.png").string();
-      files["residual_after"] = (out / "residual_after.png").string();
+                     output.staged("residual_after.png"));
+      files["residual_before"] = output.final_path("residual_before.png");
+      files["residual_after"] = output.final_path("residual_after.png");
     } catch (const std::exception& e) {
       files["plots_skipped"] = e.what();
     }
@@ -219,8 +220,8 @@ json write_diagnosis_report(const Scenario& scenario, const Diagnosis& d, const 
     files["plots_skipped"] = "gnuplot with PNG output is not installed";
   }
   if (claimed) {
-    write_file_atomically((out / "scenario.json").string(), scenario_with_effects(scenario, d.discovered));
-    files["scenario"] = (out / "scenario.json").string();
+    write_file_atomically(output.staged("scenario.json"), scenario_with_effects(scenario, d.discovered));
+    files["scenario"] = output.final_path("scenario.json");
   }
   j["files"] = files;
 
@@ -323,9 +324,10 @@ json write_diagnosis_report(const Scenario& scenario, const Diagnosis& d, const 
   }
   if (files.contains("scenario"))
     md << "The scenario with the discovered effects declared: `scenario.json` (run `sigmafem estimate "
-       << (out / "scenario.json").string() << " --data " << report.data_dir << " --out DIR`).\n";
-  write_file_atomically((out / "report.md").string(), md.str());
-  write_file_atomically((out / "report.json").string(), j.dump(2) + "\n");
+       << output.final_path("scenario.json") << " --data " << report.data_dir << " --out DIR`).\n";
+  write_file_atomically(output.staged("report.md"), md.str());
+  write_file_atomically(output.staged("report.json"), j.dump(2) + "\n");
+  output.publish();
   return j;
 }
 

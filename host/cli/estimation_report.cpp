@@ -7,6 +7,7 @@
 #include "host/cli/plot.h"
 #include "host/cli/residual_report.h"
 #include "host/common/atomic_file.h"
+#include "host/common/output_set.h"
 #include "host/data/csv_format.h"
 
 namespace sigmafem::cli {
@@ -159,8 +160,11 @@ nlohmann::ordered_json cuts_json(const EstimationRun& run, const std::vector<std
 }
 
 nlohmann::ordered_json write_estimation_report(const EstimationReport& report, const EstimationRun& run) {
-  const fs::path out(report.out_dir);
-  write_file_atomically((out / "estimates.csv").string(), estimates_csv(report, run));
+  // summary.json, what a reader opens first, is the set's marker: published last.
+  OutputSet output(report.out_dir,
+                   {"estimates.csv", "summary.json", "residual.json", "stiffness.png", "innovation.png", "residual.png"},
+                   "summary.json");
+  write_file_atomically(output.staged("estimates.csv"), estimates_csv(report, run));
 
   std::vector<int> steps;
   for (const EstimationStep& step : run.steps) steps.push_back(step.step);
@@ -227,13 +231,12 @@ nlohmann::ordered_json write_estimation_report(const EstimationReport& report, c
   std::optional<ResidualDiagnostics> residual;
   if (!run.steps.empty() && 3 * report.observed_positions.rows() == series.innovation.cols()) {
     residual = diagnose_residuals(series, report.observed_positions, report.residual);
-    const fs::path file = out / "residual.json";
     json residual_file = residual_json(*residual, report.residual);
     residual_file["adaptive_noise"] = summary["adaptive_noise"];
-    write_file_atomically(file.string(), residual_file.dump(2) + "\n");
+    write_file_atomically(output.staged("residual.json"), residual_file.dump(2) + "\n");
     summary["residual"] = {{"verdict", to_string(residual->verdict.consistency)},
                            {"failed_tests", residual->verdict.failed()},
-                           {"file", file.string()}};
+                           {"file", output.final_path("residual.json")}};
   } else {
     summary["residual"] = nullptr;
   }
@@ -244,17 +247,18 @@ nlohmann::ordered_json write_estimation_report(const EstimationReport& report, c
   } else if (!gnuplot_available()) {
     plots["skipped"] = "gnuplot (with the pngcairo terminal) is not installed: apt-get install gnuplot-nox";
   } else {
-    plot_stiffness(report, run, truth, (out / "stiffness.png").string());
-    plot_innovation(report, run, (out / "innovation.png").string());
-    plots["stiffness"] = (out / "stiffness.png").string();
-    plots["innovation"] = (out / "innovation.png").string();
+    plot_stiffness(report, run, truth, output.staged("stiffness.png"));
+    plot_innovation(report, run, output.staged("innovation.png"));
+    plots["stiffness"] = output.final_path("stiffness.png");
+    plots["innovation"] = output.final_path("innovation.png");
     if (residual) {
-      plot_residuals(*residual, series, report.scenario_name, (out / "residual.png").string());
-      plots["residual"] = (out / "residual.png").string();
+      plot_residuals(*residual, series, report.scenario_name, output.staged("residual.png"));
+      plots["residual"] = output.final_path("residual.png");
     }
   }
   summary["plots"] = plots;
-  write_file_atomically((out / "summary.json").string(), summary.dump(2) + "\n");
+  write_file_atomically(output.staged("summary.json"), summary.dump(2) + "\n");
+  output.publish();
   return summary;
 }
 

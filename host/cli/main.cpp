@@ -1,7 +1,8 @@
 // sigmafem command line. Exit codes: 0 success, 1 a run that failed (the simulation), 2 bad
 // input (files, scenario, options), 3 a device that cannot run it (no OpenCL platform or
 // Vulkan driver, a kernel or shader that fails to build or load, out of device memory),
-// with a message on stderr that says where and what.
+// with a message on stderr that says where and what; 128 + N after signal N (SIGINT,
+// SIGTERM, SIGHUP), with the run's staging files removed.
 #include <CLI/CLI.hpp>
 #include <iostream>
 #include <map>
@@ -9,6 +10,7 @@
 #include "host/cli/commands.h"
 #include "host/common/device_error.h"
 #include "host/common/input_error.h"
+#include "host/common/interruption.h"
 
 int main(int argc, char** argv) {
   CLI::App app{"sigmafem: estimates the stiffness of the ligaments that hold an organ from "
@@ -29,8 +31,12 @@ int main(int argc, char** argv) {
   } catch (const CLI::ParseError& e) {
     return app.exit(e) == 0 ? 0 : 2;
   }
+  sigmafem::install_interruption_handlers();
   try {
     for (CLI::App* sub : app.get_subcommands()) return actions.at(sub)();
+  } catch (const sigmafem::Interrupted& e) {
+    std::cerr << "sigmafem: " << e.what() << '\n';
+    return 128 + e.signal_number();
   } catch (const sigmafem::InputError& e) {
     std::cerr << "sigmafem: error: " << e.what() << '\n';
     return 2;

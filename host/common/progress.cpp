@@ -5,6 +5,8 @@
 #include <cstdio>
 #include <utility>
 
+#include "host/common/interruption.h"
+
 namespace sigmafem {
 
 Progress::Progress(std::string label, long long total, bool enabled)
@@ -15,6 +17,7 @@ Progress::Progress(std::string label, long long total, bool enabled)
       last_(start_ - std::chrono::seconds(1)) {}
 
 void Progress::update(long long done, const std::string& detail) {
+  throw_if_interrupted();   // every long loop reports progress: where Ctrl-C takes effect
   if (!active_) return;
   const auto now = std::chrono::steady_clock::now();
   if (done < total_ && now - last_ < std::chrono::milliseconds(200)) return;

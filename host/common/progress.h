@@ -11,7 +11,8 @@ class Progress {
  public:
   // `enabled` false (or stderr not a terminal) makes every call a no-op.
   Progress(std::string label, long long total, bool enabled);
-  // Reports `done` of `total`; `detail` is appended (e.g. "CG 12 it").
+  // Reports `done` of `total`; `detail` is appended (e.g. "CG 12 it"). Throws Interrupted
+  // after SIGINT/SIGTERM/SIGHUP (host/common/interruption.h), shown or not.
   void update(long long done, const std::string& detail = "");
   // Clears the line.
   void finish();

@@ -6,6 +6,7 @@
 
 #include "filter/path_consistency.h"
 #include "host/common/input_error.h"
+#include "host/common/interruption.h"
 #include "host/ensemble/effect_ensemble.h"
 #include "host/model/effects.h"
 #include "host/model/model.h"
@@ -133,7 +134,8 @@ ModelFit fit_model(const Scenario& scenario, const ObservationTable& data,
   const Eigen::Vector3d offset = camera_offset(scenario.effects);
   for (Eigen::Index c = 0; c + 2 < points.cols(); c += 3) points.middleCols(c, 3).rowwise() -= offset.transpose();
 
-  fit.run = run_estimation(*ensemble, estimation, data.times, data.so, points, {});
+  fit.run = run_estimation(*ensemble, estimation, data.times, data.so, points,
+                           [](const EstimationStep&) { throw_if_interrupted(); });
   fit.series = innovation_series(fit.run);
   ResidualDiagnosticsOptions residual = options.residual;
   if (residual.burn_in_steps < 0)

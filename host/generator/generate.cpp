@@ -12,6 +12,7 @@
 
 #include "host/common/atomic_file.h"
 #include "host/common/input_error.h"
+#include "host/common/output_set.h"
 #include "host/common/progress.h"
 #include "host/data/csv_format.h"
 #include "host/data/observation_table.h"
@@ -77,9 +78,9 @@ GenerateResult generate(const Scenario& scenario, const GenerateOptions& options
     throw InputError("--truth-refine with --backend " + options.backend +
                      ": the springs spread over the refined mesh give each node its own part of a ligament, which the "
                      "device back ends do not hold; use --backend cpu, or --truth-springs nodes");
-  std::error_code error;
-  fs::create_directories(options.out_dir, error);
-  if (error) throw InputError(options.out_dir + ": cannot create output folder: " + error.message());
+  // observations.csv, what estimate reads, is the set's marker: published last.
+  OutputSet output(options.out_dir, {"observations.csv", "truth.csv", "truth.json", scenario.name + ".pvd", "vtk"},
+                   "observations.csv");
 
   Model truth_model = truth_mesh.model();   // declared effects included
   apply_effects(options.inject, truth_model);
@@ -132,7 +133,7 @@ GenerateResult generate(const Scenario& scenario, const GenerateOptions& options
 
   std::unique_ptr<VtkSeries> vtk;
   if (vtk_every > 0)
-    vtk = std::make_unique<VtkSeries>(model, truth_mesh.nearest_observed_nodes(), options.out_dir, scenario.name);
+    vtk = std::make_unique<VtkSeries>(model, truth_mesh.nearest_observed_nodes(), output.staging_folder(), scenario.name);
 
   // The scenario's ligaments (events applied), then any extra ligament of an effect at the
   // model's stiffness.
@@ -174,10 +175,8 @@ GenerateResult generate(const Scenario& scenario, const GenerateOptions& options
   }
   progress.finish();
 
-  const fs::path out(options.out_dir);
-  write_file_atomically((out / "observations.csv").string(), format_observations_csv(table));
-  write_file_atomically((out / "truth.csv").string(),
-                        format_truth_csv(truth));
+  write_file_atomically(output.staged("observations.csv"), format_observations_csv(table));
+  write_file_atomically(output.staged("truth.csv"), format_truth_csv(truth));
   auto effects_json = [](const std::vector<EffectValue>& effects) {
     nlohmann::ordered_json list = nlohmann::ordered_json::array();
     for (const EffectValue& effect : effects) list.push_back({{"name", effect.name}, {"value", effect.value}});
@@ -189,11 +188,12 @@ GenerateResult generate(const Scenario& scenario, const GenerateOptions& options
                                        {"declared_effects", effects_json(scenario.effects)},
                                        {"injected_effects", effects_json(options.inject)},
                                        {"truth_mesh", truth_mesh_json(truth_mesh, options.truth_mesh)}};
-  write_file_atomically((out / "truth.json").string(), truth_json.dump(2) + "\n");
+  write_file_atomically(output.staged("truth.json"), truth_json.dump(2) + "\n");
   if (vtk) {
     vtk->finish();
     result.vtk_frames = vtk->frame_count();
   }
+  output.publish();
   result.steps = steps;
   result.truth_mesh = truth_mesh.description;
   result.truth_nodes = model.node_count();

@@ -33,18 +33,17 @@ VtkSeries::VtkSeries(const Model& model, std::vector<int> observed_nodes, std::s
   for (std::size_t k = 0; k < observed_nodes.size(); ++k)
     observed_mark_[observed_nodes[k]] = static_cast<int>(k) + 1;
   for (int node : model.control.nodes) control_mark_[node] = 1;
-  const fs::path partial = fs::path(directory_) / "vtk.partial";
+  const fs::path frames = fs::path(directory_) / "vtk";
   std::error_code error;
-  fs::remove_all(partial, error);
-  if (!fs::create_directories(partial, error) && error)
-    throw InputError(partial.string() + ": cannot create folder: " + error.message());
+  if (!fs::create_directories(frames, error) && error)
+    throw InputError(frames.string() + ": cannot create folder: " + error.message());
 }
 
 void VtkSeries::write_frame(double t, const Eigen::VectorXd& x) {
   char file_name[64];
   std::snprintf(file_name, sizeof file_name, "%s_%06d.vtu", name_.c_str(),
                 static_cast<int>(frames_.size()));
-  AtomicFile file((fs::path(directory_) / "vtk.partial" / file_name).string());
+  AtomicFile file((fs::path(directory_) / "vtk" / file_name).string());
   std::ostream& out = file.stream();
   const int n = model_.node_count(), m = model_.element_count();
   out << "<?xml version=\"1.0\"?>\n"
@@ -83,11 +82,6 @@ void VtkSeries::write_frame(double t, const Eigen::VectorXd& x) {
 }
 
 void VtkSeries::finish() {
-  const fs::path final_dir = fs::path(directory_) / "vtk";
-  std::error_code error;
-  fs::remove_all(final_dir, error);
-  fs::rename(fs::path(directory_) / "vtk.partial", final_dir, error);
-  if (error) throw InputError(final_dir.string() + ": cannot move frames into place: " + error.message());
   std::ostringstream pvd;
   pvd << "<?xml version=\"1.0\"?>\n"
       << "<VTKFile type=\"Collection\" version=\"0.1\" byte_order=\"LittleEndian\">\n"

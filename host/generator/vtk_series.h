@@ -4,8 +4,8 @@
 // nodes (ligament index + 1), the observed nodes (observation index + 1) and the control
 // nodes (1), so that ParaView's Threshold shows each group.
 //
-// Frames are written into `<dir>/vtk.partial/` and moved to `<dir>/vtk/` by finish(), with the
-// .pvd written last, so an interrupted run never leaves a series that looks complete.
+// Frames go to `<dir>/vtk/` and finish() writes `<dir>/<name>.pvd`; `dir` is generate's staging
+// folder (host/common/output_set.h), so an interrupted run leaves no series behind.
 #pragma once
 
 #include <Eigen/Core>
@@ -23,7 +23,7 @@ class VtkSeries {
             std::string name);
   // Writes the frame for positions x at time t.
   void write_frame(double t, const Eigen::VectorXd& x);
-  // Moves the frames into place and writes `<dir>/<name>.pvd`.
+  // Writes `<dir>/<name>.pvd`.
   void finish();
   int frame_count() const { return static_cast<int>(frames_.size()); }
 

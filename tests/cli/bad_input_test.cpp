@@ -257,16 +257,44 @@ TEST_F(BadInputTest, NothingIsAcceptedInSilence) {
   expect_refused(orphan, {"variant.json", "observations.nodes[1]", "belongs to no tetrahedron"}, "orphan node");
 }
 
-// A full disk exited 2, as if the input were bad. /dev/full behind the temporary name stands
-// for it: every write there fails with ENOSPC.
+// A full disk exited 2, as if the input were bad. A file-size limit stands for it (ulimit -f,
+// with SIGXFSZ ignored so that the write fails with EFBIG instead of killing the program).
 TEST_F(BadInputTest, AFullDiskIsTheMachinesFailureNotTheInputs) {
-  fs::create_directories(out());
-  fs::create_symlink("/dev/full", out() + "/observations.csv.partial");
-  const CommandRun run =
-      run_with_timeout("generate " + scenario_file(box_) + " --out " + out() + " --vtk-every 0 --quiet");
+  const CommandRun run = run_sigmafem_command("sh -c \"trap '' XFSZ; ulimit -f 1; " + std::string(SIGMAFEM_BINARY) +
+                                              " generate '" + scenario_file(box_) + "' --out '" + out() +
+                                              "' --vtk-every 0 --quiet\"");
   EXPECT_EQ(run.exit_code, 1) << run.output;
-  EXPECT_NE(run.output.find("observations.csv: write failed (disk full?)"), std::string::npos) << run.output;
+  EXPECT_NE(run.output.find("write failed (disk full?)"), std::string::npos) << run.output;
   EXPECT_FALSE(fs::exists(out() + "/observations.csv")) << "nothing under the final name";
+  EXPECT_FALSE(fs::exists(out() + "/.sigmafem-partial")) << "the staging folder is removed";
+}
+
+// A run stopped by SIGTERM (or Ctrl-C) leaves nothing: hundreds of vtk.partial/ frames before.
+TEST_F(BadInputTest, AnInterruptedRunLeavesNoFilesBehind) {
+  json scenario = box_;
+  scenario["time"]["steps"] = 100000;
+  scenario["output"]["vtk_every"] = 1;
+  const CommandRun run = run_sigmafem_command("timeout --preserve-status -s TERM 2 " + std::string(SIGMAFEM_BINARY) +
+                                              " generate " + scenario_file(scenario) + " --out " + out() + " --quiet");
+  EXPECT_EQ(run.exit_code, 128 + 15) << run.output;
+  EXPECT_NE(run.output.find("interrupted by signal 15"), std::string::npos) << run.output;
+  ASSERT_TRUE(fs::exists(out())) << "the folder was made before the run";
+  EXPECT_TRUE(fs::is_empty(out())) << "no frames, no staging folder, no data files";
+}
+
+// Publishing replaces the whole set: a killed run's staging folder and the previous run's
+// files of the set go, files that are not the set's stay.
+TEST_F(BadInputTest, ARunReplacesThePreviousSetAndAKilledRunsLeftovers) {
+  const std::string data = generate_data();
+  dir_.write("data/.sigmafem-partial/observations.csv", "left by a run killed with SIGKILL");
+  dir_.write("data/notes.txt", "the user's own file");
+  dir_.write("data/box.pvd", "a series from a run with VTK frames");
+  const CommandRun run = run_sigmafem("generate " + dir_.file("box5.json") + " --out " + data + " --vtk-every 0 --quiet");
+  ASSERT_EQ(run.exit_code, 0) << run.output;
+  EXPECT_FALSE(fs::exists(data + "/.sigmafem-partial"));
+  EXPECT_FALSE(fs::exists(data + "/box.pvd")) << "a series of the old set does not stay beside the new data";
+  EXPECT_TRUE(fs::exists(data + "/notes.txt"));
+  EXPECT_TRUE(fs::exists(data + "/observations.csv"));
 }
 
 }  // namespace

@@ -144,7 +144,7 @@ TEST_F(GenerateTest, VtkSeriesListsEveryFrame) {
     EXPECT_NE(pvd.find(name), std::string::npos) << "pvd lists " << name;
     EXPECT_TRUE(fs::exists(dir_ / "vtk" / name)) << name;
   }
-  EXPECT_FALSE(fs::exists(dir_ / "vtk" / "vtk.partial")) << "the staging folder is gone";
+  EXPECT_FALSE(fs::exists(dir_ / "vtk" / ".sigmafem-partial")) << "the staging folder is gone";
 }
 
 }  // namespace
