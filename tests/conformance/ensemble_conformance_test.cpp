@@ -27,6 +27,7 @@
 #include "host/reference/implicit_euler.h"
 #include "host/reference/reference_simulation.h"
 #include "host/scenario/scenario.h"
+#include "requirement.h"
 
 namespace sigmafem {
 namespace {
@@ -98,7 +99,7 @@ class EnsembleConformance : public ::testing::TestWithParam<Case> {
  protected:
   void SetUp() override {
     const std::string why = unavailable(GetParam().backend);
-    if (!why.empty()) GTEST_SKIP() << why;
+    if (!why.empty()) SIGMAFEM_MISSING(why);
     scenario_ = load_scenario(std::string(SIGMAFEM_SOURCE_DIR) + "/scenarios/" +
                               GetParam().scenario + ".json");
     model_ = make_model(scenario_);
@@ -360,7 +361,7 @@ TEST_P(VulkanAgainstOpenCl, TrajectoriesAgree) {
   const Precision precision = GetParam();
   for (const char* backend : {"opencl", "vulkan"}) {
     const std::string why = unavailable({backend, precision, backend});
-    if (!why.empty()) GTEST_SKIP() << why;
+    if (!why.empty()) SIGMAFEM_MISSING(why);
   }
   const Scenario scenario = load_scenario(std::string(SIGMAFEM_SOURCE_DIR) + "/scenarios/box.json");
   const Model model = make_model(scenario);

@@ -9,6 +9,7 @@
 #include <filesystem>
 #include <sstream>
 
+#include "requirement.h"
 #include "temp_path.h"
 #include "tests/filter/scenario_filter_options.h"
 #include "filter/estimation.h"
@@ -40,7 +41,7 @@ TEST_P(WholeRun, EstimatesMatchTheCpuBackEnd) {
   std::string why;
   if (backend == "opencl" && list_opencl_devices().empty()) why = "no OpenCL platform on this machine";
   if (backend == "vulkan") list_vulkan_devices(&why);   // sets `why` when there is none
-  if (!why.empty()) GTEST_SKIP() << why;
+  if (!why.empty()) SIGMAFEM_MISSING(why);
   const Scenario s = load_scenario(std::string(SIGMAFEM_SOURCE_DIR) + "/scenarios/box.json");
   const fs::path dir = test::unique_temp_path("sigmafem_whole_run_test");
   GenerateOptions generate_options;

@@ -16,6 +16,7 @@
 #include <iostream>
 #include <sstream>
 
+#include "requirement.h"
 #include "temp_path.h"
 #include "host/common/input_error.h"
 #include "host/generator/generate.h"
@@ -351,20 +352,20 @@ TEST(DiagnoseBox, ATruthFromTheRefinedMeshClaimsNoWrongEffect) {
 bool opencl_missing() { return list_opencl_devices().empty(); }
 
 TEST(DiagnoseLiverOnOpenCl, FindsAnExtraLigamentAmongTheSurfaceRegions) {
-  if (opencl_missing()) GTEST_SKIP() << "no OpenCL platform on this machine";
+  if (opencl_missing()) SIGMAFEM_MISSING("no OpenCL platform on this machine");
   expect_found({"extra_ligament:surface_5", {250.0}}, {}, "liver_diagnose", "opencl");
 }
 
 TEST(DiagnoseLiverOnOpenCl, FindsATimeLag) {
   // A physics effect the device kernels take per sigma point (step_constants.h).
-  if (opencl_missing()) GTEST_SKIP() << "no OpenCL platform on this machine";
+  if (opencl_missing()) SIGMAFEM_MISSING("no OpenCL platform on this machine");
   // Against the effects that also shift the organ's response (a load, a rigid offset): the
   // whole library is the box tests' (DiagnoseBox); here 5 filter runs instead of 15 keep CI short.
   expect_found({"time_lag", {0.1}}, {"gravity", "camera_offset", "time_lag"}, "liver_diagnose", "opencl");
 }
 
 TEST(DiagnoseLiverOnOpenCl, CleanDataAddNothing) {
-  if (opencl_missing()) GTEST_SKIP() << "no OpenCL platform on this machine";
+  if (opencl_missing()) SIGMAFEM_MISSING("no OpenCL platform on this machine");
   const BoxData liver = box_data({}, 1, "liver_diagnose");
   DiagnoseOptions options;
   options.backend = "opencl";
@@ -389,7 +390,7 @@ namespace {
 // declared).
 // OpenCL float32 (about 20 s for the three fits).
 TEST(DiagnoseLiverOnOpenCl, TheDeclaredModelCompletesUnderAnUndeclaredFullGravity) {
-  if (opencl_missing()) GTEST_SKIP() << "no OpenCL platform on this machine";
+  if (opencl_missing()) SIGMAFEM_MISSING("no OpenCL platform on this machine");
   const BoxData liver = box_data({{"gravity", {4.005, -8.01, 4.005}}}, 1, "liver");
   DiagnoseOptions options;
   options.backend = "opencl";

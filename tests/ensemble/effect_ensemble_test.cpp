@@ -16,6 +16,7 @@
 #include "host/opencl/opencl_device.h"
 #include "host/vulkan/vulkan_device.h"
 #include "host/scenario/scenario.h"
+#include "requirement.h"
 
 namespace sigmafem {
 namespace {
@@ -81,13 +82,13 @@ class EffectEnsembleOnDevice : public EffectEnsembleTest, public ::testing::With
 TEST_P(EffectEnsembleOnDevice, AnExtraLigamentAndACameraOffsetRunAsOnTheCpu) {
   if (GetParam() == "opencl") {
     const auto devices = list_opencl_devices();
-    if (devices.empty()) GTEST_SKIP() << "no OpenCL platform on this machine";
-    if (!devices[0].has_fp64) GTEST_SKIP() << "OpenCL device 0 has no fp64";
+    if (devices.empty()) SIGMAFEM_MISSING("no OpenCL platform on this machine");
+    if (!devices[0].has_fp64) SIGMAFEM_MISSING("OpenCL device 0 has no fp64");
   } else {
     std::string why;
     const auto devices = list_vulkan_devices(&why);
-    if (devices.empty()) GTEST_SKIP() << why;
-    if (!devices[0].has_fp64) GTEST_SKIP() << "Vulkan device 0 has no shaderFloat64";
+    if (devices.empty()) SIGMAFEM_MISSING(why);
+    if (!devices[0].has_fp64) SIGMAFEM_MISSING("Vulkan device 0 has no shaderFloat64");
   }
   DeviceOptions options;
   options.precision = Precision::double_precision;
@@ -125,7 +126,7 @@ TEST_P(EffectEnsembleOnDevice, AnExtraLigamentAndACameraOffsetRunAsOnTheCpu) {
 
 TEST_P(EffectEnsembleOnDevice, EveryPhysicsEffectPerSigmaPointRunsAsOnTheCpu) {
   if (GetParam() == "opencl" ? list_opencl_devices().empty() : list_vulkan_devices().empty())
-    GTEST_SKIP() << GetParam() << ": no device";
+    SIGMAFEM_MISSING(GetParam() << ": no device");
   // The per-sigma constants of the device kernels (step_constants.h), on a model that
   // declares a lag and a law of its own (the per-sigma values are relative to them), each
   // sigma point with its own values.
@@ -147,7 +148,7 @@ TEST_P(EffectEnsembleOnDevice, EveryPhysicsEffectPerSigmaPointRunsAsOnTheCpu) {
     device = EffectEnsemble::make(GetParam(), model, scenario_.filter->estimate, scenario_.observations.nodes,
                                   kSigma, options, effects);
   } catch (const DeviceError& e) {
-    GTEST_SKIP() << e.what();
+    SIGMAFEM_MISSING(e.what());
   }
   cpu->set_parameters(theta);
   device->set_parameters(theta);

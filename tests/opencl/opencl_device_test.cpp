@@ -10,6 +10,7 @@
 #include "host/model/model.h"
 #include "host/opencl/opencl_ensemble.h"
 #include "host/scenario/scenario.h"
+#include "requirement.h"
 
 namespace sigmafem {
 namespace {
@@ -17,7 +18,7 @@ namespace {
 class OpenClDeviceTest : public ::testing::Test {
  protected:
   void SetUp() override {
-    if (list_opencl_devices().empty()) GTEST_SKIP() << "no OpenCL platform on this machine";
+    if (list_opencl_devices().empty()) SIGMAFEM_MISSING("no OpenCL platform on this machine");
   }
 };
 

@@ -16,6 +16,7 @@
 #include <set>
 #include <sstream>
 
+#include "requirement.h"
 #include "temp_path.h"
 #include "host/common/input_error.h"
 #include "host/scenario/scenario.h"
@@ -817,7 +818,7 @@ TEST(ShippedScenarioTest, LiverLoads) {
 
 TEST(ShippedScenarioTest, SofaReferenceScenarioLoads) {
   const std::string reference = kSharedDir + "/data/sofa-reference";
-  if (!fs::exists(reference + "/scenario.json")) GTEST_SKIP() << "no " << reference;
+  if (!fs::exists(reference + "/scenario.json")) SIGMAFEM_MISSING("no " << reference);
   TempDir dir;
   dir.copy(reference + "/scenario.json", "scenario.json");
   dir.copy(reference + "/traj.csv", "traj.csv");
