@@ -2,7 +2,8 @@
 # sigmafem set-up on a Debian machine (bookworm or later):
 #   ./setup.sh run    install what is missing, build, run the main job on the default scenario
 #   ./setup.sh test   install what is missing, build, run the whole test suite: a Release build
-#                     with warnings as errors, then a build with AddressSanitizer and
+#                     with warnings as errors, the readers' fuzzers (SIGMAFEM_FUZZ_SECONDS
+#                     each, default 60), then a build with AddressSanitizer and
 #                     UndefinedBehaviorSanitizer
 # Debian packages are the only dependencies; apt-get runs only when one is missing (through
 # sudo when not root).
@@ -19,6 +20,8 @@ packages="g++ cmake ninja-build pkg-config libeigen3-dev nlohmann-json3-dev libc
           libgtest-dev libbenchmark-dev gnuplot-nox
           ocl-icd-opencl-dev opencl-clhpp-headers pocl-opencl-icd
           libvulkan-dev glslang-tools mesa-vulkan-drivers vulkan-validationlayers"
+# The tests also fuzz the input readers: clang with libFuzzer (tests/fuzz/).
+[ "$mode" = test ] && packages="$packages clang libclang-rt-dev"
 missing=""
 for p in $packages; do
   dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q 'ok installed' || missing="$missing $p"
@@ -45,6 +48,12 @@ echo "== tests (Release)"
 # instead of skipping (tests/requirement.h): the packages above provide them all.
 export SIGMAFEM_TESTS_REQUIRE=all
 ctest --test-dir build --output-on-failure -j "$jobs"
+fuzz_seconds=${SIGMAFEM_FUZZ_SECONDS:-60}
+echo "== fuzzing the input readers (libFuzzer with ASan and UBSan, $fuzz_seconds s each)"
+cmake -S tests/fuzz -B build-fuzz -G Ninja -DCMAKE_CXX_COMPILER=clang++ \
+  -DSIGMAFEM_FUZZ_SECONDS="$fuzz_seconds" >/dev/null
+cmake --build build-fuzz -j "$jobs"
+ctest --test-dir build-fuzz --output-on-failure -j "$jobs"
 echo "== building with AddressSanitizer and UndefinedBehaviorSanitizer"
 cmake -S . -B build-sanitize -G Ninja -DCMAKE_BUILD_TYPE=RelWithDebInfo -DSIGMAFEM_WERROR=ON \
   -DSIGMAFEM_SANITIZE=ON -DSIGMAFEM_BENCH=OFF >/dev/null
