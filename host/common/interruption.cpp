@@ -9,7 +9,12 @@ namespace {
 
 volatile std::sig_atomic_t g_signal = 0;
 
-extern "C" void record_signal(int signal_number) { g_signal = signal_number; }
+// Records the signal and restores the default action, so that a second Ctrl-C ends a run at
+// once where no loop checks (a hung device, a long mesh refinement).
+extern "C" void record_signal(int signal_number) {
+  g_signal = signal_number;
+  std::signal(signal_number, SIG_DFL);
+}
 
 }  // namespace
 

@@ -2,6 +2,7 @@
 // the signal; the long loops (every Progress::update, every filter step) call
 // throw_if_interrupted(), whose exception unwinds the run, so that destructors remove staging
 // folders and temporary files (host/common/output_set.h), and main exits 128 + the signal.
+// A second signal takes the default action at once (for a run stuck where no loop checks).
 #pragma once
 
 #include <stdexcept>
