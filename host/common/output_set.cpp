@@ -61,7 +61,6 @@ void OutputSet::publish() {
     if (name != marker_) move_into_place(entry.path(), out / name);
   }
   if (fs::exists(staging / marker_)) move_into_place(staging / marker_, out / marker_);
-  published_ = true;
   fs::remove_all(staging, error);
 }
 

@@ -21,7 +21,7 @@ class OutputSet {
   // Creates `out_dir` (InputError if it cannot) and a fresh staging folder in it. `names`: every
   // file or folder the command may write, `marker` among them.
   OutputSet(std::string out_dir, std::vector<std::string> names, std::string marker);
-  // Removes the staging folder unless published.
+  // Removes the staging folder (empty once published).
   ~OutputSet();
   OutputSet(const OutputSet&) = delete;
   OutputSet& operator=(const OutputSet&) = delete;
@@ -38,7 +38,6 @@ class OutputSet {
  private:
   std::string out_dir_, staging_dir_, marker_;
   std::vector<std::string> names_;
-  bool published_ = false;
 };
 
 }  // namespace sigmafem
