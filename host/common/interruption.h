@@ -2,7 +2,9 @@
 // the signal; the long loops (every Progress::update, every filter step) call
 // throw_if_interrupted(), whose exception unwinds the run, so that destructors remove staging
 // folders and temporary files (host/common/output_set.h), and main exits 128 + the signal.
-// A second signal takes the default action at once (for a run stuck where no loop checks).
+// A second signal, more than half a second after the first, takes the default action at once
+// (for a run stuck where no loop checks); a repeat within that time is the same request (the
+// signal sent to the program and then to its process group, as `timeout` does).
 #pragma once
 
 #include <stdexcept>
