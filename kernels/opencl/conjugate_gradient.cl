@@ -78,11 +78,14 @@ void cg_start(uint S, uint node_count, __global const real* c, __global const re
   sum_rr = sf_group_sum(scratch, sum_rr);
   sum_rz = sf_group_sum(scratch, sum_rz);
   if (get_local_id(0) == 0) {
-    int done = sum_bb == (real)0 || sum_rr <= c[SF_CG_TOLERANCE2] * sum_bb;
+    /* An overflowed load (|b|^2 not finite) would pass the stop test as inf <= inf: a
+     * breakdown instead, neither converged nor iterating, as in the CPU reference. */
+    int breakdown = !isfinite(sum_bb) || !isfinite(sum_rr);
+    int done = !breakdown && (sum_bb == (real)0 || sum_rr <= c[SF_CG_TOLERANCE2] * sum_bb);
     bb[s] = sum_bb;
     rr[s] = sum_rr;
     rz[s] = sum_rz;
-    active[s] = done ? 0u : 1u;
+    active[s] = done || breakdown ? 0u : 1u;
     converged[s] = done ? 1u : 0u;
     iterations[s] = 0;
   }
@@ -190,14 +193,15 @@ static inline __attribute__((always_inline)) int sf_block_cg_start(
   int any = 0;
   for (uint i = 0; i < count; ++i) {
     uint s = first + i;
-    int done = sum_bb[i] == (real)0 || sum_rr[i] <= c[SF_CG_TOLERANCE2] * sum_bb[i];
+    int breakdown = !isfinite(sum_bb[i]) || !isfinite(sum_rr[i]);   /* as in cg_start above */
+    int done = !breakdown && (sum_bb[i] == (real)0 || sum_rr[i] <= c[SF_CG_TOLERANCE2] * sum_bb[i]);
     bb[s] = sum_bb[i];
     rr[s] = sum_rr[i];
     rz[s] = sum_rz[i];
-    active[s] = done ? 0u : 1u;
+    active[s] = done || breakdown ? 0u : 1u;
     converged[s] = done ? 1u : 0u;
     iterations[s] = 0;
-    any |= !done;
+    any |= !(done || breakdown);
   }
   return any;
 }

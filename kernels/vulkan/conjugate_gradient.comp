@@ -89,11 +89,14 @@ void main() {
   sum_rr = sf_group_sum(sum_rr);
   sum_rz = sf_group_sum(sum_rz);
   if (gl_LocalInvocationID.x == 0u) {
-    bool done = sum_bb == real(0) || sum_rr <= c[SF_CG_TOLERANCE2] * sum_bb;
+    // An overflowed load (|b|^2 not finite) would pass the stop test as inf <= inf: a
+    // breakdown instead, neither converged nor iterating, as in the CPU reference.
+    bool breakdown = isinf(sum_bb) || isnan(sum_bb) || isinf(sum_rr) || isnan(sum_rr);
+    bool done = !breakdown && (sum_bb == real(0) || sum_rr <= c[SF_CG_TOLERANCE2] * sum_bb);
     bb[s] = sum_bb;
     rr[s] = sum_rr;
     rz[s] = sum_rz;
-    active_flags[s] = done ? 0u : 1u;
+    active_flags[s] = done || breakdown ? 0u : 1u;
     converged[s] = done ? 1u : 0u;
     iterations[s] = 0;
   }

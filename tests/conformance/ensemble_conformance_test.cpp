@@ -358,6 +358,21 @@ TEST_P(EnsembleConformance, IterationCapIsReported) {
     EXPECT_EQ(report.cg_iterations[s], 2);
     EXPECT_GT(report.relative_residual[s], device->cg_tolerance());
   }
+
+  // A load whose |b|^2 overflows (in float32 and in float64) made the stop test inf <= inf,
+  // and CG "converged" after no iteration with nothing solved: it is a breakdown, reported as
+  // not converged with a residual that is not a number, as by the CPU reference.
+  Model overflowing = model_;
+  overflowing.gravity = Eigen::Vector3d(0.0, 0.0, -1e200);
+  auto broken = device_ensemble(overflowing);
+  broken->set_parameters(theta_);
+  const StepReport breakdown = broken->advance(so(1));
+  ASSERT_EQ(static_cast<int>(breakdown.converged.size()), S_);
+  EXPECT_EQ(breakdown.unconverged_count(), S_);
+  for (int s = 0; s < S_; ++s) {
+    EXPECT_EQ(breakdown.cg_iterations[s], 0) << "no iteration on a load that is not finite";
+    EXPECT_FALSE(breakdown.relative_residual[s] <= device->cg_tolerance()) << breakdown.relative_residual[s];
+  }
 }
 
 // Every back end on both scenarios with S = 1, 4, 16; but Vulkan in double precision and the
