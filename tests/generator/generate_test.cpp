@@ -147,5 +147,24 @@ TEST_F(GenerateTest, VtkSeriesListsEveryFrame) {
   EXPECT_FALSE(fs::exists(dir_ / "vtk" / ".sigmafem-partial")) << "the staging folder is gone";
 }
 
+// A simulation whose solve breaks down (here a load that overflows: a scenario file cannot
+// hold one, its numbers are bounded, but a program building a Scenario can) stops with the step
+// and time, and writes nothing: no garbage trajectory under the final names.
+TEST_F(GenerateTest, ADivergingSimulationNamesItsStepAndWritesNothing) {
+  scenario_.gravity = Eigen::Vector3d(0.0, 0.0, -1e300);
+  try {
+    run("diverged", 1, 10);
+    FAIL() << "generate completed on an overflowing load";
+  } catch (const std::runtime_error& e) {
+    const std::string message = e.what();
+    EXPECT_NE(message.find("diverged at step 1 (t = 0.01 s)"), std::string::npos) << message;
+    EXPECT_NE(message.find("residual is not finite"), std::string::npos) << message;
+  }
+  EXPECT_FALSE(fs::exists(dir_ / "diverged" / "observations.csv"));
+  EXPECT_FALSE(fs::exists(dir_ / "diverged" / "truth.csv"));
+  EXPECT_FALSE(fs::exists(dir_ / "diverged" / (scenario_.name + ".pvd")));
+  EXPECT_FALSE(fs::exists(dir_ / "diverged" / ".sigmafem-partial")) << "the staging folder is removed";
+}
+
 }  // namespace
 }  // namespace sigmafem
