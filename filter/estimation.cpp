@@ -23,7 +23,9 @@ EstimationRun run_estimation(Ensemble& ensemble, const EstimationOptions& option
   LigamentCutRule cut_rule(options.cut, static_cast<int>(stiffnesses));
   EstimationRun run;
   std::deque<bool> scaled;   // the last 2W steps: did the correction use lambda > 1?
-  int catch_up_start = -1;   // index into run.steps of the firing that began the catch-up; -1: none
+  int catch_up_start = -1;   // step index (made steps, from 0) of the firing that began the catch-up; -1: none
+  int dropped = 0;           // steps made and no longer kept (keep_all_steps false)
+  const auto W = static_cast<std::size_t>(options.detector.window);
   for (Eigen::Index k = 1; k < so.rows(); ++k) {
     const auto start = std::chrono::steady_clock::now();
     EstimationStep step;
@@ -67,7 +69,6 @@ EstimationRun run_estimation(Ensemble& ensemble, const EstimationOptions& option
     // stayed 1 over the W steps before the detector's window of W (the adaptive noise, on a
     // shorter window, may engage inside it); then P opens and lambda stays 1 while the filter
     // follows. In the first 2W steps there is no such history and the detector is not armed.
-    const auto W = static_cast<std::size_t>(options.detector.window);
     scaled.push_back(result.noise_scale > 1.0);   // scaled[i]: step k - scaled.size() + 1 + i
     if (scaled.size() > 2 * W) scaled.pop_front();
     const bool armed = scaled.size() == 2 * W && std::none_of(scaled.begin(), scaled.begin() + W, [](bool b) { return b; });
@@ -79,7 +80,7 @@ EstimationRun run_estimation(Ensemble& ensemble, const EstimationOptions& option
       // The change began inside the window that fired: its earlier steps are part of the
       // catch-up. A firing during a catch-up continues it (the cap counts from its start).
       if (catch_up_start < 0) {
-        catch_up_start = static_cast<int>(run.steps.size());
+        catch_up_start = dropped + static_cast<int>(run.steps.size());
         // The estimate before the change began (the step before the window that fired) is
         // what a cut is measured against.
         if (!run.steps.empty()) {
@@ -94,7 +95,7 @@ EstimationRun run_estimation(Ensemble& ensemble, const EstimationOptions& option
       }
     }
     if (catch_up_start >= 0) {
-      const int since = static_cast<int>(run.steps.size()) - catch_up_start;   // 0: the firing step
+      const int since = dropped + static_cast<int>(run.steps.size()) - catch_up_start;   // 0: the firing step
       // Over when the NIS is back (settled) and the innovations' mean too (RecoveryCheck).
       if ((since > options.detector.hold_off && detector.settled() && recovery.recovered()) ||
           since >= options.detector.max_catch_up) {
@@ -113,6 +114,10 @@ EstimationRun run_estimation(Ensemble& ensemble, const EstimationOptions& option
     filter.hold_constants(catch_up_start >= 0);
     step.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
     run.steps.push_back(step);
+    if (!options.keep_all_steps && run.steps.size() > W) {   // the look-back above needs W
+      run.steps.erase(run.steps.begin());
+      ++dropped;
+    }
     if (on_step) on_step(step);
     for (Eigen::Index j = 0; j < stiffnesses; ++j) {
       const double k_j = step.stiffness[j];

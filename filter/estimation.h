@@ -35,6 +35,10 @@ struct EstimationOptions {
   // above; the rest (effect parameters, host/model/effects.h) are not stiffnesses.
   // -1: all of them.
   int stiffness_count = -1;
+  // false: the run keeps only the steps the change detection looks back on (its window), so
+  // that memory stays flat over an unbounded run (a navigation session; the soak run,
+  // bench/soak_main.cpp); on_step sees every step. true: every step, for the reports.
+  bool keep_all_steps = true;
 };
 
 struct EstimationStep {
@@ -84,7 +88,8 @@ struct LigamentCut {
 };
 
 struct EstimationRun {
-  std::vector<EstimationStep> steps;   // one per data row after the first
+  std::vector<EstimationStep> steps;   // one per data row after the first (with
+                                       // keep_all_steps false: the last few of them)
   bool complete = true;
   std::string stop_reason;             // why it stopped early ("" when complete)
   int changes_detected = 0;

@@ -1,4 +1,4 @@
-// A whole box estimation (1500 steps, the cut, 0.5 mm noise, simplex) on a device back end
+// A whole box estimation (the cut at step 750 and 250 steps after it, 0.5 mm noise, simplex) on a device back end
 // agrees with the same run on the CPU back end: every estimate at every step within 0.5%
 // (issues 4 and 5), for every device back end present (OpenCL, Vulkan). The device runs in float32 with a CG tolerance of 1e-6; the filter sees the
 // observed positions to about 1e-7 m (tests/conformance/ensemble_conformance_test.cpp)
@@ -42,7 +42,12 @@ TEST_P(WholeRun, EstimatesMatchTheCpuBackEnd) {
   if (backend == "opencl" && list_opencl_devices().empty()) why = "no OpenCL platform on this machine";
   if (backend == "vulkan") list_vulkan_devices(&why);   // sets `why` when there is none
   if (!why.empty()) SIGMAFEM_MISSING(why);
-  const Scenario s = load_scenario(std::string(SIGMAFEM_SOURCE_DIR) + "/scenarios/box.json");
+  Scenario s = load_scenario(std::string(SIGMAFEM_SOURCE_DIR) + "/scenarios/box.json");
+  // The shipped 1500 steps took 280 s on lavapipe (2-core machine); the last 500 add nothing
+  // to the comparison: the cut is at step 750, and the middle ligament's estimate is down
+  // from 284 to 14 N/m by step 800 and 3 N/m by step 1000 (estimates.csv of `sigmafem
+  // estimate scenarios/box.json`, seed 1), the filter following the cut through its drift.
+  s.time.steps = 1000;
   const fs::path dir = test::unique_temp_path("sigmafem_whole_run_test");
   GenerateOptions generate_options;
   generate_options.out_dir = dir.string();
