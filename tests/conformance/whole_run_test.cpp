@@ -6,16 +6,12 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
-#include <filesystem>
-#include <sstream>
 
+#include "generated_data.h"
 #include "requirement.h"
-#include "temp_path.h"
 #include "tests/filter/scenario_filter_options.h"
 #include "filter/estimation.h"
-#include "host/data/observation_table.h"
 #include "host/ensemble/make_ensemble.h"
-#include "host/generator/generate.h"
 #include "host/model/model.h"
 #include "host/opencl/opencl_device.h"
 #include "host/vulkan/vulkan_device.h"
@@ -23,7 +19,6 @@
 
 namespace sigmafem {
 namespace {
-namespace fs = std::filesystem;
 
 EstimationRun estimate_box(const Scenario& s, const ObservationTable& data,
                            const std::string& backend) {
@@ -48,15 +43,7 @@ TEST_P(WholeRun, EstimatesMatchTheCpuBackEnd) {
   // from 284 to 14 N/m by step 800 and 3 N/m by step 1000 (estimates.csv of `sigmafem
   // estimate scenarios/box.json`, seed 1), the filter following the cut through its drift.
   s.time.steps = 1000;
-  const fs::path dir = test::unique_temp_path("sigmafem_whole_run_test");
-  GenerateOptions generate_options;
-  generate_options.out_dir = dir.string();
-  generate_options.vtk_every = 0;
-  std::ostringstream log;
-  generate(s, generate_options, log);
-  const ObservationTable data = read_observations_csv(
-      (dir / "observations.csv").string(), static_cast<int>(s.observations.nodes.size()), s.time.dt);
-  fs::remove_all(dir);
+  const ObservationTable data = test::generated_observations(s);
 
   const EstimationRun cpu = estimate_box(s, data, "cpu");
   const EstimationRun device = estimate_box(s, data, backend);

@@ -6,21 +6,14 @@
 
 #include <gtest/gtest.h>
 
-#include <cmath>
-#include <filesystem>
-#include <sstream>
-
-#include "temp_path.h"
-#include "host/data/observation_table.h"
+#include "generated_data.h"
 #include "host/ensemble/cpu_ensemble.h"
-#include "host/generator/generate.h"
 #include "host/model/model.h"
 #include "host/scenario/estimation_options.h"
 #include "host/scenario/scenario.h"
 
 namespace sigmafem {
 namespace {
-namespace fs = std::filesystem;
 
 TEST(EstimationHistory, KeepingOnlyTheWindowChangesNothingButMemory) {
   // The box pulled five times as fast, so that at step 150 of 300 it is as far as the
@@ -34,15 +27,7 @@ TEST(EstimationHistory, KeepingOnlyTheWindowChangesNothingButMemory) {
   // ChangeDetectorFiresOnTheCutWithASmallDrift: the innovations after the cut stay large
   // enough for the detector.
   s.observations.noise_std = 0.0;
-  const fs::path dir = test::unique_temp_path("sigmafem_estimation_test");
-  GenerateOptions generate_options;
-  generate_options.out_dir = dir.string();
-  generate_options.vtk_every = 0;
-  std::ostringstream log;
-  generate(s, generate_options, log);
-  const ObservationTable data = read_observations_csv(
-      (dir / "observations.csv").string(), static_cast<int>(s.observations.nodes.size()), s.time.dt);
-  fs::remove_all(dir);
+  const ObservationTable data = test::generated_observations(s);
 
   auto run = [&](bool keep_all_steps, std::vector<EstimationStep>& seen) {
     EstimationOptions options = estimation_options(s);
