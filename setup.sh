@@ -66,7 +66,8 @@ echo "== tests (sanitizers)"
 # each on 2 cores); they ran above in the Release build, and EstimationLoop covers the same
 # code here in 80 steps, and so does the bounded-history check (EstimationHistory: two
 # 300-step box runs). Likewise the device conformance tests whose time goes into long
-# CPU-reference runs (200-step trajectories, repeated runs, 16 sigma points, the whole-run
+# CPU-reference runs (200-step trajectories and the reference they share, conformance_reference;
+# repeated runs, 16 sigma points, the whole-run
 # comparison) ran above; the one-step, re-centring and iteration-cap tests with 1 and 4
 # sigma points run here and cover the same host code. The residual diagnostics' two 100-step
 # box runs (ResidualDiagnosticsBox) ran above too; their synthetic tests run here. So did the
@@ -93,5 +94,5 @@ echo "== tests (sanitizers)"
 # next on none.
 ASAN_OPTIONS=detect_leaks=1:abort_on_error=1:intercept_tls_get_addr=0 UBSAN_OPTIONS=print_stacktrace=1:halt_on_error=1 \
   ctest --test-dir build-sanitize --output-on-failure -j "$jobs" \
-  -E 'TruthMeshTest.SpreadSprings|BoxEstimation|EstimationHistory|ResidualDiagnosticsBox|DiagnoseBox|DiagnoseLiver|CliTest.Diagnose|SofaReference|SofaData|WholeRun|VulkanAgainstOpenCl|vulkan_validation|Conformance.*(Trajectory|TwoRuns|_S16|VulkanDouble)'
+  -E 'conformance_reference|TruthMeshTest.SpreadSprings|BoxEstimation|EstimationHistory|ResidualDiagnosticsBox|DiagnoseBox|DiagnoseLiver|CliTest.Diagnose|SofaReference|SofaData|WholeRun|VulkanAgainstOpenCl|vulkan_validation|Conformance.*(Trajectory|TwoRuns|_S16|VulkanDouble)'
 

@@ -18,6 +18,10 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <cstdint>
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
 #include <iostream>
 #include <map>
 #include <memory>
@@ -85,6 +89,117 @@ std::string unavailable(const BackendCase& c) {
   return "";
 }
 
+// Sigma point s's log-stiffnesses: the scenario's times 0.5 .. 2, the same for every S (so a
+// case with S sigma points is the first S columns of one with more).
+Eigen::MatrixXd sigma_theta(const Model& model, const std::vector<int>& estimated, int S) {
+  Eigen::MatrixXd theta(static_cast<Eigen::Index>(estimated.size()), S);
+  for (int s = 0; s < S; ++s)
+    for (std::size_t j = 0; j < estimated.size(); ++j)
+      theta(static_cast<Eigen::Index>(j), s) =
+          std::log(model.ligaments[estimated[j]].stiffness *
+                   std::pow(2.0, std::sin(1.0 + 3.0 * s + 1.7 * static_cast<double>(j))));
+  return theta;
+}
+
+Scenario conformance_scenario(const std::string& name) {
+  return load_scenario(std::string(SIGMAFEM_SOURCE_DIR) + "/scenarios/" + name + ".json");
+}
+
+Eigen::Vector3d so_position(const Scenario& scenario, int step) {
+  return scenario.control.trajectory.position(step * scenario.time.dt, scenario.control.start);
+}
+
+// The trajectory of TrajectoryWithACutFollowsTheReference: 200 steps, the estimated middle
+// ligament cut to 0.01 N/m at step 101.
+constexpr int kTrajectorySteps = 200;
+constexpr int kCutStep = 101;
+void cut_middle_ligament(Eigen::MatrixXd& theta) { theta.row(1).setConstant(std::log(0.01)); }
+
+// The most sigma points a case has (all_cases below).
+constexpr int kMostSigmaPoints = 16;
+
+// The CPU reference's observed positions over that trajectory, one 3m x S matrix per step.
+// The reference is most of a device case's time (a 16-sigma-point double-precision run is
+// about 80% of an OpenCL case), and it is the same for every back end: ctest computes it once
+// per scenario for kMostSigmaPoints (ConformanceReference.*, a ctest fixture of the
+// trajectory cases: tests/CMakeLists.txt) and names the folder of its files in
+// SIGMAFEM_CONFORMANCE_REFERENCE; a case run alone computes the S columns it needs.
+using ObservedTrajectory = std::vector<Eigen::MatrixXd>;
+
+ObservedTrajectory reference_trajectory(const Scenario& scenario, int S) {
+  const Model model = make_model(scenario);
+  const std::vector<int>& estimated = scenario.filter->estimate;
+  CpuEnsemble reference(model, estimated, scenario.observations.nodes, S);
+  Eigen::MatrixXd theta = sigma_theta(model, estimated, S);
+  reference.set_parameters(theta);
+  ObservedTrajectory y(kTrajectorySteps);
+  for (int k = 1; k <= kTrajectorySteps; ++k) {
+    if (k == kCutStep) {
+      cut_middle_ligament(theta);
+      reference.set_parameters(theta);
+    }
+    const StepReport report = reference.advance(so_position(scenario, k));
+    EXPECT_EQ(report.unconverged_count(), 0) << "reference, step " << k;
+    reference.predicted_observations(y[k - 1]);
+  }
+  return y;
+}
+
+std::filesystem::path reference_file(const std::string& folder, const std::string& scenario) {
+  return std::filesystem::path(folder) / (scenario + ".bin");
+}
+
+// Raw doubles after three int32 sizes (steps, rows, columns); written under a temporary name
+// and renamed, so that a reader never sees half a file.
+void write_reference(const std::filesystem::path& path, const ObservedTrajectory& y) {
+  std::filesystem::create_directories(path.parent_path());
+  const std::filesystem::path staging = path.string() + ".partial";
+  {
+    std::ofstream out(staging, std::ios::binary);
+    const std::int32_t sizes[3] = {static_cast<std::int32_t>(y.size()), static_cast<std::int32_t>(y[0].rows()),
+                                   static_cast<std::int32_t>(y[0].cols())};
+    out.write(reinterpret_cast<const char*>(sizes), sizeof sizes);
+    for (const Eigen::MatrixXd& m : y)
+      out.write(reinterpret_cast<const char*>(m.data()), static_cast<std::streamsize>(sizeof(double) * m.size()));
+    ASSERT_TRUE(out.good()) << "writing " << staging;
+  }
+  std::filesystem::rename(staging, path);
+}
+
+// The first S columns of the fixture's file for `scenario`, or, without one, a fresh run.
+ObservedTrajectory shared_reference_trajectory(const Scenario& scenario, const std::string& name, int S) {
+  const char* folder = std::getenv("SIGMAFEM_CONFORMANCE_REFERENCE");
+  if (folder == nullptr) return reference_trajectory(scenario, S);
+  const std::filesystem::path path = reference_file(folder, name);
+  std::ifstream in(path, std::ios::binary);
+  std::int32_t sizes[3] = {0, 0, 0};
+  in.read(reinterpret_cast<char*>(sizes), sizeof sizes);
+  const auto rows = static_cast<Eigen::Index>(3 * scenario.observations.nodes.size());
+  if (!in || sizes[0] != kTrajectorySteps || sizes[1] != rows || sizes[2] < S) {
+    ADD_FAILURE() << "SIGMAFEM_CONFORMANCE_REFERENCE is set, but " << path
+                  << " is missing or holds other sizes (ctest runs ConformanceReference.* first)";
+    return reference_trajectory(scenario, S);
+  }
+  ObservedTrajectory y(kTrajectorySteps, Eigen::MatrixXd(rows, sizes[2]));
+  for (Eigen::MatrixXd& m : y)
+    in.read(reinterpret_cast<char*>(m.data()), static_cast<std::streamsize>(sizeof(double) * m.size()));
+  EXPECT_TRUE(in.good()) << "reading " << path;
+  for (Eigen::MatrixXd& m : y) m = Eigen::MatrixXd(m.leftCols(S));
+  return y;
+}
+
+// The fixture: with SIGMAFEM_CONFORMANCE_REFERENCE set (by ctest) it writes the file;
+// alone, it checks that the reference converges on every step of the trajectory.
+void compute_reference(const std::string& name) {
+  const ObservedTrajectory y = reference_trajectory(conformance_scenario(name), kMostSigmaPoints);
+  for (const Eigen::MatrixXd& m : y) ASSERT_TRUE(m.allFinite());
+  if (const char* folder = std::getenv("SIGMAFEM_CONFORMANCE_REFERENCE"))
+    write_reference(reference_file(folder, name), y);
+}
+
+TEST(ConformanceReference, Box) { compute_reference("box"); }
+TEST(ConformanceReference, Liver) { compute_reference("liver"); }
+
 struct Case {
   BackendCase backend;
   std::string scenario;
@@ -106,19 +221,13 @@ class EnsembleConformance : public ::testing::TestWithParam<Case> {
   void SetUp() override {
     const std::string why = unavailable(GetParam().backend);
     if (!why.empty()) SIGMAFEM_MISSING(why);
-    scenario_ = load_scenario(std::string(SIGMAFEM_SOURCE_DIR) + "/scenarios/" +
-                              GetParam().scenario + ".json");
+    scenario_ = conformance_scenario(GetParam().scenario);
     model_ = make_model(scenario_);
     S_ = GetParam().sigma_count;
     single_ = GetParam().backend.precision == Precision::single;
-    // Every sigma point gets its own stiffnesses: the scenario's times 0.5 .. 2.
+    // Every sigma point gets its own stiffnesses.
     estimated_ = scenario_.filter->estimate;
-    theta_.resize(static_cast<Eigen::Index>(estimated_.size()), S_);
-    for (int s = 0; s < S_; ++s)
-      for (std::size_t j = 0; j < estimated_.size(); ++j)
-        theta_(static_cast<Eigen::Index>(j), s) =
-            std::log(model_.ligaments[estimated_[j]].stiffness *
-                     std::pow(2.0, std::sin(1.0 + 3.0 * s + 1.7 * static_cast<double>(j))));
+    theta_ = sigma_theta(model_, estimated_, S_);
   }
 
   std::unique_ptr<DeviceEnsemble> device_ensemble(const Model& model) const {
@@ -131,9 +240,7 @@ class EnsembleConformance : public ::testing::TestWithParam<Case> {
     return std::unique_ptr<DeviceEnsemble>(dynamic_cast<DeviceEnsemble*>(ensemble.release()));
   }
 
-  Eigen::Vector3d so(int step) const {
-    return scenario_.control.trajectory.position(step * scenario_.time.dt, scenario_.control.start);
-  }
+  Eigen::Vector3d so(int step) const { return so_position(scenario_, step); }
 
   // A lone reference simulation with sigma point s's stiffnesses.
   ReferenceSimulation reference(int s) const {
@@ -251,26 +358,23 @@ TEST_P(EnsembleConformance, KernelsOfOneStepMatchTheReference) {
 // 200 steps with the middle ligament cut half way, every sigma point against the reference
 // ensemble, all observed positions at every step.
 TEST_P(EnsembleConformance, TrajectoryWithACutFollowsTheReference) {
+  const ObservedTrajectory y_reference = shared_reference_trajectory(scenario_, GetParam().scenario, S_);
+  ASSERT_FALSE(HasFailure());
   auto device = device_ensemble(model_);
-  CpuEnsemble reference(model_, estimated_, scenario_.observations.nodes, S_);
   Eigen::MatrixXd theta = theta_;
   device->set_parameters(theta);
-  reference.set_parameters(theta);
   double largest = 0.0;
   int worst_step = 0;
-  Eigen::MatrixXd y_device, y_reference;
-  for (int k = 1; k <= 200; ++k) {
-    if (k == 101) {  // the cut: the estimated middle ligament drops to 0.01 N/m
-      theta.row(1).setConstant(std::log(0.01));
+  Eigen::MatrixXd y_device;
+  for (int k = 1; k <= kTrajectorySteps; ++k) {
+    if (k == kCutStep) {
+      cut_middle_ligament(theta);
       device->set_parameters(theta);
-      reference.set_parameters(theta);
     }
     const StepReport report = device->advance(so(k));
     ASSERT_EQ(report.unconverged_count(), 0) << "step " << k;
-    reference.advance(so(k));
     device->predicted_observations(y_device);
-    reference.predicted_observations(y_reference);
-    const double difference = (y_device - y_reference).cwiseAbs().maxCoeff();
+    const double difference = (y_device - y_reference[k - 1]).cwiseAbs().maxCoeff();
     if (difference > largest) {
       largest = difference;
       worst_step = k;
@@ -415,16 +519,11 @@ TEST_P(VulkanAgainstOpenCl, TrajectoriesAgree) {
     const std::string why = unavailable({backend, precision, backend});
     if (!why.empty()) SIGMAFEM_MISSING(why);
   }
-  const Scenario scenario = load_scenario(std::string(SIGMAFEM_SOURCE_DIR) + "/scenarios/box.json");
+  const Scenario scenario = conformance_scenario("box");
   const Model model = make_model(scenario);
   const int S = 4;
   const std::vector<int>& estimated = scenario.filter->estimate;
-  Eigen::MatrixXd theta(static_cast<Eigen::Index>(estimated.size()), S);
-  for (int s = 0; s < S; ++s)
-    for (std::size_t j = 0; j < estimated.size(); ++j)
-      theta(static_cast<Eigen::Index>(j), s) =
-          std::log(model.ligaments[estimated[j]].stiffness *
-                   std::pow(2.0, std::sin(1.0 + 3.0 * s + 1.7 * static_cast<double>(j))));
+  Eigen::MatrixXd theta = sigma_theta(model, estimated, S);
   DeviceOptions options;
   options.precision = precision;
   auto opencl = make_ensemble("opencl", model, estimated, scenario.observations.nodes, S, options);
@@ -433,14 +532,13 @@ TEST_P(VulkanAgainstOpenCl, TrajectoriesAgree) {
   vulkan->set_parameters(theta);
   double largest = 0.0;
   Eigen::MatrixXd y_opencl, y_vulkan;
-  for (int k = 1; k <= 200; ++k) {
-    if (k == 101) {  // the cut, as in TrajectoryWithACutFollowsTheReference
-      theta.row(1).setConstant(std::log(0.01));
+  for (int k = 1; k <= kTrajectorySteps; ++k) {
+    if (k == kCutStep) {
+      cut_middle_ligament(theta);
       opencl->set_parameters(theta);
       vulkan->set_parameters(theta);
     }
-    const Eigen::Vector3d so =
-        scenario.control.trajectory.position(k * scenario.time.dt, scenario.control.start);
+    const Eigen::Vector3d so = so_position(scenario, k);
     ASSERT_EQ(opencl->advance(so).unconverged_count(), 0) << "step " << k;
     ASSERT_EQ(vulkan->advance(so).unconverged_count(), 0) << "step " << k;
     opencl->predicted_observations(y_opencl);
