@@ -18,7 +18,7 @@ cat "$out/devices.txt"
 # GPU's driver its CPU device may come first (it did on the first H200 lease): then point
 # OCL_ICD_VENDORS at a folder holding only the GPU's .icd file (README, "On a GPU").
 for api in OpenCL Vulkan; do
-  if ! sed -n "/^$api /,/^[A-Z]/p" "$out/devices.txt" | grep -q -- '--device 0: .*(\(discrete \)\{0,1\}gpu'; then
+  if ! sed -n "/^$api /,/^[A-Z]/p" "$out/devices.txt" | grep -Eq -- '--device 0: .*\((discrete |integrated |virtual )?gpu'; then
     echo "gpu_checks: $api device 0 is not a GPU (see devices.txt above); stopping" >&2
     exit 1
   fi
