@@ -3,6 +3,7 @@
 // the command line can print it as is and exit non-zero.
 #pragma once
 
+#include <sstream>
 #include <stdexcept>
 #include <string>
 
@@ -12,5 +13,13 @@ class InputError : public std::runtime_error {
  public:
   explicit InputError(const std::string& message) : std::runtime_error(message) {}
 };
+
+// A number as a message shows it: %g-like, 6 significant digits, enough to recognise the value
+// the user wrote (the CSV files' own format is data/csv_format.h).
+inline std::string message_number(double value) {
+  std::ostringstream out;
+  out << value;
+  return out.str();
+}
 
 }  // namespace sigmafem

@@ -40,14 +40,8 @@ constexpr int kMaxMeshRefine = 3;
 // ---------------------------------------------------------------------------------------
 // Text helpers for messages.
 
-std::string format_number(double value) {
-  std::ostringstream out;
-  out << value;  // %g-like, 6 significant digits: enough to recognise the value written
-  return out.str();
-}
-
 std::string format_vector(const Eigen::Vector3d& v) {
-  return "[" + format_number(v.x()) + ", " + format_number(v.y()) + ", " + format_number(v.z()) +
+  return "[" + message_number(v.x()) + ", " + message_number(v.y()) + ", " + message_number(v.z()) +
          "]";
 }
 
@@ -245,7 +239,7 @@ class Checker {
     // A literal such as 1e999 parses to infinity; no scenario quantity may be infinite.
     require(std::isfinite(x), path, "expected a finite number, found " + value.dump());
     require(std::fabs(x) <= kMaxScenarioMagnitude, path,
-            value.dump() + " is beyond +-" + format_number(kMaxScenarioMagnitude) +
+            value.dump() + " is beyond +-" + message_number(kMaxScenarioMagnitude) +
                 ", more than any quantity of a scenario in SI units (a unit slip?)");
     return x;
   }
@@ -293,10 +287,10 @@ class Checker {
 
   // Range checks: the message shows the rule and the value found.
   void positive(double x, const std::string& path) const {
-    require(x > 0.0, path, "must be > 0, found " + format_number(x));
+    require(x > 0.0, path, "must be > 0, found " + message_number(x));
   }
   void non_negative(double x, const std::string& path) const {
-    require(x >= 0.0, path, "must be >= 0, found " + format_number(x));
+    require(x >= 0.0, path, "must be >= 0, found " + message_number(x));
   }
 
  private:
@@ -376,7 +370,7 @@ std::vector<int> node_set(const Checker& c, const json& owner, const std::string
       spec.kind = NodeSetSpec::Kind::near;
       spec.near = near;
       spec.radius = radius;
-      asked = "near " + format_vector(near) + ", radius " + format_number(radius) + " m";
+      asked = "near " + format_vector(near) + ", radius " + message_number(radius) + " m";
       advice = "enlarge radius or list nodes";
     } else {
       const std::string box_path = child(select_path, "box");
@@ -525,7 +519,7 @@ void read_physics(const Checker& c, const json& root, Scenario& s) {
   // nu = 0.5 is incompressible: the linear elastic stiffness has lambda -> infinity.
   c.require(s.material.poisson_ratio > -1.0 && s.material.poisson_ratio < 0.5,
             "material.poisson_ratio",
-            "must be in (-1, 0.5), found " + format_number(s.material.poisson_ratio));
+            "must be in (-1, 0.5), found " + message_number(s.material.poisson_ratio));
   s.material.density = c.number(material.at("density"), "material.density");
   c.positive(s.material.density, "material.density");
 
@@ -557,7 +551,7 @@ void read_physics(const Checker& c, const json& root, Scenario& s) {
     s.solver.cg_tolerance = c.number_or(solver, "solver", "cg_tolerance", s.solver.cg_tolerance);
     // A relative residual: 1 or more would accept the warm start unchanged.
     c.require(s.solver.cg_tolerance > 0.0 && s.solver.cg_tolerance < 1.0, "solver.cg_tolerance",
-              "must be in (0, 1), found " + format_number(s.solver.cg_tolerance));
+              "must be in (0, 1), found " + message_number(s.solver.cg_tolerance));
   }
 }
 
@@ -646,8 +640,8 @@ Trajectory read_trajectory(const Checker& c, const json& value, const std::strin
     for (size_t i = 0; i < times.size(); ++i) {
       const double t = c.number(times[i], element(times_path, i));
       c.require(trajectory.times.empty() || t > trajectory.times.back(), element(times_path, i),
-                "time " + format_number(t) + " does not come after the previous time " +
-                    (trajectory.times.empty() ? "" : format_number(trajectory.times.back())) +
+                "time " + message_number(t) + " does not come after the previous time " +
+                    (trajectory.times.empty() ? "" : message_number(trajectory.times.back())) +
                     "; times must strictly increase");
       trajectory.times.push_back(t);
       trajectory.positions.push_back(c.vector3(positions[i], element(positions_path, i)));
@@ -724,7 +718,7 @@ void read_observations(const Checker& c, const json& root, Scenario& s) {
   s.observations.noise_std = c.number_or(observations, "observations", "noise_std", 0.0);
   c.require(s.observations.noise_std >= 0.0 && s.observations.noise_std <= kMaxNoiseStd,
             "observations.noise_std",
-            "must be 0 to " + format_number(kMaxNoiseStd) + " m, found " + format_number(s.observations.noise_std));
+            "must be 0 to " + message_number(kMaxNoiseStd) + " m, found " + message_number(s.observations.noise_std));
 }
 
 // The fields the filter's windowed tests share (filter.change_detection,
@@ -785,7 +779,7 @@ void read_filter(const Checker& c, const json& root, Scenario& s) {
   // The filter divides by this variance: zero would claim perfect measurements.
   spec.observation_std = c.number(filter.at("observation_std"), "filter.observation_std");
   c.require(spec.observation_std > 0.0 && spec.observation_std <= kMaxNoiseStd, "filter.observation_std",
-            "must be > 0 and at most " + format_number(kMaxNoiseStd) + " m, found " + format_number(spec.observation_std));
+            "must be > 0 and at most " + message_number(kMaxNoiseStd) + " m, found " + message_number(spec.observation_std));
   if (filter.contains("sigma_points")) {
     spec.sigma_points = c.string(filter.at("sigma_points"), "filter.sigma_points");
     c.require(spec.sigma_points == "simplex" || spec.sigma_points == "star", "filter.sigma_points",

@@ -16,12 +16,6 @@ std::string format_point(const Eigen::Vector3d& p) {
   return out.str();
 }
 
-std::string format_number(double x) {
-  std::ostringstream out;
-  out << x;
-  return out.str();
-}
-
 // The node of `mesh` nearest to p (brute force: node lists are short) and its distance.
 std::pair<int, double> nearest_node(const Mesh& mesh, const Eigen::Vector3d& p) {
   int best = -1;
@@ -53,7 +47,7 @@ class Resolver {
         resolved = select_nodes_near(to_, spec.near, spec.radius);
         if (resolved.empty())
           fail(spec.field + ".select", "near " + format_point(spec.near) + ", radius " +
-                                           format_number(spec.radius) +
+                                           message_number(spec.radius) +
                                            " m selects no node of this mesh");
         break;
       case NodeSetSpec::Kind::box:
