@@ -126,8 +126,7 @@ constexpr int kMostSigmaPoints = 16;
 // SIGMAFEM_CONFORMANCE_REFERENCE; a case run alone computes the S columns it needs.
 using ObservedTrajectory = std::vector<Eigen::MatrixXd>;
 
-ObservedTrajectory reference_trajectory(const Scenario& scenario, int S) {
-  const Model model = make_model(scenario);
+ObservedTrajectory reference_trajectory(const Scenario& scenario, const Model& model, int S) {
   const std::vector<int>& estimated = scenario.filter->estimate;
   CpuEnsemble reference(model, estimated, scenario.observations.nodes, S);
   Eigen::MatrixXd theta = sigma_theta(model, estimated, S);
@@ -167,9 +166,10 @@ void write_reference(const std::filesystem::path& path, const ObservedTrajectory
 }
 
 // The first S columns of the fixture's file for `scenario`, or, without one, a fresh run.
-ObservedTrajectory shared_reference_trajectory(const Scenario& scenario, const std::string& name, int S) {
+ObservedTrajectory shared_reference_trajectory(const Scenario& scenario, const Model& model,
+                                               const std::string& name, int S) {
   const char* folder = std::getenv("SIGMAFEM_CONFORMANCE_REFERENCE");
-  if (folder == nullptr) return reference_trajectory(scenario, S);
+  if (folder == nullptr) return reference_trajectory(scenario, model, S);
   const std::filesystem::path path = reference_file(folder, name);
   std::ifstream in(path, std::ios::binary);
   std::int32_t sizes[3] = {0, 0, 0};
@@ -178,7 +178,7 @@ ObservedTrajectory shared_reference_trajectory(const Scenario& scenario, const s
   if (!in || sizes[0] != kTrajectorySteps || sizes[1] != rows || sizes[2] < S) {
     ADD_FAILURE() << "SIGMAFEM_CONFORMANCE_REFERENCE is set, but " << path
                   << " is missing or holds other sizes (ctest runs ConformanceReference.* first)";
-    return reference_trajectory(scenario, S);
+    return reference_trajectory(scenario, model, S);
   }
   ObservedTrajectory y(kTrajectorySteps, Eigen::MatrixXd(rows, sizes[2]));
   for (Eigen::MatrixXd& m : y)
@@ -191,7 +191,8 @@ ObservedTrajectory shared_reference_trajectory(const Scenario& scenario, const s
 // The fixture: with SIGMAFEM_CONFORMANCE_REFERENCE set (by ctest) it writes the file;
 // alone, it checks that the reference converges on every step of the trajectory.
 void compute_reference(const std::string& name) {
-  const ObservedTrajectory y = reference_trajectory(conformance_scenario(name), kMostSigmaPoints);
+  const Scenario scenario = conformance_scenario(name);
+  const ObservedTrajectory y = reference_trajectory(scenario, make_model(scenario), kMostSigmaPoints);
   for (const Eigen::MatrixXd& m : y) ASSERT_TRUE(m.allFinite());
   if (const char* folder = std::getenv("SIGMAFEM_CONFORMANCE_REFERENCE"))
     write_reference(reference_file(folder, name), y);
@@ -358,7 +359,7 @@ TEST_P(EnsembleConformance, KernelsOfOneStepMatchTheReference) {
 // 200 steps with the middle ligament cut half way, every sigma point against the reference
 // ensemble, all observed positions at every step.
 TEST_P(EnsembleConformance, TrajectoryWithACutFollowsTheReference) {
-  const ObservedTrajectory y_reference = shared_reference_trajectory(scenario_, GetParam().scenario, S_);
+  const ObservedTrajectory y_reference = shared_reference_trajectory(scenario_, model_, GetParam().scenario, S_);
   ASSERT_FALSE(HasFailure());
   auto device = device_ensemble(model_);
   Eigen::MatrixXd theta = theta_;
