@@ -8,6 +8,9 @@ DeviceOptions BackendChoice::device_options() const {
   DeviceOptions options;
   options.device = device;
   options.precision = precision == "double" ? Precision::double_precision : Precision::single;
+  options.preconditioner = preconditioner == "jacobi"       ? Preconditioner::jacobi
+                           : preconditioner == "factorised" ? Preconditioner::factorised
+                                                            : Preconditioner::automatic;
   return options;
 }
 
@@ -24,6 +27,12 @@ void add_backend_options(CLI::App* command, BackendChoice& choice) {
   command->add_option("--precision", choice.precision,
                       "Arithmetic of a device back end (double needs the device's fp64)")
       ->check(CLI::IsMember({"single", "double"}))
+      ->capture_default_str();
+  command->add_option("--preconditioner", choice.preconditioner,
+                      "CG's preconditioner: jacobi, factorised (one sparse Cholesky factor shared "
+                      "by the sigma points; cpu back end only) or auto (factorised on cpu, "
+                      "jacobi on the devices)")
+      ->check(CLI::IsMember({"auto", "jacobi", "factorised"}))
       ->capture_default_str();
 }
 

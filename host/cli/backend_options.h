@@ -1,5 +1,5 @@
 // The options that choose where simulations run, shared by `estimate`, `generate` and `demo`:
-// --backend cpu|opencl|vulkan, --device N, --precision single|double.
+// --backend cpu|opencl|vulkan, --device N, --precision single|double, --preconditioner.
 #pragma once
 
 #include <CLI/CLI.hpp>
@@ -13,6 +13,7 @@ struct BackendChoice {
   std::string backend = "cpu";
   int device = 0;
   std::string precision = "single";
+  std::string preconditioner = "auto";
   DeviceOptions device_options() const;
 };
 

@@ -19,11 +19,18 @@ enum class SolveLaunch { automatic, per_iteration, whole_solve };
 // the GPU form on PoCL lets the tests run it where there is no GPU.
 enum class KernelForm { automatic, cpu, gpu };
 
+// CG's preconditioner: Jacobi (the oracle's and the device kernels'), or one sparse Cholesky
+// factor of a representative system shared by the CPU ensemble's sigma points
+// (host/reference/factorised_preconditioner.h); automatic is the factor on the CPU back end
+// and Jacobi on the devices, which have no other yet.
+enum class Preconditioner { automatic, jacobi, factorised };
+
 struct DeviceOptions {
   int device = 0;                   // index in `sigmafem devices`' list for the back end
   Precision precision = Precision::single;
   SolveLaunch solve_launch = SolveLaunch::automatic;
   KernelForm kernel_form = KernelForm::automatic;   // OpenCL only
+  Preconditioner preconditioner = Preconditioner::automatic;
 };
 
 }  // namespace sigmafem

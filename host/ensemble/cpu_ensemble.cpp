@@ -36,8 +36,9 @@ void parallel_for(int count, int threads, const Body& body) {
 }  // namespace
 
 CpuEnsemble::CpuEnsemble(const Model& model, std::vector<int> estimated, std::vector<int> observed,
-                         int sigma_count, int threads)
-    : estimated_(std::move(estimated)), observed_(std::move(observed)) {
+                         int sigma_count, int threads, Preconditioner preconditioner)
+    : estimated_(std::move(estimated)),
+      observed_(std::move(observed)) {
   if (sigma_count < 1) throw std::invalid_argument("CpuEnsemble: need at least one sigma point");
   for (int l : estimated_)
     if (l < 0 || l >= static_cast<int>(model.ligaments.size()))
@@ -45,6 +46,10 @@ CpuEnsemble::CpuEnsemble(const Model& model, std::vector<int> estimated, std::ve
   simulations_.assign(sigma_count, ReferenceSimulation(model));
   const int cores = static_cast<int>(std::thread::hardware_concurrency());
   threads_ = threads > 0 ? threads : std::max(1, cores);
+  if (preconditioner != Preconditioner::jacobi) {
+    factor_ = std::make_unique<FactorisedPreconditioner>();
+    for (ReferenceSimulation& simulation : simulations_) simulation.set_preconditioner(factor_.get());
+  }
 }
 
 void CpuEnsemble::set_parameters(const Eigen::MatrixXd& theta) {
@@ -71,12 +76,17 @@ StepReport CpuEnsemble::advance(const Eigen::Vector3d& so_position) {
   report.cg_iterations.resize(S);
   report.relative_residual.resize(S);
   report.converged.resize(S);
+  // Not positive definite (a candidate's negative stiffness): Jacobi this step, as the
+  // lone simulation (the simulations fall back to it while the factor is not ready).
+  if (factor_ && factor_->due()) factor_->factorise(simulations_[0].system_matrix());
   parallel_for(S, threads_, [&](int s) {
     const CgResult cg = simulations_[s].step(so_position);
     report.cg_iterations[s] = cg.iterations;
     report.relative_residual[s] = cg.relative_residual;
     report.converged[s] = cg.converged ? 1u : 0u;
   });
+  if (factor_)
+    factor_->record(*std::max_element(report.cg_iterations.begin(), report.cg_iterations.end()));
   return report;
 }
 

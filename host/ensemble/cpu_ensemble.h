@@ -4,15 +4,23 @@
 // worker threads (one per core, at most S); each one's arithmetic is unchanged by that, so
 // results do not depend on the thread count.
 //
+// CG's preconditioner (host/common/device_options.h): Jacobi, as the lone ReferenceSimulation,
+// or one factorisation shared by all sigma points: of sigma point 0's system, made between
+// steps when it is due (factorised_preconditioner.h), so results still do not depend on the
+// thread count; they differ from Jacobi's within the CG tolerance.
+//
 // Parameters: theta = log of the stiffness of the estimated ligaments (in the given order);
 // the other ligaments keep the model's stiffness.
 #pragma once
 
 #include <Eigen/Core>
+#include <memory>
 #include <vector>
 
 #include "filter/ensemble.h"
+#include "host/common/device_options.h"
 #include "host/model/model.h"
+#include "host/reference/factorised_preconditioner.h"
 #include "host/reference/reference_simulation.h"
 
 namespace sigmafem {
@@ -20,8 +28,11 @@ namespace sigmafem {
 class CpuEnsemble : public Ensemble {
  public:
   // `estimated`: indices into model.ligaments; `observed`: node indices; `threads` 0 = cores.
+  // Preconditioner::automatic is the shared factorisation; the conformance tests, which
+  // compare the devices' Jacobi CG with it to the last digits, ask for Jacobi.
   CpuEnsemble(const Model& model, std::vector<int> estimated, std::vector<int> observed,
-              int sigma_count, int threads = 0);
+              int sigma_count, int threads = 0,
+              Preconditioner preconditioner = Preconditioner::automatic);
 
   int sigma_count() const override { return static_cast<int>(simulations_.size()); }
   int parameter_count() const override { return static_cast<int>(estimated_.size()); }
@@ -35,6 +46,9 @@ class CpuEnsemble : public Ensemble {
   // per sigma point). Kept until changed.
   void set_physics_effects(const std::vector<PhysicsEffects>& effects);
 
+  // Factorisations made so far (0 with Jacobi).
+  int factorisations() const { return factor_ ? factor_->factorisations() : 0; }
+
   // Sigma point s's simulation (tests compare it with a lone ReferenceSimulation).
   const ReferenceSimulation& simulation(int s) const { return simulations_[s]; }
 
@@ -43,6 +57,9 @@ class CpuEnsemble : public Ensemble {
   std::vector<int> estimated_;
   std::vector<int> observed_;
   int threads_;
+  // Null with Jacobi. The simulations hold a pointer to it: in a unique_ptr so that moving
+  // the ensemble does not move it.
+  std::unique_ptr<FactorisedPreconditioner> factor_;
 };
 
 }  // namespace sigmafem

@@ -13,7 +13,12 @@ std::unique_ptr<Ensemble> make_ensemble(const std::string& backend, const Model&
                                         const std::vector<int>& estimated,
                                         const std::vector<int>& observed, int sigma_count,
                                         const DeviceOptions& options) {
-  if (backend == "cpu") return std::make_unique<CpuEnsemble>(model, estimated, observed, sigma_count);
+  if (backend == "cpu")
+    return std::make_unique<CpuEnsemble>(model, estimated, observed, sigma_count, 0,
+                                         options.preconditioner);
+  if (options.preconditioner == Preconditioner::factorised)
+    throw InputError("--preconditioner factorised: only the cpu back end has it (the " + backend +
+                     " kernels precondition CG with Jacobi)");
   if (backend == "opencl")
     return std::make_unique<OpenClEnsemble>(model, estimated, observed, sigma_count, options);
   if (backend == "vulkan")

@@ -17,7 +17,8 @@ namespace sigmafem {
 std::vector<std::string> available_backends();
 
 // Throws InputError for an unknown name, DeviceError when the device cannot run it.
-// `options` is ignored by the CPU back end.
+// The CPU back end takes only `options.preconditioner` (automatic: the shared factorisation);
+// a device back end refuses Preconditioner::factorised with an InputError.
 std::unique_ptr<Ensemble> make_ensemble(const std::string& backend, const Model& model,
                                         const std::vector<int>& estimated,
                                         const std::vector<int>& observed, int sigma_count,

@@ -14,6 +14,10 @@ TruthSimulation::TruthSimulation(Model model, const GenerateOptions& options)
   for (const SpringSet& ligament : model_.ligaments) stiffness_.push_back(ligament.stiffness);
   if (options.backend == "cpu") {
     reference_.emplace(model_);
+    if (options.device.preconditioner != Preconditioner::jacobi) {
+      factor_ = std::make_unique<FactorisedPreconditioner>();
+      reference_->set_preconditioner(factor_.get());
+    }
     return;
   }
   std::vector<int> all(model_.ligaments.size());
@@ -38,7 +42,12 @@ void TruthSimulation::set_ligament_stiffness(const std::vector<double>& stiffnes
 }
 
 CgResult TruthSimulation::step(const Eigen::Vector3d& so_position) {
-  if (reference_) return reference_->step(so_position);
+  if (reference_) {
+    if (factor_ && factor_->due()) factor_->factorise(reference_->system_matrix());
+    const CgResult result = reference_->step(so_position);
+    if (factor_) factor_->record(result.iterations);
+    return result;
+  }
   const StepReport report = device_->advance(so_position);
   CgResult result;
   result.iterations = report.cg_iterations[0];

@@ -12,6 +12,7 @@
 #include "host/ensemble/device_ensemble.h"
 #include "host/generator/generate.h"
 #include "host/model/model.h"
+#include "host/reference/factorised_preconditioner.h"
 #include "host/reference/reference_simulation.h"
 
 namespace sigmafem {
@@ -32,6 +33,7 @@ class TruthSimulation {
   Model model_;
   std::vector<double> stiffness_;
   std::optional<ReferenceSimulation> reference_;    // the "cpu" back end
+  std::unique_ptr<FactorisedPreconditioner> factor_;   // its preconditioner (null: Jacobi)
   std::unique_ptr<DeviceEnsemble> device_;          // any other
   Eigen::VectorXd positions_;                       // the device's, read back once per step
 };

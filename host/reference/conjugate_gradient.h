@@ -1,7 +1,9 @@
-// conjugate_gradient: Jacobi-preconditioned conjugate gradients for a symmetric positive
-// definite system given only by its product, written like Eigen's internal::conjugate_gradient
-// (a bare function; the caller owns the operator). The device kernels follow the same
-// stopping rule, so that iteration counts can be compared.
+// conjugate_gradient: preconditioned conjugate gradients for a symmetric positive definite
+// system given only by its product, written like Eigen's internal::conjugate_gradient (a bare
+// function; the caller owns the operator and the preconditioner). Jacobi is the oracle's and
+// the device kernels' preconditioner; the CPU ensemble can use a shared factorisation instead
+// (factorised_preconditioner.h). The device kernels follow the same stopping rule, so that
+// iteration counts can be compared.
 //
 // Stopping rule: |b - A x| <= tolerance * |b| (relative residual, 2-norm).
 #pragma once
@@ -18,11 +20,11 @@ struct CgResult {
 };
 
 // Solves A x = b. `x` is the warm start on entry and the solution on exit.
-// `apply(d, y)` sets y = A d. `inverse_diagonal` is 1 / diag(A) (Jacobi preconditioner).
-template <class Apply>
-CgResult conjugate_gradient(const Apply& apply, const Eigen::VectorXd& inverse_diagonal,
-                            const Eigen::VectorXd& b, Eigen::VectorXd& x, int max_iterations,
-                            double tolerance) {
+// `apply(d, y)` sets y = A d; `precondition(r, z)` sets z = M^-1 r for an SPD M close to A.
+template <class Apply, class Precondition>
+CgResult preconditioned_conjugate_gradient(const Apply& apply, const Precondition& precondition,
+                                           const Eigen::VectorXd& b, Eigen::VectorXd& x,
+                                           int max_iterations, double tolerance) {
   CgResult result;
   const double b_norm = b.norm();
   // An overflowed load would make the stop test tol * |b| infinite and pass at once with
@@ -46,7 +48,8 @@ CgResult conjugate_gradient(const Apply& apply, const Eigen::VectorXd& inverse_d
     result.converged = true;
     return result;
   }
-  Eigen::VectorXd z = inverse_diagonal.cwiseProduct(r);   // preconditioned residual
+  Eigen::VectorXd z(b.size());
+  precondition(r, z);                                      // preconditioned residual
   Eigen::VectorXd d = z;                                   // search direction
   double rz = r.dot(z);
   while (result.iterations < max_iterations) {
@@ -61,13 +64,24 @@ CgResult conjugate_gradient(const Apply& apply, const Eigen::VectorXd& inverse_d
       break;
     }
     if (!std::isfinite(r_norm)) break;         // not SPD (or NaN input): report, do not spin
-    z = inverse_diagonal.cwiseProduct(r);
+    precondition(r, z);
     const double rz_new = r.dot(z);
     d = z + (rz_new / rz) * d;                 // A-conjugate to the previous directions
     rz = rz_new;
   }
   result.relative_residual = r_norm / b_norm;
   return result;
+}
+
+// Jacobi-preconditioned CG: `inverse_diagonal` is 1 / diag(A).
+template <class Apply>
+CgResult conjugate_gradient(const Apply& apply, const Eigen::VectorXd& inverse_diagonal,
+                            const Eigen::VectorXd& b, Eigen::VectorXd& x, int max_iterations,
+                            double tolerance) {
+  const auto jacobi = [&](const Eigen::VectorXd& r, Eigen::VectorXd& z) {
+    z = inverse_diagonal.cwiseProduct(r);
+  };
+  return preconditioned_conjugate_gradient(apply, jacobi, b, x, max_iterations, tolerance);
 }
 
 }  // namespace sigmafem

@@ -5,6 +5,7 @@
 #include <stdexcept>
 #include <string>
 
+#include "host/reference/factorised_preconditioner.h"
 #include "host/reference/implicit_euler.h"
 
 namespace sigmafem {
@@ -108,7 +109,11 @@ CgResult ReferenceSimulation::step(const Eigen::Vector3d& so_position) {
   const Eigen::VectorXd b = system.right_hand_side(forces(x_, frames_, so_target), v_);
 
   CgResult result;
-  if (solver_ == LinearSolver::conjugate_gradient) {
+  if (solver_ == LinearSolver::conjugate_gradient && factor_ != nullptr && factor_->ready()) {
+    result = preconditioned_conjugate_gradient(system, *factor_, b, dv_,
+                                               model_.solver.cg_max_iterations,
+                                               model_.solver.cg_tolerance);
+  } else if (solver_ == LinearSolver::conjugate_gradient) {
     const Eigen::VectorXd inverse_diagonal = system.diagonal().cwiseInverse();
     result = conjugate_gradient(system, inverse_diagonal, b, dv_, model_.solver.cg_max_iterations,
                                 model_.solver.cg_tolerance);
@@ -128,6 +133,12 @@ CgResult ReferenceSimulation::step(const Eigen::Vector3d& so_position) {
   if (!x_.allFinite() || !v_.allFinite())
     throw std::runtime_error("simulation step: positions or velocities became non-finite");
   return result;
+}
+
+Eigen::SparseMatrix<double> ReferenceSimulation::system_matrix() const {
+  std::vector<Frame> frames;
+  element_frames(model_, x_, frames);
+  return ImplicitEulerSystem(model_, frames, spring_stiffness()).assemble();
 }
 
 double ReferenceSimulation::kinetic_energy() const {

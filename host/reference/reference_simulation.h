@@ -5,11 +5,13 @@
 //      Model::ligament_d0), control spring to the SO target at the END of the step
 //      (so(t_{n+1}); sigmafem's convention; so(t_{n+1} - so_lag) with a lag), gravity,
 //   3. solve (M + h B + h^2 K) dv = h (f - B v - h K v) by Jacobi-preconditioned CG
-//      warm-started from the last dv (or by a sparse direct solve, to check CG),
+//      warm-started from the last dv (or by a sparse direct solve, to check CG; or by CG
+//      with a factorisation shared by a CPU ensemble's sigma points),
 //   4. v += dv, x += h v.
 #pragma once
 
 #include <Eigen/Core>
+#include <Eigen/SparseCore>
 #include <vector>
 
 #include "host/model/effects.h"
@@ -19,6 +21,8 @@
 #include "host/reference/corotational.h"
 
 namespace sigmafem {
+
+class FactorisedPreconditioner;
 
 enum class LinearSolver { conjugate_gradient, direct };
 
@@ -34,6 +38,11 @@ class ReferenceSimulation {
   const std::vector<double>& ligament_stiffness() const { return ligament_stiffness_; }
 
   void set_linear_solver(LinearSolver solver) { solver_ = solver; }
+  // CG preconditioned by `factor` (not owned; it must outlive the steps) instead of Jacobi
+  // while factor->ready(); nullptr restores Jacobi.
+  void set_preconditioner(const FactorisedPreconditioner* factor) { factor_ = factor; }
+  // The matrix the next step solves with, at the current state (CpuEnsemble factorises one).
+  Eigen::SparseMatrix<double> system_matrix() const;
 
   // Physics effects on top of the model given at construction (diagnose estimates them per
   // sigma point); PhysicsEffects{} restores the model.
@@ -61,6 +70,7 @@ class ReferenceSimulation {
   Model model_;
   std::vector<double> ligament_stiffness_;
   LinearSolver solver_ = LinearSolver::conjugate_gradient;
+  const FactorisedPreconditioner* factor_ = nullptr;
   Eigen::VectorXd x_, v_;
   Eigen::VectorXd dv_;                 // last velocity change: the CG warm start
   std::vector<Frame> frames_;

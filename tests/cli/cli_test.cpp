@@ -219,6 +219,23 @@ TEST_F(CliTest, DiagnoseFindsAnInjectedEffectAndWritesItsReport) {
   EXPECT_NE(info.output.find("declared effect camera_offset=0.00"), std::string::npos) << info.output;
 }
 
+// The shared factorisation is the CPU back end's: asked of a device back end, exit 2 and a
+// message that says so, before any device is opened, and no data file.
+TEST_F(CliTest, TheFactorisedPreconditionerIsTheCpuBackEndsOnly) {
+  std::ofstream(dir_ / "box.json") << box_.dump(2);
+  const std::string generate =
+      "generate " + (dir_ / "box.json").string() + " --out " + (dir_ / "out").string() + " --quiet ";
+  const CommandRun device = run_sigmafem(generate + "--backend opencl --preconditioner factorised");
+  EXPECT_EQ(device.exit_code, 2) << device.output;
+  EXPECT_NE(device.output.find("--preconditioner factorised"), std::string::npos) << device.output;
+  EXPECT_NE(device.output.find("cpu back end"), std::string::npos) << device.output;
+  EXPECT_FALSE(fs::exists(dir_ / "out" / "observations.csv"));
+  const CommandRun unknown = run_sigmafem(generate + "--preconditioner cholesky");
+  EXPECT_NE(unknown.exit_code, 0) << unknown.output;
+  EXPECT_NE(unknown.output.find("--preconditioner"), std::string::npos) << unknown.output;
+  EXPECT_FALSE(fs::exists(dir_ / "out" / "observations.csv"));
+}
+
 TEST_F(CliTest, RejectsBadOptions) {
   const CommandRun run = run_sigmafem("generate");
   EXPECT_NE(run.exit_code, 0) << run.output;

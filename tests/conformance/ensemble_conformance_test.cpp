@@ -128,7 +128,8 @@ using ObservedTrajectory = std::vector<Eigen::MatrixXd>;
 
 ObservedTrajectory reference_trajectory(const Scenario& scenario, const Model& model, int S) {
   const std::vector<int>& estimated = scenario.filter->estimate;
-  CpuEnsemble reference(model, estimated, scenario.observations.nodes, S);
+  // Jacobi CG, as the device kernels: the same iterates, so float64 agrees to rounding.
+  CpuEnsemble reference(model, estimated, scenario.observations.nodes, S, 0, Preconditioner::jacobi);
   Eigen::MatrixXd theta = sigma_theta(model, estimated, S);
   reference.set_parameters(theta);
   ObservedTrajectory y(kTrajectorySteps);

@@ -28,7 +28,8 @@ class CpuEnsembleTest : public ::testing::Test {
 
 TEST_F(CpuEnsembleTest, EachSigmaPointIsTheReferenceWithItsStiffness) {
   const std::vector<int> estimated = {0, 2};
-  CpuEnsemble ensemble(model_, estimated, scenario_.observations.nodes, 3, 2);
+  // Jacobi, as the lone ReferenceSimulation: the same arithmetic, so the same bits.
+  CpuEnsemble ensemble(model_, estimated, scenario_.observations.nodes, 3, 2, Preconditioner::jacobi);
   Eigen::MatrixXd theta(2, 3);
   theta << std::log(100.0), std::log(150.0), std::log(400.0),
            std::log(50.0), std::log(200.0), std::log(250.0);
@@ -85,6 +86,42 @@ TEST_F(CpuEnsembleTest, RecenteringResamplesAroundTheCorrectedMean) {
     EXPECT_LT((ensemble.simulation(s).velocities() - expected_velocity).norm(),
               1e-12 * (1.0 + expected_velocity.norm()))
         << "re-sampled velocities of sigma point " << s;
+  }
+}
+
+// The shared factorisation (factorised_preconditioner.h) changes how each step's system is
+// solved, not which: every sigma point follows Jacobi's trajectory to the CG tolerance, in a
+// fraction of the iterations, and its bits do not depend on the thread count.
+TEST_F(CpuEnsembleTest, ASharedFactorisationFollowsJacobiInAFractionOfTheIterations) {
+  constexpr int S = 3, kSteps = 40;
+  Eigen::MatrixXd theta(2, S);
+  theta << std::log(100.0), std::log(150.0), std::log(400.0),
+           std::log(50.0), std::log(200.0), std::log(250.0);
+  CpuEnsemble jacobi(model_, {0, 2}, scenario_.observations.nodes, S, 2, Preconditioner::jacobi);
+  CpuEnsemble factorised(model_, {0, 2}, scenario_.observations.nodes, S, 2, Preconditioner::factorised);
+  CpuEnsemble one_thread(model_, {0, 2}, scenario_.observations.nodes, S, 1, Preconditioner::factorised);
+  long jacobi_iterations = 0, factorised_iterations = 0;
+  for (CpuEnsemble* ensemble : {&jacobi, &factorised, &one_thread}) ensemble->set_parameters(theta);
+  for (int k = 1; k <= kSteps; ++k) {
+    for (int it : jacobi.advance(so(k)).cg_iterations) jacobi_iterations += it;
+    for (int it : factorised.advance(so(k)).cg_iterations) factorised_iterations += it;
+    one_thread.advance(so(k));
+  }
+  EXPECT_EQ(jacobi.factorisations(), 0);
+  EXPECT_GE(factorised.factorisations(), 1);
+  EXPECT_LT(factorised.factorisations(), kSteps / 2) << "the factor is kept over steps";
+  EXPECT_LE(10 * factorised_iterations, jacobi_iterations)
+      << factorised_iterations << " iterations factorised, " << jacobi_iterations << " Jacobi";
+  for (int s = 0; s < S; ++s) {
+    const Eigen::VectorXd& x = jacobi.simulation(s).positions();
+    const Eigen::VectorXd moved = x - factorised.simulation(s).positions();
+    Eigen::VectorXd displacement = x;
+    for (int i = 0; i < model_.node_count(); ++i) displacement.segment<3>(3 * i) -= model_.rest_positions[i];
+    // Each step's velocity change is solved to |r| <= 1e-10 |b| by both; 40 such errors,
+    // amplified by at most the condition number (~1e3), stay below 1e-5 of the displacement.
+    EXPECT_LE(moved.norm(), 1e-5 * displacement.norm()) << "sigma point " << s;
+    EXPECT_EQ(factorised.simulation(s).positions(), one_thread.simulation(s).positions())
+        << "sigma point " << s << ": thread count changed the bits";
   }
 }
 
