@@ -33,12 +33,19 @@ void parallel_for(int count, int threads, const Body& body) {
     if (error) std::rethrow_exception(error);
 }
 
+// Own factors converge in about half the iterations of a shared one (bench/RESULTS.md) and
+// suit diagnose, whose sigma points differ by whole effects, but they hold S factors: up to
+// 1 GiB of them (S = 16 on a 4768-tetrahedron liver takes about 30 MB), one shared above.
+constexpr double kOwnFactorsBytes = 1024.0 * 1024.0 * 1024.0;
+
 }  // namespace
 
 CpuEnsemble::CpuEnsemble(const Model& model, std::vector<int> estimated, std::vector<int> observed,
                          int sigma_count, int threads, Preconditioner preconditioner)
     : estimated_(std::move(estimated)),
-      observed_(std::move(observed)) {
+      observed_(std::move(observed)),
+      preconditioner_(preconditioner),
+      own_factors_budget_(kOwnFactorsBytes) {
   if (sigma_count < 1) throw std::invalid_argument("CpuEnsemble: need at least one sigma point");
   for (int l : estimated_)
     if (l < 0 || l >= static_cast<int>(model.ligaments.size()))
@@ -46,10 +53,26 @@ CpuEnsemble::CpuEnsemble(const Model& model, std::vector<int> estimated, std::ve
   simulations_.assign(sigma_count, ReferenceSimulation(model));
   const int cores = static_cast<int>(std::thread::hardware_concurrency());
   threads_ = threads > 0 ? threads : std::max(1, cores);
-  if (preconditioner != Preconditioner::jacobi) {
-    factor_ = std::make_unique<FactorisedPreconditioner>();
-    for (ReferenceSimulation& simulation : simulations_) simulation.set_preconditioner(factor_.get());
+}
+
+void CpuEnsemble::make_factors() {
+  auto first = std::make_unique<FactorisedPreconditioner>();
+  first->factorise(simulations_[0].system_matrix());
+  shared_factor_ = sigma_count() * first->bytes() > own_factors_budget_;
+  factors_.push_back(std::move(first));
+  if (shared_factor_) {
+    for (ReferenceSimulation& simulation : simulations_)
+      simulation.set_preconditioner(factors_[0].get(), false);
+    return;
   }
+  for (int s = 1; s < sigma_count(); ++s) factors_.push_back(std::make_unique<FactorisedPreconditioner>());
+  for (int s = 0; s < sigma_count(); ++s) simulations_[s].set_preconditioner(factors_[s].get(), true);
+}
+
+int CpuEnsemble::factorisations() const {
+  int count = 0;
+  for (const auto& factor : factors_) count += factor->factorisations();
+  return count;
 }
 
 void CpuEnsemble::set_parameters(const Eigen::MatrixXd& theta) {
@@ -76,17 +99,17 @@ StepReport CpuEnsemble::advance(const Eigen::Vector3d& so_position) {
   report.cg_iterations.resize(S);
   report.relative_residual.resize(S);
   report.converged.resize(S);
-  // Not positive definite (a candidate's negative stiffness): Jacobi this step, as the
-  // lone simulation (the simulations fall back to it while the factor is not ready).
-  if (factor_ && factor_->due()) factor_->factorise(simulations_[0].system_matrix());
+  if (preconditioner_ != Preconditioner::jacobi && factors_.empty()) make_factors();
+  // A shared factor is made again here, between steps; own ones in each simulation's step.
+  if (shared_factor_ && factors_[0]->due()) factors_[0]->factorise(simulations_[0].system_matrix());
   parallel_for(S, threads_, [&](int s) {
     const CgResult cg = simulations_[s].step(so_position);
     report.cg_iterations[s] = cg.iterations;
     report.relative_residual[s] = cg.relative_residual;
     report.converged[s] = cg.converged ? 1u : 0u;
   });
-  if (factor_)
-    factor_->record(*std::max_element(report.cg_iterations.begin(), report.cg_iterations.end()));
+  if (shared_factor_)
+    factors_[0]->record(*std::max_element(report.cg_iterations.begin(), report.cg_iterations.end()));
   return report;
 }
 

@@ -5,9 +5,12 @@
 // results do not depend on the thread count.
 //
 // CG's preconditioner (host/common/device_options.h): Jacobi, as the lone ReferenceSimulation,
-// or one factorisation shared by all sigma points: of sigma point 0's system, made between
-// steps when it is due (factorised_preconditioner.h), so results still do not depend on the
-// thread count; they differ from Jacobi's within the CG tolerance.
+// or sparse Cholesky factors (factorised_preconditioner.h): one per sigma point, each made
+// from its own system and again when it stops paying, while the S of them fit in
+// kOwnFactorsBytes (cpu_ensemble.cpp); else one that all share, of sigma point 0's system,
+// made again between steps. The choice is made at the first step, from the size of sigma
+// point 0's factor. Either way the results do not depend on the thread count; they differ
+// from Jacobi's within the CG tolerance.
 //
 // Parameters: theta = log of the stiffness of the estimated ligaments (in the given order);
 // the other ligaments keep the model's stiffness.
@@ -46,8 +49,12 @@ class CpuEnsemble : public Ensemble {
   // per sigma point). Kept until changed.
   void set_physics_effects(const std::vector<PhysicsEffects>& effects);
 
-  // Factorisations made so far (0 with Jacobi).
-  int factorisations() const { return factor_ ? factor_->factorisations() : 0; }
+  // Factorisations made so far (0 with Jacobi), and whether the sigma points share one.
+  int factorisations() const;
+  bool shares_a_factor() const { return shared_factor_; }
+  // The most the own factors may hold together before the sigma points share one instead
+  // (default kOwnFactorsBytes); before the first step. Tests and benchmarks set it to run both.
+  void set_own_factors_budget(double bytes) { own_factors_budget_ = bytes; }
 
   // Sigma point s's simulation (tests compare it with a lone ReferenceSimulation).
   const ReferenceSimulation& simulation(int s) const { return simulations_[s]; }
@@ -57,9 +64,14 @@ class CpuEnsemble : public Ensemble {
   std::vector<int> estimated_;
   std::vector<int> observed_;
   int threads_;
-  // Null with Jacobi. The simulations hold a pointer to it: in a unique_ptr so that moving
-  // the ensemble does not move it.
-  std::unique_ptr<FactorisedPreconditioner> factor_;
+  Preconditioner preconditioner_;
+  // Empty with Jacobi and before the first step; then one per sigma point, or one shared.
+  // The simulations hold pointers to them: unique_ptrs, so that moving the ensemble does
+  // not move them.
+  std::vector<std::unique_ptr<FactorisedPreconditioner>> factors_;
+  bool shared_factor_ = false;
+  double own_factors_budget_;
+  void make_factors();
 };
 
 }  // namespace sigmafem

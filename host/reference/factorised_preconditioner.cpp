@@ -12,6 +12,12 @@ bool FactorisedPreconditioner::factorise(const Eigen::SparseMatrix<double>& A) {
   return ready_;
 }
 
+double FactorisedPreconditioner::bytes() const {
+  if (!ready_) return 0.0;
+  const double nonzeros = static_cast<double>(llt_.matrixL().nestedExpression().nonZeros());
+  return nonzeros * static_cast<double>(sizeof(double) + sizeof(int));
+}
+
 void FactorisedPreconditioner::record(int most_iterations) {
   last_ = most_iterations;
   if (fresh_) after_ = ready_ ? most_iterations : -1;

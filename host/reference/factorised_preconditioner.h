@@ -1,13 +1,12 @@
-// FactorisedPreconditioner: a sparse Cholesky factor (Eigen's SimplicialLLT) of one
-// representative implicit-Euler matrix, applied as the CG preconditioner of every sigma point
-// of a CPU ensemble (issue 18). The S systems differ from the representative only in a few
-// spring stiffnesses, small differences of element rotation and, in diagnose, a scale of
-// the modulus or the damping, so M^-1 A is close to the identity for all of them and CG
-// needs a few iterations instead of hundreds. Like SOFA's asynchronous preconditioner, the
-// factor is kept over many steps and made again when it stops paying: when a step took more
-// than twice the iterations of the first step after the last factorisation, plus 2 (the
-// most over the systems that share it). Solving with it is const and thread-safe: the sigma
-// points' threads share one factor.
+// FactorisedPreconditioner: a sparse Cholesky factor (Eigen's SimplicialLLT) of an implicit-
+// Euler matrix, applied as CG's preconditioner to the systems of later steps (issue 18).
+// Those differ from the factorised one only by the rotations of a few steps (and, for the
+// sigma points of an ensemble that share one factor, by a few spring stiffnesses), so
+// M^-1 A stays close to the identity and CG needs a few iterations instead of hundreds.
+// Like SOFA's asynchronous preconditioner, the factor is kept over many steps and made again
+// when it stops paying: when a step took more than twice the iterations of the first step
+// after the last factorisation, plus 2 (the most over the systems that share it). Solving
+// with it is const and thread-safe: sigma points' threads may share one factor.
 #pragma once
 
 #include <Eigen/Core>
@@ -22,9 +21,12 @@ class FactorisedPreconditioner {
   bool factorise(const Eigen::SparseMatrix<double>& A);
   bool ready() const { return ready_; }
   int factorisations() const { return factorisations_; }
+  // Memory the factor holds (its nonzeros with their row indices), 0 before the first.
+  double bytes() const;
 
-  // Whether to factorise before the next step (the first, after a failure, or the rule above).
-  bool due() const { return after_ < 0 || last_ > 2 * after_ + 2; }
+  // Whether to factorise before the next step (the first, after a failure, or the rule
+  // above); not between a factorisation and the record() of its first step.
+  bool due() const { return !fresh_ && (after_ < 0 || last_ > 2 * after_ + 2); }
   // The most CG iterations of a step just done with this factor.
   void record(int most_iterations);
 

@@ -39,8 +39,13 @@ class ReferenceSimulation {
 
   void set_linear_solver(LinearSolver solver) { solver_ = solver; }
   // CG preconditioned by `factor` (not owned; it must outlive the steps) instead of Jacobi
-  // while factor->ready(); nullptr restores Jacobi.
-  void set_preconditioner(const FactorisedPreconditioner* factor) { factor_ = factor; }
+  // while factor->ready(); nullptr restores Jacobi. `refresh`: the step makes the factor
+  // again from its own system when it is due (the simulation's own factor); false: the
+  // caller does (a factor an ensemble shares between its simulations).
+  void set_preconditioner(FactorisedPreconditioner* factor, bool refresh) {
+    factor_ = factor;
+    refresh_factor_ = refresh;
+  }
   // The matrix the next step solves with, at the current state (CpuEnsemble factorises one).
   Eigen::SparseMatrix<double> system_matrix() const;
 
@@ -70,7 +75,8 @@ class ReferenceSimulation {
   Model model_;
   std::vector<double> ligament_stiffness_;
   LinearSolver solver_ = LinearSolver::conjugate_gradient;
-  const FactorisedPreconditioner* factor_ = nullptr;
+  FactorisedPreconditioner* factor_ = nullptr;
+  bool refresh_factor_ = false;
   Eigen::VectorXd x_, v_;
   Eigen::VectorXd dv_;                 // last velocity change: the CG warm start
   std::vector<Frame> frames_;

@@ -89,38 +89,47 @@ TEST_F(CpuEnsembleTest, RecenteringResamplesAroundTheCorrectedMean) {
   }
 }
 
-// The shared factorisation (factorised_preconditioner.h) changes how each step's system is
-// solved, not which: every sigma point follows Jacobi's trajectory to the CG tolerance, in a
-// fraction of the iterations, and its bits do not depend on the thread count.
-TEST_F(CpuEnsembleTest, ASharedFactorisationFollowsJacobiInAFractionOfTheIterations) {
+// Factors (factorised_preconditioner.h), one per sigma point or one shared, change how each
+// step's system is solved, not which: every sigma point follows Jacobi's trajectory to the CG
+// tolerance, in a fraction of the iterations, and its bits do not depend on the thread count.
+TEST_F(CpuEnsembleTest, FactorsFollowJacobiInAFractionOfTheIterations) {
   constexpr int S = 3, kSteps = 40;
   Eigen::MatrixXd theta(2, S);
   theta << std::log(100.0), std::log(150.0), std::log(400.0),
            std::log(50.0), std::log(200.0), std::log(250.0);
   CpuEnsemble jacobi(model_, {0, 2}, scenario_.observations.nodes, S, 2, Preconditioner::jacobi);
-  CpuEnsemble factorised(model_, {0, 2}, scenario_.observations.nodes, S, 2, Preconditioner::factorised);
+  CpuEnsemble own(model_, {0, 2}, scenario_.observations.nodes, S, 2, Preconditioner::factorised);
+  CpuEnsemble shared(model_, {0, 2}, scenario_.observations.nodes, S, 2, Preconditioner::factorised);
+  shared.set_own_factors_budget(0.0);
   CpuEnsemble one_thread(model_, {0, 2}, scenario_.observations.nodes, S, 1, Preconditioner::factorised);
-  long jacobi_iterations = 0, factorised_iterations = 0;
-  for (CpuEnsemble* ensemble : {&jacobi, &factorised, &one_thread}) ensemble->set_parameters(theta);
+  long jacobi_iterations = 0, own_iterations = 0, shared_iterations = 0;
+  for (CpuEnsemble* ensemble : {&jacobi, &own, &shared, &one_thread}) ensemble->set_parameters(theta);
   for (int k = 1; k <= kSteps; ++k) {
     for (int it : jacobi.advance(so(k)).cg_iterations) jacobi_iterations += it;
-    for (int it : factorised.advance(so(k)).cg_iterations) factorised_iterations += it;
+    for (int it : own.advance(so(k)).cg_iterations) own_iterations += it;
+    for (int it : shared.advance(so(k)).cg_iterations) shared_iterations += it;
     one_thread.advance(so(k));
   }
   EXPECT_EQ(jacobi.factorisations(), 0);
-  EXPECT_GE(factorised.factorisations(), 1);
-  EXPECT_LT(factorised.factorisations(), kSteps / 2) << "the factor is kept over steps";
-  EXPECT_LE(10 * factorised_iterations, jacobi_iterations)
-      << factorised_iterations << " iterations factorised, " << jacobi_iterations << " Jacobi";
+  EXPECT_FALSE(own.shares_a_factor()) << "three factors of the box fit the default budget";
+  EXPECT_TRUE(shared.shares_a_factor()) << "a zero budget";
+  EXPECT_GE(own.factorisations(), S);
+  EXPECT_LT(own.factorisations(), S * kSteps / 4) << "factors are kept over steps";
+  EXPECT_GE(shared.factorisations(), 1);
+  EXPECT_LT(shared.factorisations(), kSteps / 4) << "the factor is kept over steps";
+  EXPECT_LE(10 * own_iterations, jacobi_iterations)
+      << own_iterations << " iterations with own factors, " << jacobi_iterations << " Jacobi";
+  EXPECT_LE(10 * shared_iterations, jacobi_iterations)
+      << shared_iterations << " iterations with a shared factor, " << jacobi_iterations << " Jacobi";
   for (int s = 0; s < S; ++s) {
     const Eigen::VectorXd& x = jacobi.simulation(s).positions();
-    const Eigen::VectorXd moved = x - factorised.simulation(s).positions();
     Eigen::VectorXd displacement = x;
     for (int i = 0; i < model_.node_count(); ++i) displacement.segment<3>(3 * i) -= model_.rest_positions[i];
     // Each step's velocity change is solved to |r| <= 1e-10 |b| by both; 40 such errors,
     // amplified by at most the condition number (~1e3), stay below 1e-5 of the displacement.
-    EXPECT_LE(moved.norm(), 1e-5 * displacement.norm()) << "sigma point " << s;
-    EXPECT_EQ(factorised.simulation(s).positions(), one_thread.simulation(s).positions())
+    EXPECT_LE((x - own.simulation(s).positions()).norm(), 1e-5 * displacement.norm()) << "sigma point " << s;
+    EXPECT_LE((x - shared.simulation(s).positions()).norm(), 1e-5 * displacement.norm()) << "sigma point " << s;
+    EXPECT_EQ(own.simulation(s).positions(), one_thread.simulation(s).positions())
         << "sigma point " << s << ": thread count changed the bits";
   }
 }
