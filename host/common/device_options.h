@@ -19,9 +19,9 @@ enum class SolveLaunch { automatic, per_iteration, whole_solve };
 // the GPU form on PoCL lets the tests run it where there is no GPU.
 enum class KernelForm { automatic, cpu, gpu };
 
-// CG's preconditioner: Jacobi (the oracle's and the device kernels'), or one sparse Cholesky
-// factor of a representative system shared by the CPU ensemble's sigma points
-// (host/reference/factorised_preconditioner.h); automatic is the factor on the CPU back end
+// CG's preconditioner: Jacobi (the oracle's and the device kernels'), or sparse Cholesky
+// factors, one per sigma point of the CPU ensemble or one they share (CpuEnsemble,
+// host/reference/factorised_preconditioner.h); automatic is the factors on the CPU back end
 // and Jacobi on the devices, which have no other yet.
 enum class Preconditioner { automatic, jacobi, factorised };
 

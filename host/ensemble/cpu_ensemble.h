@@ -31,8 +31,8 @@ namespace sigmafem {
 class CpuEnsemble : public Ensemble {
  public:
   // `estimated`: indices into model.ligaments; `observed`: node indices; `threads` 0 = cores.
-  // Preconditioner::automatic is the shared factorisation; the conformance tests, which
-  // compare the devices' Jacobi CG with it to the last digits, ask for Jacobi.
+  // Preconditioner::automatic is the factors; the conformance tests, which compare the
+  // devices' Jacobi CG with it to the last digits, ask for Jacobi.
   CpuEnsemble(const Model& model, std::vector<int> estimated, std::vector<int> observed,
               int sigma_count, int threads = 0,
               Preconditioner preconditioner = Preconditioner::automatic);

@@ -17,7 +17,7 @@ namespace sigmafem {
 std::vector<std::string> available_backends();
 
 // Throws InputError for an unknown name, DeviceError when the device cannot run it.
-// The CPU back end takes only `options.preconditioner` (automatic: the shared factorisation);
+// The CPU back end takes only `options.preconditioner` (automatic: the factors);
 // a device back end refuses Preconditioner::factorised with an InputError.
 std::unique_ptr<Ensemble> make_ensemble(const std::string& backend, const Model& model,
                                         const std::vector<int>& estimated,

@@ -1,7 +1,7 @@
 // conjugate_gradient: preconditioned conjugate gradients for a symmetric positive definite
 // system given only by its product, written like Eigen's internal::conjugate_gradient (a bare
 // function; the caller owns the operator and the preconditioner). Jacobi is the oracle's and
-// the device kernels' preconditioner; the CPU ensemble can use a shared factorisation instead
+// the device kernels' preconditioner; the CPU back end uses sparse Cholesky factors instead
 // (factorised_preconditioner.h). The device kernels follow the same stopping rule, so that
 // iteration counts can be compared.
 //

@@ -219,7 +219,7 @@ TEST_F(CliTest, DiagnoseFindsAnInjectedEffectAndWritesItsReport) {
   EXPECT_NE(info.output.find("declared effect camera_offset=0.00"), std::string::npos) << info.output;
 }
 
-// The shared factorisation is the CPU back end's: asked of a device back end, exit 2 and a
+// The factors are the CPU back end's: asked of a device back end, exit 2 and a
 // message that says so, before any device is opened, and no data file.
 TEST_F(CliTest, TheFactorisedPreconditionerIsTheCpuBackEndsOnly) {
   std::ofstream(dir_ / "box.json") << box_.dump(2);
