@@ -109,12 +109,11 @@ CgResult ReferenceSimulation::step(const Eigen::Vector3d& so_position) {
   const Eigen::VectorXd b = system.right_hand_side(forces(x_, frames_, so_target), v_);
 
   CgResult result;
+  const bool factored = solver_ == LinearSolver::conjugate_gradient && factor_ != nullptr;
   // A factor that cannot be made (not positive definite: a candidate's negative stiffness)
   // leaves this step to Jacobi; the next one tries again.
-  if (solver_ == LinearSolver::conjugate_gradient && factor_ != nullptr && refresh_factor_ &&
-      factor_->due())
-    factor_->factorise(system.assemble());
-  if (solver_ == LinearSolver::conjugate_gradient && factor_ != nullptr && factor_->ready()) {
+  if (factored && refresh_factor_ && factor_->due()) factor_->factorise(system.assemble());
+  if (factored && factor_->ready()) {
     result = preconditioned_conjugate_gradient(system, *factor_, b, dv_,
                                                model_.solver.cg_max_iterations,
                                                model_.solver.cg_tolerance);
@@ -133,7 +132,7 @@ CgResult ReferenceSimulation::step(const Eigen::Vector3d& so_position) {
     result.relative_residual = b_norm > 0.0 ? (Adv - b).norm() / b_norm : 0.0;
     result.converged = true;
   }
-  if (factor_ != nullptr && refresh_factor_) factor_->record(result.iterations);
+  if (factored && refresh_factor_) factor_->record(result.iterations);
   v_ += dv_;
   x_ += model_.dt * v_;
   if (!x_.allFinite() || !v_.allFinite())

@@ -6,7 +6,7 @@
 //      (so(t_{n+1}); sigmafem's convention; so(t_{n+1} - so_lag) with a lag), gravity,
 //   3. solve (M + h B + h^2 K) dv = h (f - B v - h K v) by Jacobi-preconditioned CG
 //      warm-started from the last dv (or by a sparse direct solve, to check CG; or by CG
-//      with a factorisation shared by a CPU ensemble's sigma points),
+//      preconditioned by a sparse Cholesky factor instead: factorised_preconditioner.h),
 //   4. v += dv, x += h v.
 #pragma once
 
