@@ -15,6 +15,9 @@
 
 namespace sigmafem {
 
+// The six edges of a tetrahedron, as pairs of its corners (0-3).
+inline constexpr int kTetrahedronEdges[6][2] = {{0, 1}, {0, 2}, {0, 3}, {1, 2}, {1, 3}, {2, 3}};
+
 struct Mesh {
   std::vector<Eigen::Vector3d> nodes;            // positions, metres once transformed
   std::vector<std::array<int, 4>> tetrahedra;    // 0-based node indices, positively oriented

@@ -7,12 +7,16 @@
 // tetrahedra.
 #pragma once
 
+#include <climits>
 #include <string>
 #include <string_view>
 
 #include "host/mesh/mesh.h"
 
 namespace sigmafem {
+
+// The largest node or element count a reader accepts: indices are ints (mesh.h).
+inline constexpr long long kMaxMeshCount = INT_MAX;
 
 // Gmsh ASCII: 1.0 (starts with $NOD), 2.x and 4.1 (start with $MeshFormat).
 Mesh read_gmsh(std::string_view text, const std::string& source);

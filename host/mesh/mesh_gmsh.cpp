@@ -37,7 +37,6 @@ namespace sigmafem {
 namespace {
 
 constexpr long long kTetrahedronType = 4;  // Gmsh element type of the 4-node tetrahedron
-constexpr long long kMaxCount = INT_MAX;   // node and element indices are ints (mesh.h)
 
 enum class GmshVersion { v1, v2, v41 };
 
@@ -164,8 +163,8 @@ class GmshReader {
       in_.fail("expected \"n-blocks n-nodes min-tag max-tag\", found " +
                std::to_string(header.size()) + " fields");
     }
-    const long long blocks = parse_integer_in(header[0], 0, kMaxCount, in_, "the block count");
-    const long long total = parse_integer_in(header[1], 0, kMaxCount, in_, "the node count");
+    const long long blocks = parse_integer_in(header[0], 0, kMaxMeshCount, in_, "the block count");
+    const long long total = parse_integer_in(header[1], 0, kMaxMeshCount, in_, "the node count");
     long long read = 0;
     for (long long b = 0; b < blocks; ++b) {
       const std::vector<std::string_view> block =
@@ -223,14 +222,14 @@ class GmshReader {
       const long long type = parse_integer(fields[1], in_, "an element type");
       std::size_t first_node = 0;
       if (v1) {
-        const long long n = parse_integer_in(fields[4], 0, kMaxCount, in_, "the node count");
+        const long long n = parse_integer_in(fields[4], 0, kMaxMeshCount, in_, "the node count");
         if (fields.size() != fixed + static_cast<std::size_t>(n)) {
           in_.fail("element " + std::to_string(id) + " says it has " + std::to_string(n) +
                    " nodes, the line lists " + std::to_string(fields.size() - fixed));
         }
         first_node = fixed;
       } else {
-        const long long tags = parse_integer_in(fields[2], 0, kMaxCount, in_, "the tag count");
+        const long long tags = parse_integer_in(fields[2], 0, kMaxMeshCount, in_, "the tag count");
         if (fields.size() < fixed + static_cast<std::size_t>(tags)) {
           in_.fail("element " + std::to_string(id) + " says it has " + std::to_string(tags) +
                    " tags, the line is shorter");
@@ -248,8 +247,8 @@ class GmshReader {
       in_.fail("expected \"n-blocks n-elements min-tag max-tag\", found " +
                std::to_string(header.size()) + " fields");
     }
-    const long long blocks = parse_integer_in(header[0], 0, kMaxCount, in_, "the block count");
-    const long long total = parse_integer_in(header[1], 0, kMaxCount, in_, "the element count");
+    const long long blocks = parse_integer_in(header[0], 0, kMaxMeshCount, in_, "the block count");
+    const long long total = parse_integer_in(header[1], 0, kMaxMeshCount, in_, "the element count");
     long long read = 0;
     for (long long b = 0; b < blocks; ++b) {
       const std::vector<std::string_view> block =
@@ -300,8 +299,8 @@ class GmshReader {
       in_.fail("element " + std::to_string(id) + " is a tetrahedron (type 4) but has " +
                std::to_string(nodes.size()) + " nodes, expected 4");
     }
-    if (mesh_.tetrahedra.size() >= static_cast<std::size_t>(kMaxCount)) {
-      in_.fail("more than " + std::to_string(kMaxCount) + " tetrahedra");
+    if (mesh_.tetrahedra.size() >= static_cast<std::size_t>(kMaxMeshCount)) {
+      in_.fail("more than " + std::to_string(kMaxMeshCount) + " tetrahedra");
     }
     mesh_.tetrahedra.push_back({nodes[0], nodes[1], nodes[2], nodes[3]});
   }
@@ -318,13 +317,13 @@ class GmshReader {
       in_.fail(std::string("expected ") + what + " alone on its line, found " +
                std::to_string(fields.size()) + " fields");
     }
-    return parse_integer_in(fields[0], 0, kMaxCount, in_, what);
+    return parse_integer_in(fields[0], 0, kMaxMeshCount, in_, what);
   }
 
   // The coordinates follow (2.x: on the same line; 4.1: after the block's tags).
   void add_node_id(long long id) {
-    if (node_index_.size() >= static_cast<std::size_t>(kMaxCount)) {
-      in_.fail("more than " + std::to_string(kMaxCount) + " nodes");
+    if (node_index_.size() >= static_cast<std::size_t>(kMaxMeshCount)) {
+      in_.fail("more than " + std::to_string(kMaxMeshCount) + " nodes");
     }
     const int index = static_cast<int>(node_index_.size());
     if (!node_index_.emplace(id, index).second) {

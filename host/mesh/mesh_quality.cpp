@@ -29,12 +29,9 @@ const double kRegularQuality = 1.0 / (6.0 * std::sqrt(2.0));
 // Fraction of kRegularQuality below which an element counts as flat.
 constexpr double kDegenerateFraction = 1e-6;
 
-// The six edges of a tetrahedron as pairs of local corners.
-constexpr int kEdges[6][2] = {{0, 1}, {0, 2}, {0, 3}, {1, 2}, {1, 3}, {2, 3}};
-
 double mean_edge_length(const Mesh& mesh, const std::array<int, 4>& t) {
   double sum = 0.0;
-  for (const auto& edge : kEdges) sum += (mesh.nodes[t[edge[1]]] - mesh.nodes[t[edge[0]]]).norm();
+  for (const auto& edge : kTetrahedronEdges) sum += (mesh.nodes[t[edge[1]]] - mesh.nodes[t[edge[0]]]).norm();
   return sum / 6.0;
 }
 

@@ -32,9 +32,7 @@ namespace sigmafem {
 
 namespace {
 
-// The six edges as local corner pairs; edge k's midpoint is local node 4 + k.
-constexpr int kEdges[6][2] = {{0, 1}, {0, 2}, {0, 3}, {1, 2}, {1, 3}, {2, 3}};
-
+// Edge k of kTetrahedronEdges (mesh.h) has its midpoint at local node 4 + k.
 constexpr int kCornerChildren[4][4] = {{0, 4, 5, 6}, {4, 1, 7, 8}, {5, 7, 2, 9}, {6, 8, 9, 3}};
 
 // The octahedron's diagonals join midpoints of opposite edges: (4,9), (5,8), (6,7). For each,
@@ -59,7 +57,7 @@ Mesh refine_uniform(const Mesh& mesh) {
   std::vector<std::uint64_t> edges;
   edges.reserve(6 * mesh.tetrahedra.size());
   for (const std::array<int, 4>& t : mesh.tetrahedra) {
-    for (const auto& edge : kEdges) edges.push_back(edge_key(t[edge[0]], t[edge[1]]));
+    for (const auto& edge : kTetrahedronEdges) edges.push_back(edge_key(t[edge[0]], t[edge[1]]));
   }
   std::sort(edges.begin(), edges.end());
   edges.erase(std::unique(edges.begin(), edges.end()), edges.end());
@@ -88,7 +86,7 @@ Mesh refine_uniform(const Mesh& mesh) {
     // A parent given inverted is refined as its positive twin, so every child is positive.
     if (tetrahedron_volume(mesh, e) < 0.0) std::swap(local[2], local[3]);
     for (int k = 0; k < 6; ++k) {
-      const std::uint64_t key = edge_key(local[kEdges[k][0]], local[kEdges[k][1]]);
+      const std::uint64_t key = edge_key(local[kTetrahedronEdges[k][0]], local[kTetrahedronEdges[k][1]]);
       const auto position = std::lower_bound(edges.begin(), edges.end(), key) - edges.begin();
       local[4 + k] = static_cast<int>(old_nodes + static_cast<std::size_t>(position));
     }

@@ -36,7 +36,6 @@ namespace sigmafem {
 namespace {
 
 constexpr long long kTetraCellType = 10;  // VTK_TETRA
-constexpr long long kMaxCount = INT_MAX;  // node and element indices are ints (mesh.h)
 constexpr int kFirstOffsetsVersion = 5;   // VTK 9 writes 5.1: CELLS as OFFSETS + CONNECTIVITY
 
 // A data type name as legacy VTK writes it, and how to decode it in a BINARY file.
@@ -226,7 +225,7 @@ class VtkReader {
       const long long components = read_count("the number of components");
       const long long tuples = read_count("the number of tuples");
       const ValueType& type = read_type();
-      if (components > 0 && tuples > kMaxCount / components) {
+      if (components > 0 && tuples > kMaxMeshCount / components) {
         in_.fail("field array of " + std::to_string(components) + " x " + std::to_string(tuples) +
                  " values is too large");
       }
@@ -249,7 +248,7 @@ class VtkReader {
   // ---- values -----------------------------------------------------------------------------
 
   long long read_count(const char* what) {
-    return parse_integer_in(in_.require_token(what), 0, kMaxCount, in_, what);
+    return parse_integer_in(in_.require_token(what), 0, kMaxMeshCount, in_, what);
   }
 
   const ValueType& read_type() {
