@@ -28,6 +28,7 @@ struct Backend {
   SolveLaunch solve_launch = SolveLaunch::automatic;
   Preconditioner preconditioner = Preconditioner::automatic;
   bool shared_factor = false;   // CPU: one factor for all sigma points, whatever its size
+  int cg_partitions = 0;        // OpenCL's GPU form: CG work-groups per sigma point (0: by mesh)
 };
 
 // The CPU back end with its default preconditioner (factors: one per sigma point within
@@ -41,6 +42,7 @@ const Backend kCpuJacobi{"cpu", Precision::double_precision, "cpu-reference doub
                          SolveLaunch::automatic, Preconditioner::jacobi};
 
 const Backend kOpenCl{"opencl", Precision::single, "opencl single, device 0"};
+const Backend kVulkan{"vulkan", Precision::single, "vulkan single, device 0"};
 // OpenCL's two ways of running CG, forced, to compare them (OpenClEnsemble chooses by itself).
 const Backend kOpenClPerIteration{"opencl", Precision::single,
                                   "opencl single, device 0, CG launched per iteration",
@@ -48,15 +50,22 @@ const Backend kOpenClPerIteration{"opencl", Precision::single,
 const Backend kOpenClWholeSolve{"opencl", Precision::single,
                                 "opencl single, device 0, CG solve in one launch",
                                 SolveLaunch::whole_solve};
+// CG with one work-group per sigma point whatever the mesh (on a GPU: before partitions).
+const Backend kOpenClOneGroup{"opencl", Precision::single,
+                              "opencl single, device 0, CG a work-group per sigma point",
+                              SolveLaunch::automatic, Preconditioner::automatic, false, 1};
+const Backend kVulkanOneGroup{"vulkan", Precision::single,
+                              "vulkan single, device 0, CG a work-group per sigma point",
+                              SolveLaunch::automatic, Preconditioner::automatic, false, 1};
 
 DeviceOptions device_options(const Backend& backend) {
   DeviceOptions options;
   options.precision = backend.precision;
   options.solve_launch = backend.solve_launch;
   options.preconditioner = backend.preconditioner;
+  options.cg_partitions = backend.cg_partitions;
   return options;
 }
-const Backend kVulkan{"vulkan", Precision::single, "vulkan single, device 0"};
 
 // make_ensemble, and the shared factor where the Backend asks for it.
 std::unique_ptr<Ensemble> make_bench_ensemble(const Backend& backend, const Scenario& s,
@@ -165,6 +174,12 @@ BENCHMARK_CAPTURE(BM_ensemble_step, opencl_per_iteration_liver_4768, kOpenClPerI
 BENCHMARK_CAPTURE(BM_ensemble_step, opencl_whole_solve_liver_4768, kOpenClWholeSolve,
                   std::string("liver"), 1)
     ->RangeMultiplier(2)->Range(1, 16)->Unit(benchmark::kMillisecond)->UseRealTime();
+BENCHMARK_CAPTURE(BM_ensemble_step, opencl_one_group_liver_4768, kOpenClOneGroup,
+                  std::string("liver"), 1)
+    ->Arg(16)->Arg(64)->Unit(benchmark::kMillisecond)->UseRealTime();
+BENCHMARK_CAPTURE(BM_ensemble_step, vulkan_one_group_liver_4768, kVulkanOneGroup,
+                  std::string("liver"), 1)
+    ->Arg(16)->Arg(64)->Unit(benchmark::kMillisecond)->UseRealTime();
 BENCHMARK_CAPTURE(BM_ensemble_step, vulkan_liver_4768, kVulkan, std::string("liver"), 1)
     ->RangeMultiplier(2)->Range(1, 256)->Unit(benchmark::kMillisecond)->UseRealTime();
 BENCHMARK_CAPTURE(BM_ensemble_step, cpu_liver_4768, kCpu, std::string("liver"), 1)
@@ -187,6 +202,12 @@ BENCHMARK_CAPTURE(BM_ensemble_step, cpu_jacobi_liver_596, kCpuJacobi, std::strin
     ->Arg(16)->Unit(benchmark::kMillisecond)->UseRealTime();
 BENCHMARK_CAPTURE(BM_ensemble_step, opencl_liver_fine_38144, kOpenCl, std::string("liver_fine"), 0)
     ->Arg(16)->Arg(64)->Unit(benchmark::kMillisecond)->UseRealTime();
+BENCHMARK_CAPTURE(BM_ensemble_step, opencl_one_group_liver_fine_38144, kOpenClOneGroup,
+                  std::string("liver_fine"), 0)
+    ->Arg(16)->Unit(benchmark::kMillisecond)->UseRealTime();
+BENCHMARK_CAPTURE(BM_ensemble_step, vulkan_one_group_liver_fine_38144, kVulkanOneGroup,
+                  std::string("liver_fine"), 0)
+    ->Arg(16)->Unit(benchmark::kMillisecond)->UseRealTime();
 BENCHMARK_CAPTURE(BM_ensemble_step, vulkan_liver_fine_38144, kVulkan, std::string("liver_fine"), 0)
     ->Arg(16)->Arg(64)->Unit(benchmark::kMillisecond)->UseRealTime();
 BENCHMARK_CAPTURE(BM_ensemble_step, cpu_liver_fine_38144, kCpu, std::string("liver_fine"), 0)
@@ -194,6 +215,12 @@ BENCHMARK_CAPTURE(BM_ensemble_step, cpu_liver_fine_38144, kCpu, std::string("liv
 BENCHMARK_CAPTURE(BM_ensemble_step, cpu_shared_liver_fine_38144, kCpuShared, std::string("liver_fine"), 0)
     ->Arg(16)->Unit(benchmark::kMillisecond)->UseRealTime();
 BENCHMARK_CAPTURE(BM_ensemble_step, opencl_box_large_117240, kOpenCl, std::string("box_large"), 0)
+    ->Arg(16)->Arg(64)->Unit(benchmark::kMillisecond)->UseRealTime();
+BENCHMARK_CAPTURE(BM_ensemble_step, opencl_one_group_box_large_117240, kOpenClOneGroup,
+                  std::string("box_large"), 0)
+    ->Arg(16)->Arg(64)->Unit(benchmark::kMillisecond)->UseRealTime();
+BENCHMARK_CAPTURE(BM_ensemble_step, vulkan_one_group_box_large_117240, kVulkanOneGroup,
+                  std::string("box_large"), 0)
     ->Arg(16)->Arg(64)->Unit(benchmark::kMillisecond)->UseRealTime();
 BENCHMARK_CAPTURE(BM_ensemble_step, vulkan_box_large_117240, kVulkan, std::string("box_large"), 0)
     ->Arg(16)->Arg(64)->Unit(benchmark::kMillisecond)->UseRealTime();

@@ -30,6 +30,9 @@ struct DeviceOptions {
   Precision precision = Precision::single;
   SolveLaunch solve_launch = SolveLaunch::automatic;
   KernelForm kernel_form = KernelForm::automatic;   // OpenCL only
+  // Work-groups per sigma point in CG on a GPU (OpenCL's GPU form, Vulkan on a GPU;
+  // cg_partitions() in host/ensemble/ensemble_tables.h); 0 chooses by the mesh's size.
+  int cg_partitions = 0;
   Preconditioner preconditioner = Preconditioner::automatic;
 };
 

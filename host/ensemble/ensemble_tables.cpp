@@ -36,6 +36,11 @@ void check_ensemble_arguments(const Model& model, const std::vector<int>& estima
                        "spring over the refined mesh), which the device back ends do not hold: use --backend cpu");
 }
 
+int cg_partitions(int nodes, int forced) {
+  if (forced > 0) return forced;
+  return std::clamp(3 * nodes / kPartitionRows, 1, kMostPartitions);
+}
+
 EnsembleTables make_ensemble_tables(const Model& model, int S) {
   const int nodes = model.node_count(), elements = model.element_count();
   EnsembleTables t;

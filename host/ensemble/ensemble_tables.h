@@ -54,6 +54,14 @@ constexpr double kSingleCgTolerance = 1e-6;
 // in single precision.
 double device_cg_tolerance(const Model& model, Precision precision);
 
+// The CG kernels' work-groups per sigma point on a GPU (kernels/opencl/conjugate_gradient.cl's
+// SF_CG_PARTITIONS, specialization constant 1 of kernels/vulkan/conjugate_gradient.comp): one
+// below 2 kPartitionRows rows (3 per node), then one per kPartitionRows rows, at most
+// kMostPartitions. `forced` > 0 (DeviceOptions::cg_partitions) is taken as it is.
+constexpr int kPartitionRows = 512;
+constexpr int kMostPartitions = 64;
+int cg_partitions(int nodes, int forced);
+
 // The tables for S = sigma_count (after the device-memory check: they are as big as the
 // per-sigma state).
 EnsembleTables make_ensemble_tables(const Model& model, int sigma_count);

@@ -77,6 +77,10 @@ OpenClEnsemble::OpenClEnsemble(const Model& model, std::vector<int> estimated,
                   (options.solve_launch == SolveLaunch::automatic &&
                    static_cast<long long>(elements_) * S_ <= kWholeSolveWork));
   cg_group_ = cg_per_group_ ? 64 : 1;
+  // The GPU form on a large mesh: P work-groups per sigma point in CG (conjugate_gradient.cl,
+  // SF_CG_PARTITIONS), so that S x P groups share the device and each work-item takes about
+  // kPartitionRows / 64 rows rather than thousands.
+  if (cg_per_group_) cg_partitions_ = cg_partitions(nodes_, options.cg_partitions);
   const int units = static_cast<int>(std::max(1u, info.compute_units));
   cg_block_ = (S_ + units - 1) / units;
   while (S_ % cg_block_ != 0) --cg_block_;
@@ -84,7 +88,8 @@ OpenClEnsemble::OpenClEnsemble(const Model& model, std::vector<int> estimated,
                         " -DSF_ELEMENT_CHUNKS=" + std::to_string(element_chunks_) +
                         " -DSF_CG_PER_GROUP=" + std::to_string(cg_per_group_ ? 1 : 0) +
                         " -DSF_GROUP_SIZE=" + std::to_string(cg_group_) +
-                        " -DSF_CG_BLOCK=" + std::to_string(cg_block_));
+                        " -DSF_CG_BLOCK=" + std::to_string(cg_block_) +
+                        " -DSF_CG_PARTITIONS=" + std::to_string(cg_partitions_));
 
   try {
     element_nodes_ = make_buffer(tables.element_nodes, "element nodes");
@@ -117,6 +122,13 @@ OpenClEnsemble::OpenClEnsemble(const Model& model, std::vector<int> estimated,
     for (cl::Buffer* b : {&active_, &converged_, &iterations_})
       *b = make_buffer(std::vector<int>(S_, 0), "CG flags");
     all_active_ = make_buffer(std::vector<int>(S_, 1), "CG flags");
+    if (cg_partitions_ > 1) {
+      const std::size_t groups = static_cast<std::size_t>(S_) * cg_partitions_;
+      partial_ = make_buffer(4 * groups, "CG partial sums");
+      own_rz_ = make_buffer(groups, "CG scalars");
+      own_active_ = make_buffer(std::vector<int>(groups, 0), "CG flags");
+      own_iterations_ = make_buffer(std::vector<int>(groups, 0), "CG flags");
+    }
     recenter_scalars_ = make_buffer(1 + kMaxParameters, "re-centring");
     directions_ = make_buffer(static_cast<std::size_t>(kMaxParameters) * S_, "re-centring");
     weights_ = make_buffer(static_cast<std::size_t>(kMaxParameters) * S_, "re-centring");
@@ -128,6 +140,13 @@ OpenClEnsemble::OpenClEnsemble(const Model& model, std::vector<int> estimated,
     k_cg_start_ = device_.kernel("cg_start");
     k_cg_iteration_ = device_.kernel("cg_iteration");
     if (whole_solve_) k_cg_solve_ = device_.kernel("cg_solve");
+    if (cg_partitions_ > 1) {
+      k_cg_start_partials_ = device_.kernel("cg_start_partials");
+      k_cg_start_scalars_ = device_.kernel("cg_start_scalars");
+      k_cg_dot_ = device_.kernel("cg_dot");
+      k_cg_update_ = device_.kernel("cg_update");
+      k_cg_direction_ = device_.kernel("cg_direction");
+    }
     k_state_update_ = device_.kernel("state_update");
     k_observation_gather_ = device_.kernel("observation_gather");
     k_recenter_ = device_.kernel("recenter");
@@ -157,6 +176,17 @@ OpenClEnsemble::OpenClEnsemble(const Model& model, std::vector<int> estimated,
       k_cg_iteration_.setArg(19, control_k_);
       k_cg_iteration_.setArg(20, mass_);
       k_cg_iteration_.setArg(21, element_out_);
+    }
+    if (cg_partitions_ > 1) {
+      set_args(k_cg_start_partials_, S, N, q_, rhs_, inverse_diagonal_, r_, z_, d_, partial_);
+      set_args(k_cg_start_scalars_, S, constants_, partial_, bb_, rr_, rz_, active_, converged_,
+               iterations_, own_active_, own_iterations_, own_rz_);
+      set_args(k_cg_dot_, S, N, d_, q_, partial_, own_active_);
+      set_args(k_cg_update_, S, N, inverse_diagonal_, dv_, r_, z_, d_, q_, partial_, own_active_,
+               own_rz_);
+      set_args(k_cg_direction_, S, N, static_cast<cl_int>(model.solver.cg_max_iterations),
+               constants_, z_, d_, partial_, bb_, rr_, rz_, active_, converged_, iterations_,
+               own_active_, own_iterations_, own_rz_);
     }
     if (whole_solve_)
       set_args(k_cg_solve_, S, E, N, static_cast<cl_int>(model.solver.cg_max_iterations),
@@ -273,6 +303,10 @@ void OpenClEnsemble::run_cg(cl::Kernel& kernel) const {
     run(kernel, static_cast<std::size_t>(S_ / cg_block_), 1);
 }
 
+void OpenClEnsemble::run_partitions(cl::Kernel& kernel) const {
+  run(kernel, cg_group_ * S_ * cg_partitions_, cg_group_);
+}
+
 std::size_t OpenClEnsemble::element_items() const {
   return static_cast<std::size_t>(elements_) * (S_ / sigma_block_);
 }
@@ -303,7 +337,12 @@ void OpenClEnsemble::conjugate_gradient() {
   // The warm start's residual (dv holds the last step's velocity change).
   element_product(dv_, all_active_);
   node_product(dv_, q_);
-  run_cg(k_cg_start_);
+  if (cg_partitions_ > 1) {
+    run_partitions(k_cg_start_partials_);
+    run(k_cg_start_scalars_, static_cast<std::size_t>(S_));
+  } else {
+    run_cg(k_cg_start_);
+  }
   // Iterate, checking on the host only now and then: first after as many iterations as the
   // last step needed (warm-started steps need about the same), then in small batches. A
   // sigma point that is done is left alone by the kernels, so overshooting changes nothing.
@@ -315,7 +354,13 @@ void OpenClEnsemble::conjugate_gradient() {
     for (int i = 0; i < count; ++i) {
       element_product(d_, active_);
       if (cg_per_group_) node_product(d_, q_);   // on a CPU cg_iteration does it
-      run_cg(k_cg_iteration_);
+      if (cg_partitions_ > 1) {
+        run_partitions(k_cg_dot_);
+        run_partitions(k_cg_update_);
+        run_partitions(k_cg_direction_);
+      } else {
+        run_cg(k_cg_iteration_);
+      }
     }
     done += count;
     device_.queue().enqueueReadBuffer(active_, CL_TRUE, 0, S_ * sizeof(cl_uint), active.data());

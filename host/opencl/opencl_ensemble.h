@@ -71,6 +71,7 @@ class OpenClEnsemble : public DeviceEnsemble {
   void conjugate_gradient();
   void run(cl::Kernel& kernel, std::size_t items, std::size_t local = 0) const;
   void run_cg(cl::Kernel& kernel) const;   // cg_start or cg_iteration, as SF_CG_PER_GROUP
+  void run_partitions(cl::Kernel& kernel) const;   // a CG kernel's S x P groups (GPU form)
 
   mutable OpenClDevice device_;
   Model model_;                             // a copy: the ensemble outlives its caller's model
@@ -87,6 +88,7 @@ class OpenClEnsemble : public DeviceEnsemble {
   int expected_iterations_ = 1;             // CG iterations the last step needed (at most)
   bool whole_solve_ = false;                // cg_solve: the whole CG solve in one launch (CPU)
   int cg_block_ = 1;                        // SF_CG_BLOCK: sigma points per CG work-item (CPU)
+  int cg_partitions_ = 1;                   // SF_CG_PARTITIONS: CG work-groups per sigma (GPU)
 
   // Shared data.
   cl::Buffer element_nodes_, element_rest_, incidence_offsets_, incidence_;
@@ -97,12 +99,16 @@ class OpenClEnsemble : public DeviceEnsemble {
   cl::Buffer frames_, element_out_, element_diagonal_, observations_;
   // Per-sigma CG scalars; all_active_ holds S ones (products outside CG).
   cl::Buffer bb_, rr_, rz_, active_, converged_, iterations_, all_active_;
+  // With partitions: the partial sums, and each (sigma, partition) group's own scalars.
+  cl::Buffer partial_, own_active_, own_iterations_, own_rz_;
   // Re-centring inputs.
   cl::Buffer recenter_scalars_, directions_, weights_;
 
   // Mutable: enqueueing a kernel (also from the const read-outs) changes no visible state.
   mutable cl::Kernel k_element_rhs_, k_node_rhs_, k_element_product_, k_node_product_;
   mutable cl::Kernel k_cg_start_, k_cg_iteration_, k_cg_solve_, k_state_update_;
+  mutable cl::Kernel k_cg_start_partials_, k_cg_start_scalars_, k_cg_dot_, k_cg_update_;
+  mutable cl::Kernel k_cg_direction_;
   mutable cl::Kernel k_observation_gather_;
   mutable cl::Kernel k_recenter_;
 };

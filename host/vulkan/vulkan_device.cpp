@@ -407,8 +407,9 @@ VulkanDevice::VulkanDevice(int index, Precision precision) : precision_(precisio
     fence.sType = VK_STRUCTURE_TYPE_FENCE_CREATE_INFO;
     check(api_->vkCreateFence(device_, &fence, nullptr, &fence_), "creating a fence");
 
-    // Enough for the ensemble's descriptor sets (a dozen, at most 21 buffers each).
-    VkDescriptorPoolSize sizes{VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, 512};
+    // Enough for the ensemble's descriptor sets (about twenty, at most 25 buffers each; about
+    // 240 buffers in all).
+    VkDescriptorPoolSize sizes{VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, 1024};
     VkDescriptorPoolCreateInfo descriptors{};
     descriptors.sType = VK_STRUCTURE_TYPE_DESCRIPTOR_POOL_CREATE_INFO;
     descriptors.maxSets = 64;
@@ -565,12 +566,14 @@ void VulkanDevice::download(const VulkanBuffer& buffer, void* data, std::size_t 
   std::memcpy(data, staging_.map, bytes);
 }
 
-VulkanKernel VulkanDevice::kernel(const char* name, int bindings, std::uint32_t group_size) {
+VulkanKernel VulkanDevice::kernel(const char* name, int bindings, std::uint32_t group_size,
+                                  std::uint32_t partitions) {
   const bool want_double = precision_ == Precision::double_precision;
   for (std::size_t i = 0; i < kVulkanShaderCount; ++i) {
     const EmbeddedShader& shader = kVulkanShaders[i];
     if (shader.double_precision == want_double && std::strcmp(shader.name, name) == 0)
-      return kernel_from_spirv(name, shader.words, shader.word_count, bindings, group_size);
+      return kernel_from_spirv(name, shader.words, shader.word_count, bindings, group_size,
+                               partitions);
   }
   throw DeviceError(std::string("no embedded Vulkan shader '") + name + "' (" +
                     (want_double ? "double" : "single") +
@@ -579,7 +582,7 @@ VulkanKernel VulkanDevice::kernel(const char* name, int bindings, std::uint32_t 
 
 VulkanKernel VulkanDevice::kernel_from_spirv(const std::string& name, const std::uint32_t* words,
                                              std::size_t word_count, int bindings,
-                                             std::uint32_t group_size) {
+                                             std::uint32_t group_size, std::uint32_t partitions) {
   // Drivers may crash on a module that is not SPIR-V, so look at its header first.
   constexpr std::uint32_t kSpirvMagic = 0x07230203;
   if (word_count < 5 || words == nullptr || words[0] != kSpirvMagic)
@@ -619,8 +622,12 @@ VulkanKernel VulkanDevice::kernel_from_spirv(const std::string& name, const std:
     code.pCode = words;
     check(api_->vkCreateShaderModule(device_, &code, nullptr, &module),
           "loading the Vulkan shader " + name);
-    VkSpecializationMapEntry entry{0, 0, sizeof(std::uint32_t)};
-    VkSpecializationInfo specialization{1, &entry, sizeof(std::uint32_t), &group_size};
+    // Constant 0 the group size, constant 1 the partitions (when given).
+    const std::uint32_t constants[2] = {group_size, partitions};
+    const VkSpecializationMapEntry entries[2] = {{0, 0, sizeof(std::uint32_t)},
+                                                 {1, sizeof(std::uint32_t), sizeof(std::uint32_t)}};
+    VkSpecializationInfo specialization{partitions > 0 ? 2u : 1u, entries, sizeof(constants),
+                                        constants};
     VkComputePipelineCreateInfo pipeline{};
     pipeline.sType = VK_STRUCTURE_TYPE_COMPUTE_PIPELINE_CREATE_INFO;
     pipeline.stage.sType = VK_STRUCTURE_TYPE_PIPELINE_SHADER_STAGE_CREATE_INFO;

@@ -80,12 +80,15 @@ class VulkanDevice {
   void download(const VulkanBuffer& buffer, void* data, std::size_t bytes);
 
   // The pipeline of embedded shader `name` in this device's precision. `group_size` > 0 sets
-  // specialization constant 0 (the work-group size of the CG shaders). Throws DeviceError
-  // when the shader is not embedded, is not SPIR-V or the driver rejects it.
-  VulkanKernel kernel(const char* name, int bindings, std::uint32_t group_size = 0);
+  // specialization constant 0 (the work-group size of the CG shaders), `partitions` > 0 (with
+  // it) constant 1 (the CG shaders' partitions per sigma point). Throws DeviceError when the
+  // shader is not embedded, is not SPIR-V or the driver rejects it.
+  VulkanKernel kernel(const char* name, int bindings, std::uint32_t group_size = 0,
+                      std::uint32_t partitions = 0);
   // Same, from given SPIR-V words (tests: a module that fails to load).
   VulkanKernel kernel_from_spirv(const std::string& name, const std::uint32_t* words,
-                                 std::size_t word_count, int bindings, std::uint32_t group_size);
+                                 std::size_t word_count, int bindings, std::uint32_t group_size,
+                                 std::uint32_t partitions = 0);
   // A descriptor set with `buffers` at bindings 0..n-1 for `kernel`.
   VkDescriptorSet bind(const VulkanKernel& kernel, const std::vector<VulkanBuffer>& buffers);
 

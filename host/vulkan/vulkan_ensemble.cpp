@@ -42,10 +42,16 @@ VulkanEnsemble::VulkanEnsemble(const Model& model, std::vector<int> estimated,
   if (need.largest > info.max_buffer || need.total > info.memory)
     throw DeviceError(out_of_device_memory_message(need, elements_, S_, info.name,
                                                    info.memory, info.max_buffer));
-  // The CG shaders take one work-group per sigma point along x.
-  if (static_cast<std::uint32_t>(S_) > device_.max_group_count())
+  // CG's work-groups per sigma point (conjugate_gradient.comp): by the mesh on a GPU, one on
+  // a CPU (lavapipe), where S groups already keep its few cores busy, unless a test forces it.
+  cg_partitions_ = info.type == "cpu" && options.cg_partitions == 0
+                       ? 1
+                       : cg_partitions(nodes_, options.cg_partitions);
+  // The CG shaders take S x partitions work-groups along x.
+  if (static_cast<std::uint64_t>(S_) * cg_partitions_ > device_.max_group_count())
     throw DeviceError("Vulkan device " + info.name + " runs at most " +
-                      std::to_string(device_.max_group_count()) + " sigma points");
+                      std::to_string(device_.max_group_count() / cg_partitions_) +
+                      " sigma points on this mesh");
   EnsembleTables tables = make_ensemble_tables(model, S_);
   ligament_k_ = std::move(tables.ligament_k);
   // Work-items per sigma point in CG: on a CPU (lavapipe) one SIMD register's worth, so that
@@ -79,6 +85,13 @@ VulkanEnsemble::VulkanEnsemble(const Model& model, std::vector<int> estimated,
   for (VulkanBuffer* b : {&active_, &converged_, &iterations_})
     *b = make_buffer(std::vector<int>(S_, 0), "CG flags");
   all_active_ = make_buffer(std::vector<int>(S_, 1), "CG flags");
+  // The partitions' partial sums and each (sigma point, partition) group's own scalars (bound
+  // but unused with one partition).
+  const std::size_t cg_groups = static_cast<std::size_t>(S_) * cg_partitions_;
+  partial_ = make_buffer(4 * cg_groups, "CG partial sums");
+  own_rz_ = make_buffer(cg_groups, "CG scalars");
+  own_active_ = make_buffer(std::vector<int>(cg_groups, 0), "CG flags");
+  own_iterations_ = make_buffer(std::vector<int>(cg_groups, 0), "CG flags");
   recenter_scalars_ = make_buffer(1 + kDeviceMaxParameters, "re-centring");
   directions_ = make_buffer(static_cast<std::size_t>(kDeviceMaxParameters) * S_, "re-centring");
   weights_ = make_buffer(static_cast<std::size_t>(kDeviceMaxParameters) * S_, "re-centring");
@@ -91,8 +104,17 @@ VulkanEnsemble::VulkanEnsemble(const Model& model, std::vector<int> estimated,
   k_node_rhs_ = device_.kernel("node_rhs", 15);
   k_element_product_ = device_.kernel("element_product", 6);
   k_node_product_ = device_.kernel("node_product", 11);
-  k_cg_start_ = device_.kernel("cg_start", 21, cg_group_);
-  k_cg_iteration_ = device_.kernel("cg_iteration", 13, cg_group_);
+  // The CG shaders: the start's three share 25 bindings, the iteration's four 17.
+  const std::uint32_t partitions = static_cast<std::uint32_t>(cg_partitions_);
+  k_cg_start_ = device_.kernel("cg_start", 25, cg_group_, partitions);
+  k_cg_iteration_ = device_.kernel("cg_iteration", 17, cg_group_, partitions);
+  if (cg_partitions_ > 1) {
+    k_cg_start_partials_ = device_.kernel("cg_start_partials", 25, cg_group_, partitions);
+    k_cg_start_scalars_ = device_.kernel("cg_start_scalars", 25, cg_group_, partitions);
+    k_cg_dot_ = device_.kernel("cg_dot", 17, cg_group_, partitions);
+    k_cg_update_ = device_.kernel("cg_update", 17, cg_group_, partitions);
+    k_cg_direction_ = device_.kernel("cg_direction", 17, cg_group_, partitions);
+  }
   k_state_update_ = device_.kernel("state_update", 5);
   k_observation_gather_ = device_.kernel("observation_gather", 3);
   k_recenter_ = device_.kernel("recenter", 5);
@@ -116,12 +138,22 @@ VulkanEnsemble::VulkanEnsemble(const Model& model, std::vector<int> estimated,
   s_product_all_ = device_.bind(
       k_element_product_, {element_nodes_, element_rest_, frames_, d_, all_active_, element_out_});
   s_node_product_ = device_.bind(k_node_product_, with_shared({d_, element_out_, q_}));
-  s_cg_start_ = device_.bind(k_cg_start_,
-                             with_shared({element_out_, rhs_, inverse_diagonal_, dv_, r_, z_, d_,
-                                          bb_, rr_, rz_, active_, converged_, iterations_}));
-  s_cg_iteration_ = device_.bind(k_cg_iteration_, {constants_, inverse_diagonal_, dv_, r_, z_, d_,
-                                                   q_, bb_, rr_, rz_, active_, converged_,
-                                                   iterations_});
+  const std::vector<VulkanBuffer> start_buffers = with_shared(
+      {element_out_, rhs_, inverse_diagonal_, dv_, r_, z_, d_, bb_, rr_, rz_, active_, converged_,
+       iterations_, partial_, own_active_, own_iterations_, own_rz_});
+  const std::vector<VulkanBuffer> iteration_buffers = {
+      constants_, inverse_diagonal_, dv_,     r_,          z_,         d_,
+      q_,         bb_,               rr_,     rz_,         active_,    converged_,
+      iterations_, partial_,         own_active_, own_iterations_, own_rz_};
+  s_cg_start_ = device_.bind(k_cg_start_, start_buffers);
+  s_cg_iteration_ = device_.bind(k_cg_iteration_, iteration_buffers);
+  if (cg_partitions_ > 1) {
+    s_cg_start_partials_ = device_.bind(k_cg_start_partials_, start_buffers);
+    s_cg_start_scalars_ = device_.bind(k_cg_start_scalars_, start_buffers);
+    s_cg_dot_ = device_.bind(k_cg_dot_, iteration_buffers);
+    s_cg_update_ = device_.bind(k_cg_update_, iteration_buffers);
+    s_cg_direction_ = device_.bind(k_cg_direction_, iteration_buffers);
+  }
   s_state_update_ = device_.bind(k_state_update_, {constants_, bb_, dv_, x_, v_});
   s_observation_gather_ = device_.bind(k_observation_gather_, {observed_nodes_, x_, observations_});
   s_recenter_ = device_.bind(k_recenter_, {recenter_scalars_, directions_, weights_, x_, v_});
@@ -221,9 +253,18 @@ void VulkanEnsemble::record_cg_iterations(VkCommandBuffer cmd, int count) const 
   push.S = static_cast<std::uint32_t>(S_);
   push.count = static_cast<std::uint32_t>(nodes_);
   push.max_iterations = model_.solver.cg_max_iterations;
+  const std::uint32_t groups = static_cast<std::uint32_t>(S_ * cg_partitions_);
   for (int i = 0; i < count; ++i) {
     record_system_product(cmd, s_product_cg_);
-    device_.dispatch(cmd, k_cg_iteration_, s_cg_iteration_, &push, static_cast<std::uint32_t>(S_));
+    if (cg_partitions_ > 1) {
+      device_.dispatch(cmd, k_cg_dot_, s_cg_dot_, &push, groups);
+      device_.barrier(cmd);
+      device_.dispatch(cmd, k_cg_update_, s_cg_update_, &push, groups);
+      device_.barrier(cmd);
+      device_.dispatch(cmd, k_cg_direction_, s_cg_direction_, &push, groups);
+    } else {
+      device_.dispatch(cmd, k_cg_iteration_, s_cg_iteration_, &push, groups);
+    }
     device_.barrier(cmd);
   }
 }
@@ -250,7 +291,15 @@ StepReport VulkanEnsemble::advance(const Eigen::Vector3d& so_position) {
   PushConstants push;
   push.S = static_cast<std::uint32_t>(S_);
   push.count = static_cast<std::uint32_t>(nodes_);
-  device_.dispatch(cmd, k_cg_start_, s_cg_start_, &push, static_cast<std::uint32_t>(S_));
+  if (cg_partitions_ > 1) {
+    device_.dispatch(cmd, k_cg_start_partials_, s_cg_start_partials_, &push,
+                     static_cast<std::uint32_t>(S_ * cg_partitions_));
+    device_.barrier(cmd);
+    device_.dispatch(cmd, k_cg_start_scalars_, s_cg_start_scalars_, &push,
+                     (static_cast<std::uint32_t>(S_) + cg_group_ - 1) / cg_group_);
+  } else {
+    device_.dispatch(cmd, k_cg_start_, s_cg_start_, &push, static_cast<std::uint32_t>(S_));
+  }
   device_.barrier(cmd);
 
   // Then batches until every sigma point is done or the cap is reached. A sigma point that

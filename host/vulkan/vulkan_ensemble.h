@@ -84,6 +84,7 @@ class VulkanEnsemble : public DeviceEnsemble {
   std::size_t device_bytes_ = 0;
   std::vector<double> ligament_k_;
   std::uint32_t cg_group_ = 64;              // work-items per sigma point in the CG shaders
+  int cg_partitions_ = 1;                    // work-groups per sigma point in them (constant 1)
   int expected_iterations_ = 1;              // CG iterations the last step needed (at most)
   int last_step_waits_ = 0;
   // The observations gathered at the end of the last advance(), until recenter() moves x.
@@ -99,10 +100,12 @@ class VulkanEnsemble : public DeviceEnsemble {
   VulkanBuffer ligament_k_buffer_, x_, v_, dv_, rhs_, inverse_diagonal_, r_, z_, d_, q_;
   VulkanBuffer frames_, element_out_, element_diagonal_, observations_;
   VulkanBuffer bb_, rr_, rz_, active_, converged_, iterations_, all_active_;
+  VulkanBuffer partial_, own_active_, own_iterations_, own_rz_;   // CG's partitions
   VulkanBuffer recenter_scalars_, directions_, weights_;
 
   VulkanKernel k_element_rhs_, k_node_rhs_, k_element_product_, k_node_product_;
   VulkanKernel k_cg_start_, k_cg_iteration_, k_state_update_, k_observation_gather_, k_recenter_;
+  VulkanKernel k_cg_start_partials_, k_cg_start_scalars_, k_cg_dot_, k_cg_update_, k_cg_direction_;
   // Descriptor sets; element_product has three: the warm start's product (dv, all active),
   // the CG product (d, the active flags) and system_product()'s (d, all active).
   VkDescriptorSet s_element_rhs_ = VK_NULL_HANDLE, s_node_rhs_ = VK_NULL_HANDLE;
@@ -111,6 +114,9 @@ class VulkanEnsemble : public DeviceEnsemble {
   VkDescriptorSet s_cg_start_ = VK_NULL_HANDLE, s_cg_iteration_ = VK_NULL_HANDLE;
   VkDescriptorSet s_state_update_ = VK_NULL_HANDLE, s_observation_gather_ = VK_NULL_HANDLE;
   VkDescriptorSet s_recenter_ = VK_NULL_HANDLE;
+  VkDescriptorSet s_cg_start_partials_ = VK_NULL_HANDLE, s_cg_start_scalars_ = VK_NULL_HANDLE;
+  VkDescriptorSet s_cg_dot_ = VK_NULL_HANDLE, s_cg_update_ = VK_NULL_HANDLE;
+  VkDescriptorSet s_cg_direction_ = VK_NULL_HANDLE;
 };
 
 }  // namespace sigmafem

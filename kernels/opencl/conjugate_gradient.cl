@@ -8,7 +8,9 @@
  * left alone, so the host may enqueue several iterations between checks without changing
  * anyone's result. Two forms of these kernels:
  *  - a GPU (SF_CG_PER_GROUP = 1): one work-group per sigma point owns its rows and reduces
- *    its dot products in the group (a fixed tree: the same bits every run);
+ *    its dot products in the group (a fixed tree: the same bits every run); on a large mesh
+ *    P work-groups per sigma point, each with a partition of its rows, and three launches
+ *    for what cg_iteration does in one (SF_CG_PARTITIONS, below);
  *  - a CPU (SF_CG_PER_GROUP = 0): one work-item per block of SF_CG_BLOCK sigma points (S over
  *    the compute units) goes down the rows with the block innermost, on contiguous data:
  *    vectorised, and each cache line read once (one work-item per sigma point read a line per
@@ -27,6 +29,25 @@
 #ifndef SF_CG_PER_GROUP
 #  define SF_CG_PER_GROUP 1
 #endif
+
+/* Sigma point s's scalars after the warm start, from its sums b.b, r.r and r.z; returns
+ * whether it iterates. An overflowed load (|b|^2 not finite) would pass the stop test as
+ * inf <= inf: a breakdown instead, neither converged nor iterating, as in the CPU reference.
+ * b = 0 counts as converged: the state update then uses dv = 0, the exact solution. */
+static inline int sf_cg_start_scalars(uint s, real sum_bb, real sum_rr, real sum_rz,
+                                      __global const real* c, __global real* bb,
+                                      __global real* rr, __global real* rz, __global uint* active,
+                                      __global uint* converged, __global int* iterations) {
+  int breakdown = !isfinite(sum_bb) || !isfinite(sum_rr);
+  int done = !breakdown && (sum_bb == (real)0 || sum_rr <= c[SF_CG_TOLERANCE2] * sum_bb);
+  bb[s] = sum_bb;
+  rr[s] = sum_rr;
+  rz[s] = sum_rz;
+  active[s] = done || breakdown ? 0u : 1u;
+  converged[s] = done ? 1u : 0u;
+  iterations[s] = 0;
+  return !(done || breakdown);
+}
 
 #if SF_CG_PER_GROUP
 /* Work-items per sigma point: a power of two (the host passes the same number). */
@@ -49,8 +70,7 @@ static inline real sf_group_sum(__local real* scratch, real value) {
 
 /* The warm start's residual and the first direction: with q = A x (x = the last step's dv,
  * from element_product and node_product), r = b - q, z = M^-1 r, d = z; bb, rr, rz; and
- * whether the warm start is already good enough (b = 0 counts as converged: the state update
- * then uses dv = 0, the exact solution). */
+ * whether the warm start is already good enough. */
 __kernel __attribute__((reqd_work_group_size(SF_GROUP_SIZE, 1, 1)))
 void cg_start(uint S, uint node_count, __global const real* c, __global const real* q,
               __global const real* b, __global const real* inverse_diagonal, __global real* r,
@@ -77,18 +97,8 @@ void cg_start(uint S, uint node_count, __global const real* c, __global const re
   sum_bb = sf_group_sum(scratch, sum_bb);
   sum_rr = sf_group_sum(scratch, sum_rr);
   sum_rz = sf_group_sum(scratch, sum_rz);
-  if (get_local_id(0) == 0) {
-    /* An overflowed load (|b|^2 not finite) would pass the stop test as inf <= inf: a
-     * breakdown instead, neither converged nor iterating, as in the CPU reference. */
-    int breakdown = !isfinite(sum_bb) || !isfinite(sum_rr);
-    int done = !breakdown && (sum_bb == (real)0 || sum_rr <= c[SF_CG_TOLERANCE2] * sum_bb);
-    bb[s] = sum_bb;
-    rr[s] = sum_rr;
-    rz[s] = sum_rz;
-    active[s] = done || breakdown ? 0u : 1u;
-    converged[s] = done ? 1u : 0u;
-    iterations[s] = 0;
-  }
+  if (get_local_id(0) == 0)
+    sf_cg_start_scalars(s, sum_bb, sum_rr, sum_rz, c, bb, rr, rz, active, converged, iterations);
 }
 
 /* One CG iteration of one sigma point, given q = A d (node_product): alpha = rz / d.q, x += alpha d, r -= alpha q, z = M^-1 r, then the convergence
@@ -156,6 +166,189 @@ void cg_iteration(uint S, uint node_count, int max_iterations, __global const re
     }
   }
 }
+/* Partitions: on a large mesh one group per sigma point leaves most of a GPU idle (S groups
+ * of 64 work-items, each going down thousands of rows). With SF_CG_PARTITIONS = P > 1 (the
+ * host's choice by the rows) each sigma point's rows are cut into P contiguous partitions and
+ * every (sigma point, partition) pair is a work-group, S x P in all (group g: s = g / P,
+ * p = g % P). An iteration then takes three launches after the product, each ending where a
+ * sum over all rows is needed: cg_dot (d.q), cg_update (alpha; x, r, z; r.r and r.z) and
+ * cg_direction (the stop test and beta; d). A group's partial sums go to `partial`
+ * [(quantity * S + s) * P + p]; a group that needs a sum adds the P partials itself, in
+ * partition order, so every group of a sigma point gets the same bits, in every run. Each group
+ * also keeps its own copy of its sigma point's active flag, iteration count and r.z (the own_*
+ * arrays, [s * P + p]): no group reads what another group of the same launch writes. Group
+ * (s, 0) writes the per-sigma scalars that the host and the other kernels read. */
+#ifndef SF_CG_PARTITIONS
+#  define SF_CG_PARTITIONS 1
+#endif
+#define SF_PARTIAL_DQ 0
+#define SF_PARTIAL_RR 1
+#define SF_PARTIAL_RZ 2
+#define SF_PARTIAL_BB 3
+
+/* Partition p's rows: [*begin, *end). */
+static inline void sf_partition_rows(uint rows, uint p, uint* begin, uint* end) {
+  uint size = (rows + SF_CG_PARTITIONS - 1) / SF_CG_PARTITIONS;
+  *begin = min(rows, p * size);
+  *end = min(rows, *begin + size);
+}
+
+/* Sigma point s's P partials of one quantity, summed in partition order. */
+static inline real sf_partials_sum(__global const real* partial, uint quantity, uint S, uint s) {
+  __global const real* at = partial + ((size_t)quantity * S + s) * SF_CG_PARTITIONS;
+  real sum = (real)0;
+  for (uint p = 0; p < SF_CG_PARTITIONS; ++p) sum += at[p];
+  return sum;
+}
+
+/* cg_start's first part, per partition: r = b - q, z = M^-1 r, d = z and the partial sums. */
+__kernel __attribute__((reqd_work_group_size(SF_GROUP_SIZE, 1, 1)))
+void cg_start_partials(uint S, uint node_count, __global const real* q, __global const real* b,
+                       __global const real* inverse_diagonal, __global real* r, __global real* z,
+                       __global real* d, __global real* partial) {
+  __local real scratch[SF_GROUP_SIZE];
+  uint s = get_group_id(0) / SF_CG_PARTITIONS;
+  uint p = get_group_id(0) % SF_CG_PARTITIONS;
+  uint begin, end;
+  sf_partition_rows(3 * node_count, p, &begin, &end);
+  real sum_bb = (real)0;
+  real sum_rr = (real)0;
+  real sum_rz = (real)0;
+  for (uint row = begin + get_local_id(0); row < end; row += SF_GROUP_SIZE) {
+    size_t at = (size_t)row * S + s;
+    real bi = b[at];
+    real ri = bi - q[at];
+    real zi = inverse_diagonal[at] * ri;
+    r[at] = ri;
+    z[at] = zi;
+    d[at] = zi;
+    sum_bb += bi * bi;
+    sum_rr += ri * ri;
+    sum_rz += ri * zi;
+  }
+  sum_bb = sf_group_sum(scratch, sum_bb);
+  sum_rr = sf_group_sum(scratch, sum_rr);
+  sum_rz = sf_group_sum(scratch, sum_rz);
+  if (get_local_id(0) == 0) {
+    partial[((size_t)SF_PARTIAL_BB * S + s) * SF_CG_PARTITIONS + p] = sum_bb;
+    partial[((size_t)SF_PARTIAL_RR * S + s) * SF_CG_PARTITIONS + p] = sum_rr;
+    partial[((size_t)SF_PARTIAL_RZ * S + s) * SF_CG_PARTITIONS + p] = sum_rz;
+  }
+}
+
+/* cg_start's second part, a work-item per sigma point: the scalars and every group's copies. */
+__kernel void cg_start_scalars(uint S, __global const real* c, __global const real* partial,
+                               __global real* bb, __global real* rr, __global real* rz,
+                               __global uint* active, __global uint* converged,
+                               __global int* iterations, __global uint* own_active,
+                               __global int* own_iterations, __global real* own_rz) {
+  uint s = get_global_id(0);
+  if (s >= S) return;
+  real sum_rz = sf_partials_sum(partial, SF_PARTIAL_RZ, S, s);
+  int going = sf_cg_start_scalars(s, sf_partials_sum(partial, SF_PARTIAL_BB, S, s),
+                                  sf_partials_sum(partial, SF_PARTIAL_RR, S, s), sum_rz, c, bb, rr,
+                                  rz, active, converged, iterations);
+  for (uint p = 0; p < SF_CG_PARTITIONS; ++p) {
+    own_active[s * SF_CG_PARTITIONS + p] = going ? 1u : 0u;
+    own_iterations[s * SF_CG_PARTITIONS + p] = 0;
+    own_rz[s * SF_CG_PARTITIONS + p] = sum_rz;
+  }
+}
+
+/* An iteration's first part after q = A d: the partial d.q. */
+__kernel __attribute__((reqd_work_group_size(SF_GROUP_SIZE, 1, 1)))
+void cg_dot(uint S, uint node_count, __global const real* d, __global const real* q,
+            __global real* partial, __global const uint* own_active) {
+  __local real scratch[SF_GROUP_SIZE];
+  uint g = get_group_id(0);
+  if (!own_active[g]) return; /* the same for the whole group: no barrier is left waiting */
+  uint s = g / SF_CG_PARTITIONS;
+  uint p = g % SF_CG_PARTITIONS;
+  uint begin, end;
+  sf_partition_rows(3 * node_count, p, &begin, &end);
+  real sum_dq = (real)0;
+  for (uint row = begin + get_local_id(0); row < end; row += SF_GROUP_SIZE) {
+    size_t at = (size_t)row * S + s;
+    sum_dq += d[at] * q[at];
+  }
+  sum_dq = sf_group_sum(scratch, sum_dq);
+  if (get_local_id(0) == 0) partial[((size_t)SF_PARTIAL_DQ * S + s) * SF_CG_PARTITIONS + p] = sum_dq;
+}
+
+/* The second part: alpha = r.z / d.q, x += alpha d, r -= alpha q, z = M^-1 r; partial r.r, r.z. */
+__kernel __attribute__((reqd_work_group_size(SF_GROUP_SIZE, 1, 1)))
+void cg_update(uint S, uint node_count, __global const real* inverse_diagonal, __global real* x,
+               __global real* r, __global real* z, __global const real* d,
+               __global const real* q, __global real* partial, __global const uint* own_active,
+               __global const real* own_rz) {
+  __local real scratch[SF_GROUP_SIZE];
+  uint g = get_group_id(0);
+  if (!own_active[g]) return;
+  uint s = g / SF_CG_PARTITIONS;
+  uint p = g % SF_CG_PARTITIONS;
+  real alpha = own_rz[g] / sf_partials_sum(partial, SF_PARTIAL_DQ, S, s);
+  uint begin, end;
+  sf_partition_rows(3 * node_count, p, &begin, &end);
+  real sum_rr = (real)0;
+  real sum_rz = (real)0;
+  for (uint row = begin + get_local_id(0); row < end; row += SF_GROUP_SIZE) {
+    size_t at = (size_t)row * S + s;
+    x[at] += alpha * d[at];
+    real ri = r[at] - alpha * q[at];
+    real zi = inverse_diagonal[at] * ri;
+    r[at] = ri;
+    z[at] = zi;
+    sum_rr += ri * ri;
+    sum_rz += ri * zi;
+  }
+  sum_rr = sf_group_sum(scratch, sum_rr);
+  sum_rz = sf_group_sum(scratch, sum_rz);
+  if (get_local_id(0) == 0) {
+    partial[((size_t)SF_PARTIAL_RR * S + s) * SF_CG_PARTITIONS + p] = sum_rr;
+    partial[((size_t)SF_PARTIAL_RZ * S + s) * SF_CG_PARTITIONS + p] = sum_rz;
+  }
+}
+
+/* The third part: the stop test (as cg_iteration's), the scalars, and d = z + beta d. */
+__kernel __attribute__((reqd_work_group_size(SF_GROUP_SIZE, 1, 1)))
+void cg_direction(uint S, uint node_count, int max_iterations, __global const real* c,
+                  __global const real* z, __global real* d, __global const real* partial,
+                  __global const real* bb, __global real* rr, __global real* rz,
+                  __global uint* active, __global uint* converged, __global int* iterations,
+                  __global uint* own_active, __global int* own_iterations,
+                  __global real* own_rz) {
+  uint g = get_group_id(0);
+  if (!own_active[g]) return;
+  uint s = g / SF_CG_PARTITIONS;
+  uint p = g % SF_CG_PARTITIONS;
+  int count = own_iterations[g] + 1;
+  real rz_old = own_rz[g];
+  real sum_rr = sf_partials_sum(partial, SF_PARTIAL_RR, S, s);
+  real sum_rz = sf_partials_sum(partial, SF_PARTIAL_RZ, S, s);
+  int done = sum_rr <= c[SF_CG_TOLERANCE2] * bb[s];
+  int stop = done || !isfinite(sum_rr) || count >= max_iterations;
+  barrier(CLK_GLOBAL_MEM_FENCE); /* everyone has read the old copies before they change */
+  if (get_local_id(0) == 0) {
+    own_iterations[g] = count;
+    own_rz[g] = sum_rz;
+    if (stop) own_active[g] = 0u;
+    if (p == 0) {
+      iterations[s] = count;
+      rr[s] = sum_rr;
+      rz[s] = sum_rz;
+      if (done) converged[s] = 1u;
+      if (stop) active[s] = 0u;
+    }
+  }
+  if (stop) return;
+  real beta = sum_rz / rz_old;
+  uint begin, end;
+  sf_partition_rows(3 * node_count, p, &begin, &end);
+  for (uint row = begin + get_local_id(0); row < end; row += SF_GROUP_SIZE) {
+    size_t at = (size_t)row * S + s;
+    d[at] = z[at] + beta * d[at];
+  }
+}
 #endif /* SF_CG_PER_GROUP */
 
 #if !SF_CG_PER_GROUP
@@ -191,18 +384,9 @@ static inline __attribute__((always_inline)) int sf_block_cg_start(
     }
   }
   int any = 0;
-  for (uint i = 0; i < count; ++i) {
-    uint s = first + i;
-    int breakdown = !isfinite(sum_bb[i]) || !isfinite(sum_rr[i]);   /* as in cg_start above */
-    int done = !breakdown && (sum_bb[i] == (real)0 || sum_rr[i] <= c[SF_CG_TOLERANCE2] * sum_bb[i]);
-    bb[s] = sum_bb[i];
-    rr[s] = sum_rr[i];
-    rz[s] = sum_rz[i];
-    active[s] = done || breakdown ? 0u : 1u;
-    converged[s] = done ? 1u : 0u;
-    iterations[s] = 0;
-    any |= !(done || breakdown);
-  }
+  for (uint i = 0; i < count; ++i)
+    any |= sf_cg_start_scalars(first + i, sum_bb[i], sum_rr[i], sum_rz[i], c, bb, rr, rz, active,
+                               converged, iterations);
   return any;
 }
 

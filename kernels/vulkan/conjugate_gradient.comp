@@ -1,9 +1,11 @@
 /* conjugate_gradient: Jacobi-preconditioned CG for all sigma points at once, with per-sigma
  * scalars and a per-sigma convergence flag (as kernels/opencl/conjugate_gradient.cl; host:
  * host/reference/conjugate_gradient.h, the same stopping rule |r| <= tolerance |b|).
- * Compiled twice (cmake/compile_glsl.cmake):
+ * Compiled once per entry point (cmake/compile_glsl.cmake):
  *   -DSF_ENTRY_CG_START      cg_start:     the warm start's residual and first direction
  *   -DSF_ENTRY_CG_ITERATION  cg_iteration: one iteration after the product q = A d
+ * and, for partitions (below), cg_start_partials and cg_start_scalars for cg_start, and
+ * cg_dot, cg_update and cg_direction for cg_iteration.
  *
  * One work-group per sigma point owns every row of that sigma point, so the dot products are
  * reduced inside the group by a fixed tree (the same bits every run) and the rest of a CG
@@ -12,18 +14,28 @@
  * or broke down) returns at once, so the host records many iterations in one command buffer
  * without changing anyone's result.
  *
+ * Partitions: on a large mesh a group per sigma point leaves most of a GPU idle. With
+ * specialization constant 1, P > 1, each sigma point's nodes are cut into P contiguous
+ * partitions and every (sigma point, partition) pair is a work-group (group g: s = g / P,
+ * p = g % P), as the OpenCL kernels' SF_CG_PARTITIONS (whose comment says how the partial
+ * sums, summed in partition order, and each group's own copies of its scalars keep every
+ * group's bits the same and no group reading what another writes).
+ *
  * Per-sigma scalars (arrays of S): bb = b.b, rr = r.r, rz = r.z, active (1 while iterating),
  * converged (1 converged, 0 hit the cap or broke down), iterations (products done). */
 #version 450
 #extension GL_GOOGLE_include_directive : require
 
-#if defined(SF_ENTRY_CG_START)
+#if defined(SF_ENTRY_CG_START) || defined(SF_ENTRY_CG_START_PARTIALS) || \
+    defined(SF_ENTRY_CG_START_SCALARS)
+#  define SF_START_FAMILY
 #  include "node_assembly.h"
 #else
 #  include "ensemble_layout.h"
 #endif
 
 layout(local_size_x_id = 0) in;
+layout(constant_id = 1) const uint SF_PARTITIONS = 1u;
 
 shared real scratch[gl_WorkGroupSize.x];
 
@@ -42,7 +54,27 @@ real sf_group_sum(real value) {
   return scratch[0];
 }
 
-#if defined(SF_ENTRY_CG_START)
+/* Partition p's nodes: [begin, end) of the push constant's node count. */
+void sf_partition_nodes(uint p, out uint begin, out uint end) {
+  uint size = (sf_push.count + SF_PARTITIONS - 1u) / SF_PARTITIONS;
+  begin = min(sf_push.count, p * size);
+  end = min(sf_push.count, begin + size);
+}
+
+/* The partial sums' quantities: partial[(quantity * S + s) * P + p]. */
+#define SF_PARTIAL_DQ 0u
+#define SF_PARTIAL_RR 1u
+#define SF_PARTIAL_RZ 2u
+#define SF_PARTIAL_BB 3u
+
+/* Sigma point s's P partials of one quantity, summed in partition order (needs `partial`). */
+#define SF_PARTIALS_SUM(quantity, S, s, sum_)                                    \
+  sum_ = real(0);                                                                \
+  for (uint p_ = 0u; p_ < SF_PARTITIONS; ++p_)                                   \
+    sum_ += partial[((quantity) * (S) + (s)) * SF_PARTITIONS + p_];
+
+#if defined(SF_START_FAMILY)
+/* One descriptor set for the three start shaders (and the OpenCL kernels' argument order). */
 layout(std430, binding = 8) restrict readonly buffer ElementOut { real element_out[]; };
 layout(std430, binding = 9) restrict readonly buffer B { real b[]; };
 layout(std430, binding = 10) restrict readonly buffer InverseDiagonal { real inverse_diagonal[]; };
@@ -56,17 +88,19 @@ layout(std430, binding = 17) restrict writeonly buffer RZ { real rz[]; };
 layout(std430, binding = 18) restrict writeonly buffer Active { uint active_flags[]; };
 layout(std430, binding = 19) restrict writeonly buffer Converged { uint converged[]; };
 layout(std430, binding = 20) restrict writeonly buffer Iterations { int iterations[]; };
+layout(std430, binding = 21) restrict buffer Partial { real partial[]; };
+layout(std430, binding = 22) restrict writeonly buffer OwnActive { uint own_active[]; };
+layout(std430, binding = 23) restrict writeonly buffer OwnIterations { int own_iterations[]; };
+layout(std430, binding = 24) restrict writeonly buffer OwnRz { real own_rz[]; };
 
-/* With q = A x (x = the last step's dv, products in element_out), r = b - q, z = M^-1 r,
- * d = z; bb, rr, rz; and whether the warm start is already good enough (b = 0 counts as
- * converged: the state update then uses dv = 0, the exact solution). */
-void main() {
-  uint S = sf_push.S;
-  uint s = gl_WorkGroupID.x;
-  real sum_bb = real(0);
-  real sum_rr = real(0);
-  real sum_rz = real(0);
-  for (uint n = gl_LocalInvocationID.x; n < sf_push.count; n += gl_WorkGroupSize.x) {
+/* Over nodes [begin, end) of sigma point s, with q = A x (x = the last step's dv, products
+ * in element_out): r = b - q, z = M^-1 r, d = z; and the group's sums b.b, r.r, r.z. */
+void sf_start_rows(uint s, uint S, uint begin, uint end, out real sum_bb, out real sum_rr,
+                   out real sum_rz) {
+  sum_bb = real(0);
+  sum_rr = real(0);
+  sum_rz = real(0);
+  for (uint n = begin + gl_LocalInvocationID.x; n < end; n += gl_WorkGroupSize.x) {
     real spring = sf_node_spring(n, s, S);
     real m = sf_solver_mass(mass[n], spring);
     real Kd[3];
@@ -88,21 +122,70 @@ void main() {
   sum_bb = sf_group_sum(sum_bb);
   sum_rr = sf_group_sum(sum_rr);
   sum_rz = sf_group_sum(sum_rz);
+}
+
+/* Sigma point s's scalars after the warm start; whether it iterates. An overflowed load
+ * (|b|^2 not finite) would pass the stop test as inf <= inf: a breakdown instead, neither
+ * converged nor iterating, as in the CPU reference. b = 0 counts as converged: the state
+ * update then uses dv = 0, the exact solution. */
+bool sf_start_scalars(uint s, real sum_bb, real sum_rr, real sum_rz) {
+  bool breakdown = isinf(sum_bb) || isnan(sum_bb) || isinf(sum_rr) || isnan(sum_rr);
+  bool done = !breakdown && (sum_bb == real(0) || sum_rr <= c[SF_CG_TOLERANCE2] * sum_bb);
+  bb[s] = sum_bb;
+  rr[s] = sum_rr;
+  rz[s] = sum_rz;
+  active_flags[s] = done || breakdown ? 0u : 1u;
+  converged[s] = done ? 1u : 0u;
+  iterations[s] = 0;
+  return !(done || breakdown);
+}
+
+#  if defined(SF_ENTRY_CG_START)
+void main() {
+  uint s = gl_WorkGroupID.x;
+  real sum_bb, sum_rr, sum_rz;
+  sf_start_rows(s, sf_push.S, 0u, sf_push.count, sum_bb, sum_rr, sum_rz);
+  if (gl_LocalInvocationID.x == 0u) sf_start_scalars(s, sum_bb, sum_rr, sum_rz);
+}
+
+#  elif defined(SF_ENTRY_CG_START_PARTIALS)
+/* cg_start's rows, partition by partition: the partial sums. */
+void main() {
+  uint S = sf_push.S;
+  uint s = gl_WorkGroupID.x / SF_PARTITIONS;
+  uint p = gl_WorkGroupID.x % SF_PARTITIONS;
+  uint begin, end;
+  sf_partition_nodes(p, begin, end);
+  real sum_bb, sum_rr, sum_rz;
+  sf_start_rows(s, S, begin, end, sum_bb, sum_rr, sum_rz);
   if (gl_LocalInvocationID.x == 0u) {
-    // An overflowed load (|b|^2 not finite) would pass the stop test as inf <= inf: a
-    // breakdown instead, neither converged nor iterating, as in the CPU reference.
-    bool breakdown = isinf(sum_bb) || isnan(sum_bb) || isinf(sum_rr) || isnan(sum_rr);
-    bool done = !breakdown && (sum_bb == real(0) || sum_rr <= c[SF_CG_TOLERANCE2] * sum_bb);
-    bb[s] = sum_bb;
-    rr[s] = sum_rr;
-    rz[s] = sum_rz;
-    active_flags[s] = done || breakdown ? 0u : 1u;
-    converged[s] = done ? 1u : 0u;
-    iterations[s] = 0;
+    partial[(SF_PARTIAL_BB * S + s) * SF_PARTITIONS + p] = sum_bb;
+    partial[(SF_PARTIAL_RR * S + s) * SF_PARTITIONS + p] = sum_rr;
+    partial[(SF_PARTIAL_RZ * S + s) * SF_PARTITIONS + p] = sum_rz;
   }
 }
 
-#elif defined(SF_ENTRY_CG_ITERATION)
+#  else /* SF_ENTRY_CG_START_SCALARS */
+/* An invocation per sigma point: the sums of the partials, the scalars and every group's
+ * copies. */
+void main() {
+  uint S = sf_push.S;
+  uint s = gl_GlobalInvocationID.x;
+  if (s >= S) return;
+  real sum_bb, sum_rr, sum_rz;
+  SF_PARTIALS_SUM(SF_PARTIAL_BB, S, s, sum_bb)
+  SF_PARTIALS_SUM(SF_PARTIAL_RR, S, s, sum_rr)
+  SF_PARTIALS_SUM(SF_PARTIAL_RZ, S, s, sum_rz)
+  bool going = sf_start_scalars(s, sum_bb, sum_rr, sum_rz);
+  for (uint p = 0u; p < SF_PARTITIONS; ++p) {
+    own_active[s * SF_PARTITIONS + p] = going ? 1u : 0u;
+    own_iterations[s * SF_PARTITIONS + p] = 0;
+    own_rz[s * SF_PARTITIONS + p] = sum_rz;
+  }
+}
+#  endif
+
+#else /* the iteration's shaders: one descriptor set for the four */
 layout(std430, binding = 0) restrict readonly buffer C { real c[]; };
 layout(std430, binding = 1) restrict readonly buffer InverseDiagonal { real inverse_diagonal[]; };
 layout(std430, binding = 2) restrict buffer X { real x[]; };
@@ -116,30 +199,28 @@ layout(std430, binding = 9) restrict buffer RZ { real rz[]; };
 layout(std430, binding = 10) restrict buffer Active { uint active_flags[]; };
 layout(std430, binding = 11) restrict buffer Converged { uint converged[]; };
 layout(std430, binding = 12) restrict buffer Iterations { int iterations[]; };
+layout(std430, binding = 13) restrict buffer Partial { real partial[]; };
+layout(std430, binding = 14) restrict buffer OwnActive { uint own_active[]; };
+layout(std430, binding = 15) restrict buffer OwnIterations { int own_iterations[]; };
+layout(std430, binding = 16) restrict buffer OwnRz { real own_rz[]; };
 
-/* alpha = rz / d.q, x += alpha d, r -= alpha q, z = M^-1 r, then the convergence test
- * (|r|^2 <= tol^2 |b|^2), the cap, breakdown (a residual that is not finite: the matrix is
- * not SPD or the input held a NaN), and d = z + beta d. */
-void main() {
-  uint S = sf_push.S;
-  uint s = gl_WorkGroupID.x;
-  if (active_flags[s] == 0u) return; /* the same for the whole group: no barrier is left waiting */
-  int count = iterations[s] + 1;
-  real rz_old = rz[s];
-  real bb_s = bb[s];
-  uint first = gl_LocalInvocationID.x;
-
+/* The group's d.q over nodes [begin, end) of sigma point s. */
+real sf_dq_rows(uint s, uint S, uint begin, uint end) {
   real sum_dq = real(0);
-  for (uint n = first; n < sf_push.count; n += gl_WorkGroupSize.x)
+  for (uint n = begin + gl_LocalInvocationID.x; n < end; n += gl_WorkGroupSize.x)
     for (uint k = 0u; k < 3u; ++k) {
       uint row = (3u * n + k) * S + s;
       sum_dq += d[row] * q[row];
     }
-  real alpha = rz_old / sf_group_sum(sum_dq);
+  return sf_group_sum(sum_dq);
+}
 
-  real sum_rr = real(0);
-  real sum_rz = real(0);
-  for (uint n = first; n < sf_push.count; n += gl_WorkGroupSize.x)
+/* x += alpha d, r -= alpha q, z = M^-1 r over the nodes; the group's r.r and r.z. */
+void sf_update_rows(uint s, uint S, uint begin, uint end, real alpha, out real sum_rr,
+                    out real sum_rz) {
+  sum_rr = real(0);
+  sum_rz = real(0);
+  for (uint n = begin + gl_LocalInvocationID.x; n < end; n += gl_WorkGroupSize.x)
     for (uint k = 0u; k < 3u; ++k) {
       uint row = (3u * n + k) * S + s;
       x[row] += alpha * d[row];
@@ -152,27 +233,119 @@ void main() {
     }
   sum_rr = sf_group_sum(sum_rr);
   sum_rz = sf_group_sum(sum_rz);
+}
 
-  bool done = sum_rr <= c[SF_CG_TOLERANCE2] * bb_s;
-  bool stop = done || isnan(sum_rr) || isinf(sum_rr) || count >= sf_push.max_iterations;
-  memoryBarrierBuffer();
-  barrier(); /* everyone has read the old scalars before they change */
-  if (first == 0u) {
-    iterations[s] = count;
-    rr[s] = sum_rr;
-    rz[s] = sum_rz;
-    if (done) converged[s] = 1u;
-    if (stop) active_flags[s] = 0u;
-  }
-  if (stop) return;
-  real beta = sum_rz / rz_old;
-  for (uint n = first; n < sf_push.count; n += gl_WorkGroupSize.x)
+/* d = z + beta d over the nodes. */
+void sf_direction_rows(uint s, uint S, uint begin, uint end, real beta) {
+  for (uint n = begin + gl_LocalInvocationID.x; n < end; n += gl_WorkGroupSize.x)
     for (uint k = 0u; k < 3u; ++k) {
       uint row = (3u * n + k) * S + s;
       d[row] = z[row] + beta * d[row];
     }
 }
 
-#else
-#  error "conjugate_gradient.comp: define SF_ENTRY_CG_START or SF_ENTRY_CG_ITERATION"
+/* The convergence test (|r|^2 <= tol^2 |b|^2), the cap and breakdown (a residual that is not
+ * finite: the matrix is not SPD or the input held a NaN) after `count` products. */
+bool sf_done(uint s, real sum_rr) { return sum_rr <= c[SF_CG_TOLERANCE2] * bb[s]; }
+bool sf_stop(bool done, real sum_rr, int count) {
+  return done || isnan(sum_rr) || isinf(sum_rr) || count >= sf_push.max_iterations;
+}
+
+/* Sigma point s's scalars after an iteration (read by the host and the other shaders). */
+void sf_store_scalars(uint s, int count, real sum_rr, real sum_rz, bool done, bool stop) {
+  iterations[s] = count;
+  rr[s] = sum_rr;
+  rz[s] = sum_rz;
+  if (done) converged[s] = 1u;
+  if (stop) active_flags[s] = 0u;
+}
+
+#  if defined(SF_ENTRY_CG_ITERATION)
+/* alpha = rz / d.q, x += alpha d, r -= alpha q, z = M^-1 r, then the stop test and
+ * d = z + beta d. */
+void main() {
+  uint S = sf_push.S;
+  uint s = gl_WorkGroupID.x;
+  if (active_flags[s] == 0u) return; /* the same for the whole group: no barrier is left waiting */
+  int count = iterations[s] + 1;
+  real rz_old = rz[s];
+  real alpha = rz_old / sf_dq_rows(s, S, 0u, sf_push.count);
+  real sum_rr, sum_rz;
+  sf_update_rows(s, S, 0u, sf_push.count, alpha, sum_rr, sum_rz);
+  bool done = sf_done(s, sum_rr);
+  bool stop = sf_stop(done, sum_rr, count);
+  memoryBarrierBuffer();
+  barrier(); /* everyone has read the old scalars before they change */
+  if (gl_LocalInvocationID.x == 0u) sf_store_scalars(s, count, sum_rr, sum_rz, done, stop);
+  if (stop) return;
+  sf_direction_rows(s, S, 0u, sf_push.count, sum_rz / rz_old);
+}
+
+#  elif defined(SF_ENTRY_CG_DOT)
+/* The iteration's first part after q = A d: the partition's d.q. */
+void main() {
+  uint S = sf_push.S;
+  uint g = gl_WorkGroupID.x;
+  if (own_active[g] == 0u) return;
+  uint s = g / SF_PARTITIONS;
+  uint p = g % SF_PARTITIONS;
+  uint begin, end;
+  sf_partition_nodes(p, begin, end);
+  real sum_dq = sf_dq_rows(s, S, begin, end);
+  if (gl_LocalInvocationID.x == 0u) partial[(SF_PARTIAL_DQ * S + s) * SF_PARTITIONS + p] = sum_dq;
+}
+
+#  elif defined(SF_ENTRY_CG_UPDATE)
+/* The second part: alpha, the partition's x, r, z, and its r.r and r.z. */
+void main() {
+  uint S = sf_push.S;
+  uint g = gl_WorkGroupID.x;
+  if (own_active[g] == 0u) return;
+  uint s = g / SF_PARTITIONS;
+  uint p = g % SF_PARTITIONS;
+  real sum_dq;
+  SF_PARTIALS_SUM(SF_PARTIAL_DQ, S, s, sum_dq)
+  uint begin, end;
+  sf_partition_nodes(p, begin, end);
+  real sum_rr, sum_rz;
+  sf_update_rows(s, S, begin, end, own_rz[g] / sum_dq, sum_rr, sum_rz);
+  if (gl_LocalInvocationID.x == 0u) {
+    partial[(SF_PARTIAL_RR * S + s) * SF_PARTITIONS + p] = sum_rr;
+    partial[(SF_PARTIAL_RZ * S + s) * SF_PARTITIONS + p] = sum_rz;
+  }
+}
+
+#  elif defined(SF_ENTRY_CG_DIRECTION)
+/* The third part: the stop test, the group's copies (and group (s, 0) the scalars), and the
+ * partition's d = z + beta d. */
+void main() {
+  uint S = sf_push.S;
+  uint g = gl_WorkGroupID.x;
+  if (own_active[g] == 0u) return;
+  uint s = g / SF_PARTITIONS;
+  uint p = g % SF_PARTITIONS;
+  int count = own_iterations[g] + 1;
+  real rz_old = own_rz[g];
+  real sum_rr, sum_rz;
+  SF_PARTIALS_SUM(SF_PARTIAL_RR, S, s, sum_rr)
+  SF_PARTIALS_SUM(SF_PARTIAL_RZ, S, s, sum_rz)
+  bool done = sf_done(s, sum_rr);
+  bool stop = sf_stop(done, sum_rr, count);
+  memoryBarrierBuffer();
+  barrier(); /* everyone has read the old copies before they change */
+  if (gl_LocalInvocationID.x == 0u) {
+    own_iterations[g] = count;
+    own_rz[g] = sum_rz;
+    if (stop) own_active[g] = 0u;
+    if (p == 0u) sf_store_scalars(s, count, sum_rr, sum_rz, done, stop);
+  }
+  if (stop) return;
+  uint begin, end;
+  sf_partition_nodes(p, begin, end);
+  sf_direction_rows(s, S, begin, end, sum_rz / rz_old);
+}
+
+#  else
+#    error "conjugate_gradient.comp: define one of the SF_ENTRY_CG_* entry points"
+#  endif
 #endif
