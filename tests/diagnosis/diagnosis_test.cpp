@@ -390,12 +390,12 @@ namespace {
 // explain) and calls its residual inconsistent; the gravity candidate's fit explains the data
 // far better, finds the gravity and is consistent, and so is the true model (the gravity
 // declared).
-// OpenCL float32 (about 20 s for the three fits).
-TEST(DiagnoseLiverOnOpenCl, TheDeclaredModelCompletesUnderAnUndeclaredFullGravity) {
-  if (opencl_missing()) SIGMAFEM_MISSING("no OpenCL platform on this machine");
+// On the CPU back end (its sparse factors): 31 s alone on the 2-core machine, where OpenCL on
+// PoCL took 58 s (stop 32); the device ensembles are the other DiagnoseLiverOnOpenCl tests'.
+TEST(DiagnoseLiver, TheDeclaredModelCompletesUnderAnUndeclaredFullGravity) {
   const BoxData liver = box_data({{"gravity", {4.005, -8.01, 4.005}}}, 1, "liver");
   DiagnoseOptions options;
-  options.backend = "opencl";
+  options.backend = "cpu";
   const ModelFit declared = fit_model(liver.scenario, liver.data, liver.truth, {}, options);
   ASSERT_TRUE(declared.run.complete) << declared.run.stop_reason;
   EXPECT_EQ(declared.run.steps.size(), 2000u);
