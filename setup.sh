@@ -46,8 +46,12 @@ if [ -n "$missing" ]; then
 fi
 
 jobs=$(nproc 2>/dev/null || echo 2)
+# Unity builds (CMake puts 8 sources in one translation unit) parse Eigen, gtest and the
+# standard headers once per 8 files instead of once per file: on 2 cores the Release build
+# took 3:00 instead of 4:30, the sanitizer build 5:32 instead of 8:05 (stop 32).
+unity=-DCMAKE_UNITY_BUILD=ON
 step "building (Release, warnings as errors)"
-cmake -S . -B build -G Ninja -DCMAKE_BUILD_TYPE=Release -DSIGMAFEM_WERROR=ON >/dev/null
+cmake -S . -B build -G Ninja -DCMAKE_BUILD_TYPE=Release -DSIGMAFEM_WERROR=ON $unity >/dev/null
 cmake --build build -j "$jobs"
 
 if [ "$mode" = run ]; then
@@ -73,7 +77,7 @@ step "building with AddressSanitizer and UndefinedBehaviorSanitizer"
 # full -g it took about 15 minutes on 2 cores, with -O2 -g1 11 min 42 s, with -O1 -g1 9 min
 # 14 s (fresh machine, stop 30); the tests below then take 239 s instead of 183.
 cmake -S . -B build-sanitize -G Ninja -DCMAKE_BUILD_TYPE=RelWithDebInfo -DSIGMAFEM_WERROR=ON \
-  -DCMAKE_CXX_FLAGS_RELWITHDEBINFO="-O1 -g1 -DNDEBUG" -DSIGMAFEM_SANITIZE=ON -DSIGMAFEM_BENCH=OFF >/dev/null
+  -DCMAKE_CXX_FLAGS_RELWITHDEBINFO="-O1 -g1 -DNDEBUG" -DSIGMAFEM_SANITIZE=ON -DSIGMAFEM_BENCH=OFF $unity >/dev/null
 cmake --build build-sanitize -j "$jobs"
 step "tests (sanitizers)"
 # The 1500-step box estimations run about 30x slower under the sanitizers (over 13 minutes

@@ -126,8 +126,9 @@ OpenClEnsemble::OpenClEnsemble(const Model& model, std::vector<int> estimated,
       const std::size_t groups = static_cast<std::size_t>(S_) * cg_partitions_;
       partial_ = make_buffer(4 * groups, "CG partial sums");
       own_rz_ = make_buffer(groups, "CG scalars");
-      own_active_ = make_buffer(std::vector<int>(groups, 0), "CG flags");
-      own_iterations_ = make_buffer(std::vector<int>(groups, 0), "CG flags");
+      const std::vector<int> flags(groups, 0);
+      own_active_ = make_buffer(flags, "CG flags");
+      own_iterations_ = make_buffer(flags, "CG flags");
     }
     recenter_scalars_ = make_buffer(1 + kMaxParameters, "re-centring");
     directions_ = make_buffer(static_cast<std::size_t>(kMaxParameters) * S_, "re-centring");

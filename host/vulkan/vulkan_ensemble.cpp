@@ -90,8 +90,9 @@ VulkanEnsemble::VulkanEnsemble(const Model& model, std::vector<int> estimated,
   const std::size_t cg_groups = static_cast<std::size_t>(S_) * cg_partitions_;
   partial_ = make_buffer(4 * cg_groups, "CG partial sums");
   own_rz_ = make_buffer(cg_groups, "CG scalars");
-  own_active_ = make_buffer(std::vector<int>(cg_groups, 0), "CG flags");
-  own_iterations_ = make_buffer(std::vector<int>(cg_groups, 0), "CG flags");
+  const std::vector<int> flags(cg_groups, 0);
+  own_active_ = make_buffer(flags, "CG flags");
+  own_iterations_ = make_buffer(flags, "CG flags");
   recenter_scalars_ = make_buffer(1 + kDeviceMaxParameters, "re-centring");
   directions_ = make_buffer(static_cast<std::size_t>(kDeviceMaxParameters) * S_, "re-centring");
   weights_ = make_buffer(static_cast<std::size_t>(kDeviceMaxParameters) * S_, "re-centring");

@@ -28,13 +28,13 @@ namespace sigmafem {
 namespace {
 namespace fs = std::filesystem;
 
-constexpr int kPoints = 12, kRows = 3 * kPoints;
+constexpr int kResidualPoints = 12, kRows = 3 * kResidualPoints;
 constexpr int kSteps = 500;
 
 // Observed points spread over a 30 x 15 x 15 cm box, like the box scenario's top face and more.
 Eigen::MatrixX3d synthetic_points() {
-  Eigen::MatrixX3d p(kPoints, 3);
-  for (int j = 0; j < kPoints; ++j)
+  Eigen::MatrixX3d p(kResidualPoints, 3);
+  for (int j = 0; j < kResidualPoints; ++j)
     p.row(j) << 0.3 * ((j * 7) % 12) / 11.0, 0.15 * ((j * 5) % 12) / 11.0, 0.15 * ((j * 3) % 4) / 3.0;
   return p;
 }
@@ -182,7 +182,7 @@ TEST(ResidualDiagnostics, AnSThatOverstatesByAFewPercentPassesBothNisTests) {
 TEST(ResidualDiagnostics, ATranslationOfEveryPointIsTheRigidPart) {
   const Eigen::Vector3d t(0.2e-3, -0.1e-3, 0.05e-3);   // well under the noise of one step
   Eigen::VectorXd offset(kRows);
-  for (int j = 0; j < kPoints; ++j) offset.segment<3>(3 * j) = t;
+  for (int j = 0; j < kResidualPoints; ++j) offset.segment<3>(3 * j) = t;
   const ResidualDiagnostics d = diagnose_residuals(synthetic_series(7, 1.0, 0.0, offset), synthetic_points());
   EXPECT_EQ(d.verdict.consistency, Consistency::inconsistent) << describe(d);
   EXPECT_TRUE(failed(d, "rigid_bias")) << describe(d);

@@ -9,11 +9,11 @@
 #include <string>
 
 #include "host/scenario/scenario.h"
+#include "scenario_directory.h"
 
 namespace sigmafem {
 namespace {
 
-const std::string kScenarios = std::string(SIGMAFEM_SOURCE_DIR) + "/scenarios/";
 
 double total(const std::vector<SpringShare>& shares) {
   double sum = 0.0;

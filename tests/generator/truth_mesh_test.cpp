@@ -22,13 +22,13 @@
 #include "host/generator/generate.h"
 #include "host/model/model.h"
 #include "host/reference/reference_simulation.h"
+#include "scenario_directory.h"
 #include "temp_path.h"
 
 namespace sigmafem {
 namespace {
 namespace fs = std::filesystem;
 
-const std::string kScenarios = std::string(SIGMAFEM_SOURCE_DIR) + "/scenarios/";
 
 // The header and the rows (as numbers) of a sigmafem CSV.
 struct Csv {

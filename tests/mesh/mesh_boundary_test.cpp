@@ -11,6 +11,7 @@
 #include <vector>
 
 #include "host/mesh/mesh.h"
+#include "mesh/unit_tetrahedron.h"
 #include "tests/mesh/mesh_test_support.h"
 
 namespace sigmafem {
@@ -27,13 +28,6 @@ std::set<Face> sorted_faces(const std::vector<Face>& faces) {
   std::set<Face> set;
   for (const Face& f : faces) set.insert(sorted(f));
   return set;
-}
-
-Mesh unit_tetrahedron() {
-  Mesh mesh;
-  mesh.nodes = {{0, 0, 0}, {1, 0, 0}, {0, 1, 0}, {0, 0, 1}};
-  mesh.tetrahedra = {{0, 1, 2, 3}};
-  return mesh;
 }
 
 TEST(BoundaryFaces, OneTetrahedronHasFourOutwardFaces) {

@@ -7,6 +7,7 @@
 
 #include "host/common/input_error.h"
 #include "host/mesh/mesh.h"
+#include "mesh/unit_tetrahedron.h"
 #include "tests/mesh/mesh_test_support.h"
 
 namespace sigmafem {
@@ -14,13 +15,6 @@ namespace {
 
 // A regular tetrahedron: volume / (mean edge)^3 = 1 / (6 sqrt 2).
 const double kRegularQuality = 1.0 / (6.0 * std::sqrt(2.0));
-
-Mesh unit_tetrahedron() {
-  Mesh mesh;
-  mesh.nodes = {{0, 0, 0}, {1, 0, 0}, {0, 1, 0}, {0, 0, 1}};
-  mesh.tetrahedra = {{0, 1, 2, 3}};
-  return mesh;
-}
 
 std::string check_error(Mesh& mesh, const std::string& source) {
   try {

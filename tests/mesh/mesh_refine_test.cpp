@@ -10,6 +10,7 @@
 #include <vector>
 
 #include "host/mesh/mesh.h"
+#include "mesh/unit_tetrahedron.h"
 #include "tests/mesh/mesh_test_support.h"
 
 namespace sigmafem {
@@ -18,15 +19,8 @@ namespace {
 // Volumes are sums of a few thousand products: exact up to rounding of that order.
 constexpr double kVolumeRoundoff = 1e-12;
 
-Mesh unit_tetrahedron() {
-  Mesh mesh;
-  mesh.nodes = {{0, 0, 0}, {1, 0, 0}, {0, 1, 0}, {0, 0, 1}};
-  mesh.tetrahedra = {{0, 1, 2, 3}};
-  return mesh;
-}
-
 // Sum of |volume|: meaningful for a parent given with inverted elements too.
-double total_volume(const Mesh& mesh) {
+double total_absolute_volume(const Mesh& mesh) {
   double sum = 0.0;
   for (int e = 0; e < mesh.tetrahedron_count(); ++e) sum += std::abs(tetrahedron_volume(mesh, e));
   return sum;
@@ -62,7 +56,7 @@ void expect_valid_refinement(const Mesh& parent, const Mesh& child, const char* 
                 kVolumeRoundoff * std::abs(tetrahedron_volume(parent, e)))
         << what << ": the children of element " << e << " fill it";
   }
-  EXPECT_NEAR(total_volume(child), total_volume(parent), kVolumeRoundoff * total_volume(parent))
+  EXPECT_NEAR(total_absolute_volume(child), total_absolute_volume(parent), kVolumeRoundoff * total_absolute_volume(parent))
       << what;
   // Conforming: a mismatch between neighbours would leave extra unmatched faces.
   const auto faces = boundary_faces(child);

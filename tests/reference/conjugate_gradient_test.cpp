@@ -35,7 +35,7 @@ constexpr double kReportedResidualAgreement = 1e-6;
 // A looser tolerance than the one the warm start was solved to: it must already be met.
 constexpr double kLooseTolerance = 1e-8;
 constexpr int kMaxIterations = 2000;     // ~20x what the system needs
-constexpr int kWarmUpSteps = 30;
+constexpr int kCgWarmUpSteps = 30;
 
 class ConjugateGradientTest : public ::testing::Test {
  protected:
@@ -43,7 +43,7 @@ class ConjugateGradientTest : public ::testing::Test {
     held_ = test::held_box();
     const Model& model = held_.model;
     ReferenceSimulation simulation(model);
-    for (int step = 1; step <= kWarmUpSteps; ++step)
+    for (int step = 1; step <= kCgWarmUpSteps; ++step)
       ASSERT_TRUE(simulation.step(test::held_box_so(model, step * model.dt)).converged)
           << "CG of warm-up step " << step;
     x_ = simulation.positions();
@@ -51,7 +51,7 @@ class ConjugateGradientTest : public ::testing::Test {
     springs_ = simulation.spring_stiffness();
     system_ = std::make_unique<ImplicitEulerSystem>(model, frames_, springs_);
     b_ = system_->right_hand_side(
-        simulation.forces(x_, frames_, test::held_box_so(model, (kWarmUpSteps + 1) * model.dt)),
+        simulation.forces(x_, frames_, test::held_box_so(model, (kCgWarmUpSteps + 1) * model.dt)),
         simulation.velocities());
     inverse_diagonal_ = system_->diagonal().cwiseInverse();
   }

@@ -23,9 +23,9 @@ namespace {
 // frame, a rest shape not subtracted) gives forces of order E h^2.
 constexpr double kRigidForceTolerance = 1e-10;
 // Element rotation vs the applied one: rotations built from unit vectors, ~10 ulps.
-constexpr double kRotationTolerance = 1e-12;
+constexpr double kAssemblyRotationTolerance = 1e-12;
 // The assembled tangent is a sum of element matrices, each symmetric to a few ulps of its norm.
-constexpr double kSymmetryTolerance = 1e-13;
+constexpr double kAssemblySymmetryTolerance = 1e-13;
 // Free-body spectrum (dense eigensolver, eigenvalues accurate to ~1e-15 of the largest):
 // the six rigid-body modes are zero to rounding, far below 1e-9 of the largest eigenvalue;
 // the softest elastic mode of this 3 x 2 x 2 box is 4e-3 of it (measured), far above 1e-4.
@@ -44,7 +44,7 @@ constexpr double kJacobianStep = 1e-6;   // m, displacement size of the differen
 // deformations of ~1e-3 m, i.e. ~1e-13 of the force.
 constexpr double kObjectivityTolerance = 1e-10;
 
-constexpr Material kMaterial{3000.0, 0.45, 1000.0};   // soft tissue
+constexpr Material kTissue{3000.0, 0.45, 1000.0};   // soft tissue
 constexpr double kCellSize = 0.1;                     // m
 
 class CorotationalTest : public ::testing::Test {
@@ -52,7 +52,7 @@ class CorotationalTest : public ::testing::Test {
   CorotationalTest()
       : box_(test::structured_box(Eigen::Vector3d(3 * kCellSize, 2 * kCellSize, 2 * kCellSize), 3,
                                   2, 2, 0.1)),
-        model_(make_model(box_.mesh, kMaterial)),
+        model_(make_model(box_.mesh, kTissue)),
         rest_(test::flat_positions(box_.mesh)) {}
 
   // The rigid motions tried: random ones and large explicit ones (90, 170, 180 degrees).
@@ -91,7 +91,7 @@ class CorotationalTest : public ::testing::Test {
 };
 
 TEST_F(CorotationalTest, RigidMotionsGiveNoForceAndTheirRotation) {
-  const double force_scale = kMaterial.young_modulus * kCellSize * kCellSize * 1e-3;
+  const double force_scale = kTissue.young_modulus * kCellSize * kCellSize * 1e-3;
   int motion_index = 0;
   for (const auto& [Q, t] : rigid_motions()) {
     const Eigen::VectorXd x = test::rigidly_moved(rest_, Q, t);
@@ -110,7 +110,7 @@ TEST_F(CorotationalTest, RigidMotionsGiveNoForceAndTheirRotation) {
         worst_element = e;
       }
     }
-    EXPECT_LE(worst, kRotationTolerance)
+    EXPECT_LE(worst, kAssemblyRotationTolerance)
         << "element rotation vs the applied rotation, element " << worst_element
         << ", rigid motion " << motion_index;
     ++motion_index;
@@ -122,7 +122,7 @@ TEST_F(CorotationalTest, TangentOfAFreeBodyHasExactlySixZeroModes) {
   for (const auto& [Q, t] : rigid_motions()) {
     const Eigen::MatrixXd K = dense_tangent(test::rigidly_moved(rest_, Q, t));
     const double scale = K.norm();
-    EXPECT_LE((K - K.transpose()).norm(), kSymmetryTolerance * scale)
+    EXPECT_LE((K - K.transpose()).norm(), kAssemblySymmetryTolerance * scale)
         << "asymmetry of the assembled tangent, rigid motion " << motion_index;
     const Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> eigen(0.5 * (K + K.transpose()),
                                                                Eigen::EigenvaluesOnly);
@@ -164,7 +164,7 @@ TEST_F(CorotationalTest, MatrixFreeProductAndDiagonalEqualTheAssembledMatrix) {
   element_frames(model_, x, frames);
   const Eigen::SparseMatrix<double> K = assemble_element_stiffness(model_, frames);
   const Eigen::MatrixXd K_dense(K);
-  EXPECT_LE((K_dense - K_dense.transpose()).norm(), kSymmetryTolerance * K_dense.norm())
+  EXPECT_LE((K_dense - K_dense.transpose()).norm(), kAssemblySymmetryTolerance * K_dense.norm())
       << "asymmetry of the assembled tangent of a deformed state";
   for (int trial = 0; trial < 3; ++trial) {
     const Eigen::VectorXd d = test::random_vector(random_, x.size());

@@ -16,17 +16,17 @@ namespace {
 // Sums of ~100 element volumes or masses against the box's exact volume: ~1e-15 relative.
 constexpr double kSumTolerance = 1e-13;
 // Closed-form Lame coefficients of simple numbers: exact to an ulp or two.
-constexpr double kFormulaTolerance = 1e-15;
+constexpr double kModelFormulaTolerance = 1e-15;
 
 TEST(ModelTest, LameCoefficientsAreTheIsotropicFormulas) {
   // E = 1, nu = 0.25: lambda = E nu / ((1 + nu)(1 - 2 nu)) = 0.4, mu = E / (2 (1 + nu)) = 0.4.
   const Eigen::Vector2d lame = lame_coefficients(Material{1.0, 0.25, 1.0});
-  EXPECT_NEAR(lame[0], 0.4, kFormulaTolerance) << "Lame lambda for E = 1, nu = 0.25";
-  EXPECT_NEAR(lame[1], 0.4, kFormulaTolerance) << "shear modulus mu for E = 1, nu = 0.25";
+  EXPECT_NEAR(lame[0], 0.4, kModelFormulaTolerance) << "Lame lambda for E = 1, nu = 0.25";
+  EXPECT_NEAR(lame[1], 0.4, kModelFormulaTolerance) << "shear modulus mu for E = 1, nu = 0.25";
   // nu = 0: no lateral coupling.
   const Eigen::Vector2d uncoupled = lame_coefficients(Material{3.0, 0.0, 1.0});
   EXPECT_EQ(uncoupled[0], 0.0) << "Lame lambda for nu = 0";
-  EXPECT_NEAR(uncoupled[1], 1.5, kFormulaTolerance) << "shear modulus mu for E = 3, nu = 0";
+  EXPECT_NEAR(uncoupled[1], 1.5, kModelFormulaTolerance) << "shear modulus mu for E = 3, nu = 0";
 }
 
 TEST(ModelTest, MassIsLumpedAQuarterOfEachElementPerCorner) {

@@ -11,12 +11,12 @@
 #include <string>
 
 #include "host/common/input_error.h"
+#include "scenario_directory.h"
 #include "temp_path.h"
 
 namespace sigmafem {
 namespace {
 
-const std::string kScenarios = std::string(SIGMAFEM_SOURCE_DIR) + "/scenarios/";
 
 Mesh box_fine() {
   Mesh mesh = read_mesh(kScenarios + "box_fine.msh");
