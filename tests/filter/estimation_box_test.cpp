@@ -1,15 +1,21 @@
-// The whole estimation on the paper's box (issue 3): from noise-free data and a prior 2x off
-// the truth, the ROUKF with the CPU ensemble converges to the truth, follows the cut, and
-// keeps the uncut ligaments' estimates sane through it; with no cut the change detector
-// stays silent; missing observations are handled.
+// The whole estimation on the paper's box and on the liver (issue 3): from noise-free data and
+// a prior 2x off the truth, the ROUKF with the CPU ensemble converges to the truth, follows
+// the cut, and keeps the uncut ligaments' estimates sane through it; at 0.5 mm noise the truth
+// lies inside the stated intervals; with no cut the change detector stays silent; missing
+// observations are handled.
 #include <gtest/gtest.h>
 
 #include <algorithm>
 
 #include <cmath>
 #include <filesystem>
+#include <iostream>
+#include <map>
+#include <memory>
 #include <random>
 #include <sstream>
+#include <string>
+#include <tuple>
 
 #include "temp_path.h"
 #include "tests/filter/scenario_filter_options.h"
@@ -34,7 +40,7 @@ constexpr int kStepsToFollow = 150;       // filter steps from the cut until wit
 // fifth of the scenario's 0.5 mm.
 constexpr double kNoiseFreeObservationStd = 1e-4;
 
-struct BoxData {
+struct ExperimentData {
   Scenario scenario;
   ObservationTable observations;
   TruthTable truth;
@@ -42,13 +48,13 @@ struct BoxData {
 
 using test::filter_options;
 
-// Generates the box data once per configuration (noise, with or without the cut).
-const BoxData& box_data(bool noise_free, bool with_cut) {
-  static std::map<std::pair<bool, bool>, std::unique_ptr<BoxData>> cache;
-  auto& slot = cache[{noise_free, with_cut}];
+// Generates a shipped scenario's data once per configuration (noise, with or without the cut).
+const ExperimentData& experiment_data(const std::string& name, bool noise_free, bool with_cut) {
+  static std::map<std::tuple<std::string, bool, bool>, std::unique_ptr<ExperimentData>> cache;
+  auto& slot = cache[{name, noise_free, with_cut}];
   if (!slot) {
-    slot = std::make_unique<BoxData>();
-    slot->scenario = load_scenario(std::string(SIGMAFEM_SOURCE_DIR) + "/scenarios/box.json");
+    slot = std::make_unique<ExperimentData>();
+    slot->scenario = load_scenario(std::string(SIGMAFEM_SOURCE_DIR) + "/scenarios/" + name + ".json");
     if (noise_free) slot->scenario.observations.noise_std = 0.0;
     if (!with_cut) slot->scenario.events.clear();
     const fs::path dir = test::unique_temp_path("sigmafem_estimation_box_test");
@@ -66,20 +72,20 @@ const BoxData& box_data(bool noise_free, bool with_cut) {
   return *slot;
 }
 
-struct BoxRun {
+struct ExperimentRun {
   EstimationRun run;
   std::vector<int> steps;
   Eigen::MatrixXd estimate, std_dev, truth;   // rows = filter steps, columns = estimated
 };
 
-BoxRun run_box(const BoxData& data, SigmaPointSet set, double observation_std,
+ExperimentRun run_experiment(const ExperimentData& data, SigmaPointSet set, double observation_std,
                const Eigen::MatrixXd& points) {
   const Scenario& s = data.scenario;
   const EstimationOptions options = filter_options(s, set, observation_std);
   const int p = static_cast<int>(s.filter->estimate.size());
   CpuEnsemble ensemble(make_model(s), s.filter->estimate, s.observations.nodes,
                        sigma_point_count(set, p));
-  BoxRun box;
+  ExperimentRun box;
   box.run = run_estimation(ensemble, options, data.observations.times, data.observations.so,
                            points, {});
   const Eigen::Index rows = static_cast<Eigen::Index>(box.run.steps.size());
@@ -100,8 +106,8 @@ BoxRun run_box(const BoxData& data, SigmaPointSet set, double observation_std,
 class BoxEstimationTest : public ::testing::TestWithParam<SigmaPointSet> {};
 
 TEST_P(BoxEstimationTest, ConvergesFromTwiceTheTruthAndFollowsTheCut) {
-  const BoxData& data = box_data(true, true);
-  const BoxRun box = run_box(data, GetParam(), kNoiseFreeObservationStd, data.observations.points);
+  const ExperimentData& data = experiment_data("box", true, true);
+  const ExperimentRun box = run_experiment(data, GetParam(), kNoiseFreeObservationStd, data.observations.points);
   ASSERT_TRUE(box.run.complete) << box.run.stop_reason;
   const std::vector<PhaseErrors> phases = error_figures(box.steps, box.estimate, box.std_dev, box.truth);
   ASSERT_EQ(phases.size(), 2u) << "one cut: two phases";
@@ -130,8 +136,8 @@ INSTANTIATE_TEST_SUITE_P(BothSets, BoxEstimationTest,
 
 TEST(BoxEstimation, ChangeDetectorStaysSilentWithoutACut) {
   // The shipped noise (0.5 mm) and the filter told the same: a model that is right.
-  const BoxData& data = box_data(false, false);
-  const BoxRun box = run_box(data, SigmaPointSet::simplex, data.scenario.filter->observation_std,
+  const ExperimentData& data = experiment_data("box", false, false);
+  const ExperimentRun box = run_experiment(data, SigmaPointSet::simplex, data.scenario.filter->observation_std,
                              data.observations.points);
   ASSERT_TRUE(box.run.complete) << box.run.stop_reason;
   EXPECT_EQ(box.run.changes_detected, 0) << "a false alarm over " << box.run.steps.size() << " steps";
@@ -142,7 +148,7 @@ TEST(BoxEstimation, ChangeDetectorFiresOnTheCutWithASmallDrift) {
   // With a drift of 0.02 the filter follows a cut slowly, so the innovations after it stay
   // large for a while: the detector must fire soon after the cut (and not before it), and
   // widen the covariance so that the estimates still follow within the goal.
-  const BoxData& data = box_data(true, true);
+  const ExperimentData& data = experiment_data("box", true, true);
   const Scenario& s = data.scenario;
   EstimationOptions options = filter_options(s, SigmaPointSet::simplex, kNoiseFreeObservationStd);
   options.roukf.parameter_drift_log_std = 0.02;
@@ -194,14 +200,14 @@ TEST(BoxEstimation, ChangeDetectorFiresOnTheCutWithASmallDrift) {
 TEST(BoxEstimation, HandlesMissingObservations) {
   // A third of the observed coordinates are missing at random steps (an occluded marker):
   // the filter drops those rows and still converges before the cut.
-  const BoxData& data = box_data(true, true);
+  const ExperimentData& data = experiment_data("box", true, true);
   Eigen::MatrixXd points = data.observations.points;
   std::mt19937 engine(4);
   std::bernoulli_distribution missing(1.0 / 3.0);
   for (Eigen::Index k = 1; k < points.rows(); ++k)
     for (Eigen::Index c = 0; c < points.cols(); c += 3)
       if (missing(engine)) points.block(k, c, 1, 3).setConstant(NAN);
-  const BoxRun box = run_box(data, SigmaPointSet::simplex, kNoiseFreeObservationStd, points);
+  const ExperimentRun box = run_experiment(data, SigmaPointSet::simplex, kNoiseFreeObservationStd, points);
   ASSERT_TRUE(box.run.complete) << box.run.stop_reason;
   const std::vector<PhaseErrors> phases = error_figures(box.steps, box.estimate, box.std_dev, box.truth);
   EXPECT_LT(phases[0].mean_abs_error, kBeforeCutError);
@@ -209,6 +215,60 @@ TEST(BoxEstimation, HandlesMissingObservations) {
   for (const EstimationStep& step : box.run.steps) fewer += step.observed_rows < points.cols();
   EXPECT_GT(fewer, 1000) << "most steps had missing rows";
 }
+
+// The liver (issue 3): the paper's errors were about 3 and 12 N/m before and after the cut,
+// the cut followed in about three times the box's steps; issue 3 asks for under 1.5 and 6 N/m
+// within 400 steps on noise-free data. Measured at stop 32 (CPU back end and its factors,
+// simplex): 0.12 and 0.65 N/m, followed in 304 steps (the README's table, with Jacobi CG:
+// 0.14 and 1.06 N/m, 314 steps).
+constexpr double kLiverBeforeCutError = 1.5;   // N/m
+constexpr double kLiverAfterCutError = 6.0;    // N/m
+constexpr int kLiverStepsToFollow = 400;
+
+TEST(LiverEstimation, ConvergesFromTwiceTheTruthAndFollowsTheCut) {
+  const ExperimentData& data = experiment_data("liver", true, true);
+  const ExperimentRun liver = run_experiment(data, SigmaPointSet::simplex, kNoiseFreeObservationStd,
+                                             data.observations.points);
+  ASSERT_TRUE(liver.run.complete) << liver.run.stop_reason;
+  const std::vector<PhaseErrors> phases =
+      error_figures(liver.steps, liver.estimate, liver.std_dev, liver.truth);
+  ASSERT_EQ(phases.size(), 2u) << "one cut: two phases";
+  EXPECT_LT(phases[0].mean_abs_error, kLiverBeforeCutError) << "before the cut";
+  EXPECT_LT(phases[1].mean_abs_error, kLiverAfterCutError) << "after the cut";
+  EXPECT_GE(phases[1].steps_to_follow, 0) << "the estimates must settle after the cut";
+  EXPECT_LE(phases[1].steps_to_follow, kLiverStepsToFollow);
+  std::cout << "liver, noise-free: mean |error| " << phases[0].mean_abs_error << " and "
+            << phases[1].mean_abs_error << " N/m, the cut followed in " << phases[1].steps_to_follow
+            << " steps\n";
+}
+
+// At the scenarios' 0.5 mm noise (seed 1), the truth lies inside estimate +- 2 std for at
+// least 90% of each phase's last 20% of steps (issue 3's coverage goal). Measured at stop 32:
+// box 99.3% / 98.9%, liver 98.5% / 98.5% (the README's table, with Jacobi CG: 99 / 98 and
+// 95 / 100).
+constexpr double kCoverageAtHalfAMillimetre = 0.9;
+
+class NoisyEstimationTest : public ::testing::TestWithParam<const char*> {};
+
+TEST_P(NoisyEstimationTest, TheTruthLiesInsideTwoStd) {
+  const ExperimentData& data = experiment_data(GetParam(), false, true);
+  const ExperimentRun run = run_experiment(data, SigmaPointSet::simplex,
+                                           data.scenario.filter->observation_std,
+                                           data.observations.points);
+  ASSERT_TRUE(run.run.complete) << run.run.stop_reason;
+  const std::vector<PhaseErrors> phases = error_figures(run.steps, run.estimate, run.std_dev, run.truth);
+  ASSERT_EQ(phases.size(), 2u) << "one cut: two phases";
+  for (const PhaseErrors& phase : phases) {
+    EXPECT_GE(phase.coverage, kCoverageAtHalfAMillimetre) << GetParam() << ", " << phase.name;
+    std::cout << GetParam() << ", " << phase.name << ": mean |error| " << phase.mean_abs_error
+              << " N/m, coverage " << 100.0 * phase.coverage << "%\n";
+  }
+}
+
+INSTANTIATE_TEST_SUITE_P(HalfAMillimetre, NoisyEstimationTest, ::testing::Values("box", "liver"),
+                         [](const ::testing::TestParamInfo<const char*>& param_info) {
+                           return std::string(param_info.param);
+                         });
 
 }  // namespace
 }  // namespace sigmafem
