@@ -15,10 +15,13 @@ DeviceOptions BackendChoice::device_options() const {
 }
 
 void add_backend_options(CLI::App* command, BackendChoice& choice) {
+  std::vector<std::string> names = available_backends();
+  names.insert(names.begin(), "auto");
   command->add_option("--backend", choice.backend,
-                      "Where the simulations run: cpu (the double-precision reference) or a "
-                      "device back end")
-      ->check(CLI::IsMember(available_backends()))
+                      "Where the simulations run: cpu (the double-precision reference), a "
+                      "device back end, or auto (a GPU where one is there and the ensemble is "
+                      "large enough to pay, else cpu; the first line of output says which)")
+      ->check(CLI::IsMember(names))
       ->capture_default_str();
   command->add_option("--device", choice.device,
                       "Device index for a device back end (see `sigmafem devices`)")

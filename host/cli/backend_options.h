@@ -1,5 +1,5 @@
 // The options that choose where simulations run, shared by `estimate`, `generate` and `demo`:
-// --backend cpu|opencl|vulkan, --device N, --precision single|double, --preconditioner.
+// --backend auto|cpu|opencl|vulkan, --device N, --precision single|double, --preconditioner.
 #pragma once
 
 #include <CLI/CLI.hpp>
@@ -10,7 +10,7 @@
 namespace sigmafem::cli {
 
 struct BackendChoice {
-  std::string backend = "cpu";
+  std::string backend = "auto";   // `generate` sets "cpu" before add_backend_options
   int device = 0;
   std::string precision = "single";
   std::string preconditioner = "auto";

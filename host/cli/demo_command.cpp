@@ -67,7 +67,8 @@ Action add_demo_command(CLI::App& app) {
     generate_options.out_dir = (out / "data").string();
     generate_options.seed = options->seed;
     generate_options.progress = true;
-    generate_options.backend = options->backend.backend;
+    // The truth stays the double-precision reference unless a back end is named.
+    generate_options.backend = options->backend.backend == "auto" ? "cpu" : options->backend.backend;
     generate_options.device = options->backend.device_options();
     std::cout << "sigmafem demo: scenario " << scenario.path << "\n1. synthetic data\n";
     const GenerateResult result = generate(scenario, generate_options, std::cerr);
@@ -80,6 +81,7 @@ Action add_demo_command(CLI::App& app) {
     job.backend = options->backend.backend;
     job.device = options->backend.device_options();
     job.sigma_points = options->sigma_points;
+    job.out = &std::cout;
     const auto summary = run_estimation_job(scenario, job);
     print_estimation_summary(std::cout, summary, job.out_dir);
     return summary["complete"].get<bool>() ? 0 : 1;

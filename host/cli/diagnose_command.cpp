@@ -13,7 +13,11 @@
 #include "host/cli/diagnosis_report.h"
 #include "host/common/input_error.h"
 #include "host/common/input_file.h"
+#include "filter/sigma_points.h"
 #include "host/diagnosis/diagnosis.h"
+#include "host/ensemble/choose_backend.h"
+#include "host/model/model.h"
+#include "host/scenario/estimation_options.h"
 #include "host/scenario/scenario.h"
 
 namespace sigmafem::cli {
@@ -72,7 +76,6 @@ Action add_diagnose_command(CLI::App& app) {
     DiagnosisReport report;
     report.data_dir = options->data_dir;
     report.out_dir = options->out_dir;
-    report.backend = options->backend.backend;
     // truth.json is optional like truth.csv: unusable, it is a warning and left out.
     if (fs::exists(data / "truth.json")) {
       const std::string path = (data / "truth.json").string();
@@ -87,13 +90,22 @@ Action add_diagnose_command(CLI::App& app) {
       }
     }
     DiagnoseOptions diagnose_options;
-    diagnose_options.backend = options->backend.backend;
     diagnose_options.device = options->backend.device_options();
     diagnose_options.max_rounds = options->max_rounds;
     diagnose_options.burn_in_fraction = options->burn_in;
     diagnose_options.sigma_points = options->sigma_points == "scenario"
                                         ? std::nullopt
                                         : std::optional<SigmaPointSet>(parse_sigma_point_set(options->sigma_points));
+    // --backend auto decides by the declared model's ensemble (the candidates' are a few
+    // sigma points larger).
+    const SigmaPointSet set =
+        diagnose_options.sigma_points.value_or(estimation_options(scenario).roukf.sigma_points);
+    const BackendDecision backend = resolve_backend(
+        options->backend.backend, make_model(scenario),
+        sigma_point_count(set, static_cast<int>(scenario.filter->estimate.size())));
+    diagnose_options.backend = report.backend = backend.backend;
+    report.backend_reason = backend.reason;
+    if (!options->quiet) std::cout << "backend: " << backend.backend << " (" << backend.reason << ")\n" << std::flush;
     std::stringstream names(options->candidates);
     for (std::string name; std::getline(names, name, ',');)
       if (!name.empty()) diagnose_options.candidates.push_back(name);

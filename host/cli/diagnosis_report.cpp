@@ -131,6 +131,7 @@ json write_diagnosis_report(const Scenario& scenario, const Diagnosis& d, const 
   j["scenario"] = scenario.path;
   j["data"] = report.data_dir;
   j["backend"] = report.backend;
+  j["backend_reason"] = report.backend_reason;
   const std::string sigma_points =
       options.sigma_points ? to_string(*options.sigma_points) : scenario.filter->sigma_points;
   j["sigma_points"] = sigma_points;

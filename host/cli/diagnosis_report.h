@@ -15,7 +15,8 @@ namespace sigmafem::cli {
 struct DiagnosisReport {
   std::string data_dir;
   std::string out_dir;
-  std::string backend;
+  std::string backend;          // the back end that ran (cpu, opencl, vulkan)
+  std::string backend_reason;   // "given", or why --backend auto chose it
   nlohmann::ordered_json truth_effects;   // truth.json's effects when present, else null
 };
 

@@ -16,6 +16,7 @@
 #include "host/common/progress.h"
 #include "host/data/observation_table.h"
 #include "host/data/truth_table.h"
+#include "host/ensemble/choose_backend.h"
 #include "host/ensemble/make_ensemble.h"
 #include "host/model/effects.h"
 #include "host/model/model.h"
@@ -52,9 +53,11 @@ json run_estimation_job(const Scenario& scenario, const EstimationJob& job) {
       sigma_point_count(options.roukf.sigma_points, static_cast<int>(spec.estimate.size()));
 
   fs::create_directories(job.out_dir);
-  std::unique_ptr<Ensemble> ensemble =
-      make_ensemble(job.backend, make_model(scenario), scenario.filter->estimate,
-                    scenario.observations.nodes, sigma_count, job.device);
+  const Model model = make_model(scenario);
+  const BackendDecision backend = resolve_backend(job.backend, model, sigma_count);
+  if (job.out) *job.out << "backend: " << backend.backend << " (" << backend.reason << ")\n" << std::flush;
+  std::unique_ptr<Ensemble> ensemble = make_ensemble(
+      backend.backend, model, scenario.filter->estimate, scenario.observations.nodes, sigma_count, job.device);
   Progress progress("estimate " + scenario.name + ": step", table.row_count() - 1, job.progress);
   const EstimationRun run = run_estimation(
       *ensemble, options, table.times, table.so, table.points, [&](const EstimationStep& step) {
@@ -68,7 +71,8 @@ json run_estimation_job(const Scenario& scenario, const EstimationJob& job) {
   report.scenario_name = scenario.name;
   report.data_dir = job.data_dir;
   report.out_dir = job.out_dir;
-  report.backend = job.backend;
+  report.backend = backend.backend;
+  report.backend_reason = backend.reason;
   report.sigma_points = to_string(options.roukf.sigma_points);
   report.sigma_count = sigma_count;
   for (int l : spec.estimate) report.names.push_back(scenario.ligaments[l].name);

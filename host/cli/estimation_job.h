@@ -3,6 +3,7 @@
 #pragma once
 
 #include <nlohmann/json.hpp>
+#include <ostream>
 #include <string>
 
 #include "host/common/device_options.h"
@@ -13,10 +14,11 @@ namespace sigmafem::cli {
 struct EstimationJob {
   std::string data_dir;
   std::string out_dir;
-  std::string backend = "cpu";
+  std::string backend = "auto";    // or cpu, opencl, vulkan (make_ensemble)
   DeviceOptions device;            // for a device back end
   std::string sigma_points;        // "" = the scenario's filter.sigma_points
   bool progress = true;
+  std::ostream* out = nullptr;     // the back end's line ("backend: ..."), before the run
 };
 
 // Runs the job; returns the summary written to summary.json. Throws InputError for bad input

@@ -21,7 +21,8 @@ struct EstimationReport {
   std::string scenario_name;
   std::string data_dir;
   std::string out_dir;
-  std::string backend;
+  std::string backend;          // the back end that ran (cpu, opencl, vulkan)
+  std::string backend_reason;   // "given", or why --backend auto chose it
   std::string sigma_points;
   int sigma_count = 0;
   std::vector<std::string> names;             // estimated ligaments

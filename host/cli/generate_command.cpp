@@ -67,6 +67,8 @@ Action add_generate_command(CLI::App& app) {
                   "position); observed positions are interpolated at the observed nodes' rest "
                   "positions. Recorded in truth.json")
       ->type_name("FILE");
+  // The truth is the double-precision reference unless the user names another back end.
+  options->backend.backend = "cpu";
   add_backend_options(sub, options->backend);
   sub->add_flag("--quiet", options->quiet, "No progress line and no summary");
   return [options, sub]() {

@@ -1,6 +1,7 @@
 #include "host/ensemble/make_ensemble.h"
 
 #include "host/common/input_error.h"
+#include "host/ensemble/choose_backend.h"
 #include "host/ensemble/cpu_ensemble.h"
 #include "host/opencl/opencl_ensemble.h"
 #include "host/vulkan/vulkan_ensemble.h"
@@ -13,6 +14,9 @@ std::unique_ptr<Ensemble> make_ensemble(const std::string& backend, const Model&
                                         const std::vector<int>& estimated,
                                         const std::vector<int>& observed, int sigma_count,
                                         const DeviceOptions& options) {
+  if (backend == "auto")
+    return make_ensemble(resolve_backend(backend, model, sigma_count).backend, model, estimated,
+                         observed, sigma_count, options);
   if (backend == "cpu")
     return std::make_unique<CpuEnsemble>(model, estimated, observed, sigma_count, 0,
                                          options.preconditioner);

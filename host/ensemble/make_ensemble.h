@@ -16,7 +16,8 @@ namespace sigmafem {
 // The back ends this build has, in the order `--backend` lists them.
 std::vector<std::string> available_backends();
 
-// Throws InputError for an unknown name, DeviceError when the device cannot run it.
+// "auto" is resolve_backend()'s choice (host/ensemble/choose_backend.h). Throws InputError
+// for an unknown name, DeviceError when the device cannot run it.
 // The CPU back end takes only `options.preconditioner` (automatic: the factors);
 // a device back end refuses Preconditioner::factorised with an InputError.
 std::unique_ptr<Ensemble> make_ensemble(const std::string& backend, const Model& model,

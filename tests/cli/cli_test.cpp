@@ -13,6 +13,7 @@
 #include <vector>
 
 #include "cli/sigmafem_command.h"
+#include "host/ensemble/choose_backend.h"
 #include "requirement.h"
 #include "temp_path.h"
 
@@ -230,6 +231,9 @@ TEST_F(CliTest, TheFactorisedPreconditionerIsTheCpuBackEndsOnly) {
   EXPECT_NE(device.output.find("--preconditioner factorised"), std::string::npos) << device.output;
   EXPECT_NE(device.output.find("cpu back end"), std::string::npos) << device.output;
   EXPECT_FALSE(fs::exists(dir_ / "out" / "observations.csv"));
+  const CommandRun no_such_backend = run_sigmafem(generate + "--backend gpu");
+  EXPECT_EQ(no_such_backend.exit_code, 2) << no_such_backend.output;
+  EXPECT_NE(no_such_backend.output.find("--backend"), std::string::npos) << no_such_backend.output;
   const CommandRun unknown = run_sigmafem(generate + "--preconditioner cholesky");
   EXPECT_NE(unknown.exit_code, 0) << unknown.output;
   EXPECT_NE(unknown.output.find("--preconditioner"), std::string::npos) << unknown.output;
@@ -255,10 +259,16 @@ TEST_F(CliTest, EstimateWritesEstimatesSummaryResidualsAndPlots) {
                                       " --out " + (dir_ / "estimate").string());
   ASSERT_EQ(run.exit_code, 0) << run.output;
   EXPECT_NE(run.output.find("estimated 'box' over 30 filter steps"), std::string::npos) << run.output;
+  // --backend auto by default: the first line says what it chose and why (the choice itself:
+  // tests/ensemble/choose_backend_test.cpp), and so does the summary.
+  const BackendDecision expected = choose_backend(find_gpus(), 1344, 4);   // box.json: 1344 tetrahedra, simplex, 3 ligaments
+  EXPECT_EQ(run.output.rfind("backend: " + expected.backend + " (auto: ", 0), 0u) << run.output;
   const fs::path out = dir_ / "estimate";
   EXPECT_TRUE(fs::exists(out / "estimates.csv"));
   std::ifstream summary_file(out / "summary.json");
   const json summary = json::parse(summary_file);
+  EXPECT_EQ(summary["backend"], expected.backend);
+  EXPECT_EQ(summary["backend_reason"], expected.reason);
   EXPECT_TRUE(summary["complete"].get<bool>());
   EXPECT_EQ(summary["filter_steps"].get<int>(), 30);
   EXPECT_TRUE(summary["errors"].is_object()) << "truth.csv was in the data folder";

@@ -1,0 +1,36 @@
+#include "host/ensemble/choose_backend.h"
+
+#include "host/opencl/opencl_device.h"
+#include "host/vulkan/vulkan_device.h"
+
+namespace sigmafem {
+
+GpuPresence find_gpus() {
+  GpuPresence gpus;
+  const std::vector<OpenClDeviceInfo> opencl = list_opencl_devices();
+  if (!opencl.empty() && opencl[0].type == "gpu") gpus.opencl = opencl[0].name;
+  const std::vector<VulkanDeviceInfo> vulkan = list_vulkan_devices();
+  if (!vulkan.empty() && vulkan[0].type.find("gpu") != std::string::npos)
+    gpus.vulkan = vulkan[0].name;
+  return gpus;
+}
+
+BackendDecision choose_backend(const GpuPresence& gpus, long long elements, int sigma_count) {
+  const long long pairs = elements * sigma_count;
+  const std::string size = std::to_string(elements) + " tetrahedra x " +
+                           std::to_string(sigma_count) + " sigma points";
+  if (gpus.opencl.empty() && gpus.vulkan.empty())
+    return {"cpu", "auto: no GPU; the CPU back end is the fastest without one"};
+  if (pairs < kGpuPairs)
+    return {"cpu", "auto: " + size + " is too small for the GPU to pay (from " +
+                       std::to_string(kGpuPairs) + " pairs)"};
+  if (!gpus.opencl.empty()) return {"opencl", "auto: " + size + " on the GPU " + gpus.opencl};
+  return {"vulkan", "auto: " + size + " on the GPU " + gpus.vulkan};
+}
+
+BackendDecision resolve_backend(const std::string& backend, const Model& model, int sigma_count) {
+  if (backend != "auto") return {backend, "given"};
+  return choose_backend(find_gpus(), model.element_count(), sigma_count);
+}
+
+}  // namespace sigmafem
