@@ -166,6 +166,7 @@ void cg_iteration(uint S, uint node_count, int max_iterations, __global const re
     }
   }
 }
+
 /* Partitions: on a large mesh one group per sigma point leaves most of a GPU idle (S groups
  * of 64 work-items, each going down thousands of rows). With SF_CG_PARTITIONS = P > 1 (the
  * host's choice by the rows) each sigma point's rows are cut into P contiguous partitions and
