@@ -3,6 +3,7 @@
 // the command line can print it as is and exit non-zero.
 #pragma once
 
+#include <Eigen/Core>
 #include <sstream>
 #include <stdexcept>
 #include <string>
@@ -20,6 +21,11 @@ inline std::string message_number(double value) {
   std::ostringstream out;
   out << value;
   return out.str();
+}
+
+// A point or vector as a message shows it: [x, y, z], each as message_number.
+inline std::string message_point(const Eigen::Vector3d& p) {
+  return "[" + message_number(p.x()) + ", " + message_number(p.y()) + ", " + message_number(p.z()) + "]";
 }
 
 }  // namespace sigmafem

@@ -40,11 +40,6 @@ constexpr int kMaxMeshRefine = 3;
 // ---------------------------------------------------------------------------------------
 // Text helpers for messages.
 
-std::string format_vector(const Eigen::Vector3d& v) {
-  return "[" + message_number(v.x()) + ", " + message_number(v.y()) + ", " + message_number(v.z()) +
-         "]";
-}
-
 std::string in_quotes(const std::string& s) {
   return "\"" + s + "\"";
 }
@@ -370,7 +365,7 @@ std::vector<int> node_set(const Checker& c, const json& owner, const std::string
       spec.kind = NodeSetSpec::Kind::near;
       spec.near = near;
       spec.radius = radius;
-      asked = "near " + format_vector(near) + ", radius " + message_number(radius) + " m";
+      asked = "near " + message_point(near) + ", radius " + message_number(radius) + " m";
       advice = "enlarge radius or list nodes";
     } else {
       const std::string box_path = child(select_path, "box");
@@ -379,13 +374,13 @@ std::vector<int> node_set(const Checker& c, const json& owner, const std::string
       const Eigen::Vector3d min = c.vector3(box.at("min"), child(box_path, "min"));
       const Eigen::Vector3d max = c.vector3(box.at("max"), child(box_path, "max"));
       c.require((min.array() <= max.array()).all(), box_path,
-                "min " + format_vector(min) + " exceeds max " + format_vector(max) +
+                "min " + message_point(min) + " exceeds max " + message_point(max) +
                     " in some coordinate");
       nodes = select_nodes_in_box(mesh, min, max);
       spec.kind = NodeSetSpec::Kind::box;
       spec.min = min;
       spec.max = max;
-      asked = "box min " + format_vector(min) + ", max " + format_vector(max) + " m";
+      asked = "box min " + message_point(min) + ", max " + message_point(max) + " m";
       advice = "enlarge the box or list nodes";
     }
     // With a mesh scale set, a selection written in file units is the usual cause.

@@ -10,12 +10,6 @@ namespace sigmafem {
 
 namespace {
 
-std::string format_point(const Eigen::Vector3d& p) {
-  std::ostringstream out;
-  out << "[" << p.x() << ", " << p.y() << ", " << p.z() << "]";
-  return out.str();
-}
-
 // The node of `mesh` nearest to p (brute force: node lists are short) and its distance.
 std::pair<int, double> nearest_node(const Mesh& mesh, const Eigen::Vector3d& p) {
   int best = -1;
@@ -46,15 +40,15 @@ class Resolver {
       case NodeSetSpec::Kind::near:
         resolved = select_nodes_near(to_, spec.near, spec.radius);
         if (resolved.empty())
-          fail(spec.field + ".select", "near " + format_point(spec.near) + ", radius " +
+          fail(spec.field + ".select", "near " + message_point(spec.near) + ", radius " +
                                            message_number(spec.radius) +
                                            " m selects no node of this mesh");
         break;
       case NodeSetSpec::Kind::box:
         resolved = select_nodes_in_box(to_, spec.min, spec.max);
         if (resolved.empty())
-          fail(spec.field + ".select", "box min " + format_point(spec.min) + ", max " +
-                                           format_point(spec.max) + " m selects no node of this mesh");
+          fail(spec.field + ".select", "box min " + message_point(spec.min) + ", max " +
+                                           message_point(spec.max) + " m selects no node of this mesh");
         break;
       case NodeSetSpec::Kind::automatic:
         break;   // resolve_automatic_regions
@@ -74,7 +68,7 @@ class Resolver {
     const auto [nearest, distance] = nearest_node(to_, p);
     if (distance > kCoincidentTolerance) {
       std::ostringstream what;
-      what << "node " << node << " at " << format_point(p) << " m has no node of this mesh within "
+      what << "node " << node << " at " << message_point(p) << " m has no node of this mesh within "
            << kCoincidentTolerance << " m (the nearest, node " << nearest << ", is "
            << distance * 1e3 << " mm away); list nodes that both meshes have, or give the set "
            << "by position (\"select\")";
