@@ -68,21 +68,16 @@ static inline real sf_group_sum(__local real* scratch, real value) {
   return scratch[0];
 }
 
-/* The warm start's residual and the first direction: with q = A x (x = the last step's dv,
- * from element_product and node_product), r = b - q, z = M^-1 r, d = z; bb, rr, rz; and
- * whether the warm start is already good enough. */
-__kernel __attribute__((reqd_work_group_size(SF_GROUP_SIZE, 1, 1)))
-void cg_start(uint S, uint node_count, __global const real* c, __global const real* q,
-              __global const real* b, __global const real* inverse_diagonal, __global real* r,
-              __global real* z, __global real* d, __global real* bb, __global real* rr,
-              __global real* rz, __global uint* active, __global uint* converged,
-              __global int* iterations) {
-  __local real scratch[SF_GROUP_SIZE];
-  uint s = get_group_id(0);
+/* Rows [begin, end) of sigma point s at the warm start, with q = A x: r = b - q,
+ * z = M^-1 r, d = z; the group's sums b.b, r.r, r.z in sums[0..2]. */
+static inline void sf_start_rows(uint S, uint s, uint begin, uint end, __global const real* q,
+                                 __global const real* b, __global const real* inverse_diagonal,
+                                 __global real* r, __global real* z, __global real* d,
+                                 __local real* scratch, real sums[3]) {
   real sum_bb = (real)0;
   real sum_rr = (real)0;
   real sum_rz = (real)0;
-  for (uint row = get_local_id(0); row < 3 * node_count; row += SF_GROUP_SIZE) {
+  for (uint row = begin + get_local_id(0); row < end; row += SF_GROUP_SIZE) {
     size_t at = (size_t)row * S + s;
     real bi = b[at];
     real ri = bi - q[at];
@@ -94,9 +89,25 @@ void cg_start(uint S, uint node_count, __global const real* c, __global const re
     sum_rr += ri * ri;
     sum_rz += ri * zi;
   }
-  sum_bb = sf_group_sum(scratch, sum_bb);
-  sum_rr = sf_group_sum(scratch, sum_rr);
-  sum_rz = sf_group_sum(scratch, sum_rz);
+  sums[0] = sf_group_sum(scratch, sum_bb);
+  sums[1] = sf_group_sum(scratch, sum_rr);
+  sums[2] = sf_group_sum(scratch, sum_rz);
+}
+
+/* The warm start's residual and the first direction: with q = A x (x = the last step's dv,
+ * from element_product and node_product), r = b - q, z = M^-1 r, d = z; bb, rr, rz; and
+ * whether the warm start is already good enough. */
+__kernel __attribute__((reqd_work_group_size(SF_GROUP_SIZE, 1, 1)))
+void cg_start(uint S, uint node_count, __global const real* c, __global const real* q,
+              __global const real* b, __global const real* inverse_diagonal, __global real* r,
+              __global real* z, __global real* d, __global real* bb, __global real* rr,
+              __global real* rz, __global uint* active, __global uint* converged,
+              __global int* iterations) {
+  __local real scratch[SF_GROUP_SIZE];
+  uint s = get_group_id(0);
+  real sums[3];
+  sf_start_rows(S, s, 0, 3 * node_count, q, b, inverse_diagonal, r, z, d, scratch, sums);
+  real sum_bb = sums[0], sum_rr = sums[1], sum_rz = sums[2];
   if (get_local_id(0) == 0)
     sf_cg_start_scalars(s, sum_bb, sum_rr, sum_rz, c, bb, rr, rz, active, converged, iterations);
 }
@@ -212,24 +223,9 @@ void cg_start_partials(uint S, uint node_count, __global const real* q, __global
   uint p = get_group_id(0) % SF_CG_PARTITIONS;
   uint begin, end;
   sf_partition_rows(3 * node_count, p, &begin, &end);
-  real sum_bb = (real)0;
-  real sum_rr = (real)0;
-  real sum_rz = (real)0;
-  for (uint row = begin + get_local_id(0); row < end; row += SF_GROUP_SIZE) {
-    size_t at = (size_t)row * S + s;
-    real bi = b[at];
-    real ri = bi - q[at];
-    real zi = inverse_diagonal[at] * ri;
-    r[at] = ri;
-    z[at] = zi;
-    d[at] = zi;
-    sum_bb += bi * bi;
-    sum_rr += ri * ri;
-    sum_rz += ri * zi;
-  }
-  sum_bb = sf_group_sum(scratch, sum_bb);
-  sum_rr = sf_group_sum(scratch, sum_rr);
-  sum_rz = sf_group_sum(scratch, sum_rz);
+  real sums[3];
+  sf_start_rows(S, s, begin, end, q, b, inverse_diagonal, r, z, d, scratch, sums);
+  real sum_bb = sums[0], sum_rr = sums[1], sum_rz = sums[2];
   if (get_local_id(0) == 0) {
     partial[((size_t)SF_PARTIAL_BB * S + s) * SF_CG_PARTITIONS + p] = sum_bb;
     partial[((size_t)SF_PARTIAL_RR * S + s) * SF_CG_PARTITIONS + p] = sum_rr;
