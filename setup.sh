@@ -2,15 +2,18 @@
 # sigmafem set-up on a Debian machine (bookworm or later):
 #   ./setup.sh run    install what is missing, build, run the main job on the default scenario
 #   ./setup.sh test   install what is missing, build, run the whole test suite: a Release build
-#                     with warnings as errors, the readers' fuzzers (SIGMAFEM_FUZZ_SECONDS
-#                     each, default 60), then a build with AddressSanitizer and
-#                     UndefinedBehaviorSanitizer (clang: a second compiler's warnings too)
+#                     with warnings as errors and every test, then the readers' fuzzers
+#                     (SIGMAFEM_FUZZ_SECONDS each, default 60): what CI runs (.ci/run)
+#   ./setup.sh sanitize  install what is missing, build with AddressSanitizer and
+#                     UndefinedBehaviorSanitizer (clang: a second compiler's warnings too), run
+#                     the tests that fit under them. Not in the test command since stop 33:
+#                     with it the command took 20 minutes, against 15 asked (README, Set-up).
 # Debian packages are the only dependencies; apt-get runs only when one is missing (through
 # sudo when not root).
 set -euo pipefail
 cd "$(dirname "$0")"
 mode=${1:-run}
-case "$mode" in run|test) ;; *) echo "usage: ./setup.sh run|test" >&2; exit 2 ;; esac
+case "$mode" in run|test|sanitize) ;; *) echo "usage: ./setup.sh run|test|sanitize" >&2; exit 2 ;; esac
 
 # Each step prints its start time from the beginning, and the test command ends with the time
 # of each step (the README quotes them).
@@ -32,9 +35,9 @@ packages="g++ cmake ninja-build pkg-config libeigen3-dev nlohmann-json3-dev libc
           libgtest-dev libbenchmark-dev gnuplot-nox
           ocl-icd-opencl-dev opencl-clhpp-headers pocl-opencl-icd
           libvulkan-dev glslang-tools mesa-vulkan-drivers vulkan-validationlayers"
-# The tests also fuzz the input readers with clang and libFuzzer (tests/fuzz/), and build
-# the sanitizer tier with clang.
-[ "$mode" = test ] && packages="$packages clang libclang-rt-dev"
+# The tests also fuzz the input readers with clang and libFuzzer (tests/fuzz/), and the
+# sanitizer tier is built with clang.
+[ "$mode" != run ] && packages="$packages clang libclang-rt-dev"
 missing=""
 for p in $packages; do
   dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q 'ok installed' || missing="$missing $p"
@@ -51,6 +54,11 @@ jobs=$(nproc 2>/dev/null || echo 2)
 # standard headers once per 8 files instead of once per file: on 2 cores the Release build
 # took 3:00 instead of 4:30, the sanitizer build 5:32 instead of 8:05 (stop 32).
 unity=-DCMAKE_UNITY_BUILD=ON
+# A test whose device, fp64, gnuplot, validation layer or shared data is missing fails
+# instead of skipping (tests/requirement.h): the packages above provide them all.
+export SIGMAFEM_TESTS_REQUIRE=all
+
+if [ "$mode" != sanitize ]; then
 step "building (Release, warnings as errors)"
 cmake -S . -B build -G Ninja -DCMAKE_BUILD_TYPE=Release -DSIGMAFEM_WERROR=ON $unity >/dev/null
 cmake --build build -j "$jobs"
@@ -61,9 +69,6 @@ if [ "$mode" = run ]; then
 fi
 
 step "tests (Release)"
-# A test whose device, fp64, gnuplot, validation layer or shared data is missing fails here
-# instead of skipping (tests/requirement.h): the packages above provide them all.
-export SIGMAFEM_TESTS_REQUIRE=all
 ctest --test-dir build --output-on-failure -j "$jobs"
 fuzz_seconds=${SIGMAFEM_FUZZ_SECONDS:-60}
 step "building the input readers' fuzzers (clang, libFuzzer, ASan and UBSan)"
@@ -72,10 +77,11 @@ cmake -S tests/fuzz -B build-fuzz -G Ninja -DCMAKE_CXX_COMPILER=clang++ \
 cmake --build build-fuzz -j "$jobs"
 step "fuzzing the input readers ($fuzz_seconds s each)"
 ctest --test-dir build-fuzz --output-on-failure -j "$jobs"
+
+else
 step "building with AddressSanitizer and UndefinedBehaviorSanitizer (clang)"
 # -O1 -g1: the optimisation AddressSanitizer's authors recommend, and line tables only, all a
-# report's stack trace needs. This build is the longest step after the Release tests: with
-# full -g it took about 15 minutes on 2 cores, with -O2 -g1 11 min 42 s, with -O1 -g1 9 min
+# report's stack trace needs. With full -g this build took about 15 minutes on 2 cores, with -O2 -g1 11 min 42 s, with -O1 -g1 9 min
 # 14 s (fresh machine, stop 30), 6:01 as a unity build (stop 32). Clang compiles it in two
 # thirds of GCC's time (3:40 against 5:32 on the 2-core machine, stop 33; the tests below take
 # the same 2 minutes), and its warnings, as errors here, add to GCC's in the Release build.
@@ -87,27 +93,27 @@ cmake --build build-sanitize -j "$jobs"
 step "tests (sanitizers)"
 # The 1500-step box estimations run about 30x slower under the sanitizers (over 13 minutes
 # each on 2 cores; so would the 2000-step liver ones, LiverEstimation and the 0.5 mm
-# NoisyEstimation); they ran above in the Release build, and EstimationLoop covers the same
+# NoisyEstimation); they run in the test command's Release build, and EstimationLoop covers the same
 # code here in 80 steps, and so does the bounded-history check (EstimationHistory: two
 # 300-step box runs). Likewise the device conformance tests whose time goes into long
-# CPU-reference runs (200-step trajectories and the reference they share, conformance_reference;
+# CPU-reference runs (100-step trajectories and the reference they share, conformance_reference;
 # repeated runs, 16 sigma points, the whole-run
-# comparison) ran above; the one-step, re-centring and iteration-cap tests with 1 and 4
+# comparison) run there; the one-step, re-centring and iteration-cap tests with 1 and 4
 # sigma points run here and cover the same host code. The residual diagnostics' two 100-step
-# box runs (ResidualDiagnosticsBox) ran above too; their synthetic tests run here. So did the
+# box runs (ResidualDiagnosticsBox) run there too; their synthetic tests run here. So do the
 # whole diagnoses (DiagnoseBox, DiagnoseLiver: 5 to 20 filter runs each) and the Vulkan-against-OpenCL
 # comparison (of two trajectories that trajectory cases keep; no host code of its own), the
 # convergence of the refined truth (two runs on the box_diagnose mesh refined twice), the CLI's
 # short diagnose, the SOFA comparison (the CPU reference's 2000-step runs, which the
 # estimation tests here drive too), the filter and diagnose on SOFA's data (SofaData: whole
 # diagnoses of 600-1000 steps; the claim checks they reach run here in ModelFormClaim) and the float64 Vulkan conformance cases (lavapipe's
-# software doubles; VulkanSingle runs the same host code here). Kept to hold CI under 30
-# minutes on 2 cores (fresh-machine: 28 minutes before these went).
+# software doubles; VulkanSingle runs the same host code here). Left out when this tier was
+# part of the test command, which took 28 minutes on 2 cores with them (stop 30).
 # Vulkan on lavapipe runs under the sanitizers as it is: Mesa is not instrumented, and the
 # Vulkan device holds one instance for the process so that the loader does not unload Mesa
 # under its one-time allocations (host/vulkan/vulkan_device.cpp), which LeakSanitizer would
-# otherwise report from an unloaded module. The ctest vulkan_validation ran above and is left
-# out here: with the validation layer (loaded and unloaded with each instance) LeakSanitizer
+# otherwise report from an unloaded module. The ctest vulkan_validation (in the test command)
+# is left out here: with the validation layer (loaded and unloaded with each instance) LeakSanitizer
 # reports, at exit, allocations made by Mesa's LLVM and by modules already unloaded: none in
 # sigmafem's code, and none it could free.
 # intercept_tls_get_addr=0: GCC 12's sanitizer runtime (and LLVM's up to 16) takes a dynamic TLS
@@ -119,6 +125,7 @@ step "tests (sanitizers)"
 ASAN_OPTIONS=detect_leaks=1:abort_on_error=1:intercept_tls_get_addr=0 UBSAN_OPTIONS=print_stacktrace=1:halt_on_error=1 \
   ctest --test-dir build-sanitize --output-on-failure -j "$jobs" \
   -E 'conformance_reference|TruthMeshTest.SpreadSprings|BoxEstimation|LiverEstimation|NoisyEstimation|EstimationHistory|ResidualDiagnosticsBox|DiagnoseBox|DiagnoseLiver|CliTest.Diagnose|SofaReference|SofaData|WholeRun|VulkanAgainstOpenCl|vulkan_validation|Conformance.*(Trajectory|TwoRuns|_S16|VulkanDouble)'
+fi
 step
 echo "== passed in $(clock "$SECONDS"):"
 for i in "${!step_names[@]}"; do echo "   $(clock "${step_seconds[$i]}")  ${step_names[$i]}"; done
