@@ -70,7 +70,7 @@ DeviceOptions device_options(const Backend& backend) {
 // make_ensemble, and the shared factor where the Backend asks for it.
 std::unique_ptr<Ensemble> make_bench_ensemble(const Backend& backend, const Scenario& s,
                                               const Model& model, int S) {
-  auto ensemble = make_ensemble(backend.name, model, s.filter->estimate, s.observations.nodes, S,
+  auto ensemble = make_ensemble(backend.name, model, s.filter->estimate, s.observations.observed, S,
                                 device_options(backend));
   if (backend.shared_factor) dynamic_cast<CpuEnsemble&>(*ensemble).set_own_factors_budget(0.0);
   return ensemble;
@@ -139,14 +139,14 @@ void BM_filter_step(benchmark::State& state, const Backend& backend, const std::
   }
   Roukf filter(options, *ensemble);
   ReferenceSimulation truth(model);
-  Eigen::VectorXd y(3 * static_cast<Eigen::Index>(s.observations.nodes.size()));
+  Eigen::VectorXd y(3 * static_cast<Eigen::Index>(s.observations.observed.size()));
   int step = 0;
   const auto observe = [&] {
     ++step;
     const Eigen::Vector3d so = bench::so_position(s, step);
     truth.step(so);
-    for (std::size_t k = 0; k < s.observations.nodes.size(); ++k)
-      y.segment<3>(3 * static_cast<Eigen::Index>(k)) = truth.node_position(s.observations.nodes[k]);
+    for (std::size_t k = 0; k < s.observations.observed.size(); ++k)
+      y.segment<3>(3 * static_cast<Eigen::Index>(k)) = s.observations.observed[k].of(truth.positions());
     return so;
   };
   // Warm-up steps, untimed: PoCL compiles a kernel at its first launch.

@@ -47,13 +47,13 @@ int main(int argc, char** argv) {
     if (!scenario.filter) throw std::runtime_error(std::string(argv[1]) + ": no filter block");
     const ObservationTable data =
         read_observations_csv(std::string(argv[2]) + "/observations.csv",
-                              static_cast<int>(scenario.observations.nodes.size()), scenario.time.dt);
+                              static_cast<int>(scenario.observations.observed.size()), scenario.time.dt);
     EstimationOptions options = estimation_options(scenario);
     options.keep_all_steps = false;
     const int sigma_count =
         sigma_point_count(options.roukf.sigma_points, static_cast<int>(scenario.filter->estimate.size()));
     auto ensemble = make_ensemble(backend, make_model(scenario), scenario.filter->estimate,
-                                  scenario.observations.nodes, sigma_count);
+                                  scenario.observations.observed, sigma_count);
     std::cout << "step,rss_kb\n";
     long at_1000 = 0, highest = 0, highest_step = 0;
     const EstimationRun run =

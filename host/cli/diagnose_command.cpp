@@ -67,7 +67,7 @@ Action add_diagnose_command(CLI::App& app) {
       throw InputError("scenario " + scenario.path + ": filter: missing; diagnose needs a filter block");
     const fs::path data(options->data_dir);
     const ObservationTable table = read_observations_csv(
-        (data / "observations.csv").string(), static_cast<int>(scenario.observations.nodes.size()), scenario.time.dt);
+        (data / "observations.csv").string(), static_cast<int>(scenario.observations.observed.size()), scenario.time.dt);
     if (table.row_count() < 2)
       throw InputError("observations " + (data / "observations.csv").string() +
                        ": needs at least two rows (the rest state and one step)");

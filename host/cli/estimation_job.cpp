@@ -35,7 +35,7 @@ json run_estimation_job(const Scenario& scenario, const EstimationJob& job) {
   const fs::path data(job.data_dir);
   ObservationTable table =
       read_observations_csv((data / "observations.csv").string(),
-                            static_cast<int>(scenario.observations.nodes.size()), scenario.time.dt);
+                            static_cast<int>(scenario.observations.observed.size()), scenario.time.dt);
   if (table.row_count() < 2)
     throw InputError("observations " + (data / "observations.csv").string() +
                      ": needs at least two rows (the rest state and one step)");
@@ -57,7 +57,7 @@ json run_estimation_job(const Scenario& scenario, const EstimationJob& job) {
   const BackendDecision backend = resolve_backend(job.backend, model, sigma_count);
   if (job.out) *job.out << "backend: " << backend.backend << " (" << backend.reason << ")\n" << std::flush;
   std::unique_ptr<Ensemble> ensemble = make_ensemble(
-      backend.backend, model, scenario.filter->estimate, scenario.observations.nodes, sigma_count, job.device);
+      backend.backend, model, scenario.filter->estimate, scenario.observations.observed, sigma_count, job.device);
   Progress progress("estimate " + scenario.name + ": step", table.row_count() - 1, job.progress);
   const EstimationRun run = run_estimation(
       *ensemble, options, table.times, table.so, table.points, [&](const EstimationStep& step) {

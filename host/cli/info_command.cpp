@@ -4,6 +4,7 @@
 #include <memory>
 
 #include "host/cli/commands.h"
+#include "host/common/input_error.h"
 #include "host/mesh/mesh.h"
 #include "host/scenario/scenario.h"
 
@@ -52,6 +53,14 @@ Action add_info_command(CLI::App& app) {
                 << event.stiffness << " N/m\n";
     std::cout << "  observed: ";
     print_nodes(std::cout, s.observations.nodes);
+    for (std::size_t k = 0; k < s.observations.points.size(); ++k) {
+      const ObservedPoint& point = s.observations.observed[s.observations.nodes.size() + k];
+      std::cout << "  observed point " << k << " at " << message_point(s.observations.points[k])
+                << ": nodes";
+      for (std::size_t c = 0; c < 4; ++c)
+        if (point.weights[c] != 0.0) std::cout << " " << point.nodes[c] << " (" << point.weights[c] << ")";
+      std::cout << "\n";
+    }
     return 0;
   };
 }

@@ -30,7 +30,7 @@ void print_generate_summary(std::ostream& out, const Scenario& scenario,
     out << "  warning: CG hit its iteration cap in " << result.unconverged_steps
         << " steps (see the messages above)\n";
   out << "  " << (dir / "observations.csv").string() << "  ("
-      << scenario.observations.nodes.size() << " observed nodes, noise "
+      << scenario.observations.observed.size() << " observed points, noise "
       << scenario.observations.noise_std * 1e3 << " mm, seed " << options.seed << ")\n";
   out << "  " << (dir / "truth.csv").string() << '\n';
   if (result.vtk_frames > 0)

@@ -127,7 +127,7 @@ ModelFit fit_model(const Scenario& scenario, const ObservationTable& data,
 
   const int sigma_count = sigma_point_count(roukf.sigma_points, p);
   const std::unique_ptr<EffectEnsemble> ensemble =
-      EffectEnsemble::make(options.backend, make_model(scenario), spec.estimate, scenario.observations.nodes,
+      EffectEnsemble::make(options.backend, make_model(scenario), spec.estimate, scenario.observations.observed,
                            sigma_count, options.device, effects);
   // A camera offset the scenario declares: the positions are the data minus the offset.
   Eigen::MatrixXd points = data.points;

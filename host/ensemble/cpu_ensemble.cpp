@@ -40,7 +40,7 @@ constexpr double kOwnFactorsBytes = 1024.0 * 1024.0 * 1024.0;
 
 }  // namespace
 
-CpuEnsemble::CpuEnsemble(const Model& model, std::vector<int> estimated, std::vector<int> observed,
+CpuEnsemble::CpuEnsemble(const Model& model, std::vector<int> estimated, ObservedPoints observed,
                          int sigma_count, int threads, Preconditioner preconditioner)
     : estimated_(std::move(estimated)),
       observed_(std::move(observed)),
@@ -50,6 +50,7 @@ CpuEnsemble::CpuEnsemble(const Model& model, std::vector<int> estimated, std::ve
   for (int l : estimated_)
     if (l < 0 || l >= static_cast<int>(model.ligaments.size()))
       throw std::invalid_argument("CpuEnsemble: no ligament " + std::to_string(l));
+  check_observed_points(observed_, model.node_count(), "CpuEnsemble");
   simulations_.assign(sigma_count, ReferenceSimulation(model));
   const int cores = static_cast<int>(std::thread::hardware_concurrency());
   threads_ = threads > 0 ? threads : std::max(1, cores);
@@ -117,7 +118,7 @@ void CpuEnsemble::predicted_observations(Eigen::MatrixXd& y) const {
   y.resize(observation_count(), sigma_count());
   for (int s = 0; s < sigma_count(); ++s)
     for (std::size_t k = 0; k < observed_.size(); ++k)
-      y.block<3, 1>(3 * static_cast<Eigen::Index>(k), s) = simulations_[s].node_position(observed_[k]);
+      y.block<3, 1>(3 * static_cast<Eigen::Index>(k), s) = observed_[k].of(simulations_[s].positions());
 }
 
 void CpuEnsemble::recenter(const Recentering& r) {

@@ -22,6 +22,7 @@
 
 #include "filter/ensemble.h"
 #include "host/common/device_options.h"
+#include "host/mesh/observed_points.h"
 #include "host/model/model.h"
 #include "host/reference/factorised_preconditioner.h"
 #include "host/reference/reference_simulation.h"
@@ -30,10 +31,11 @@ namespace sigmafem {
 
 class CpuEnsemble : public Ensemble {
  public:
-  // `estimated`: indices into model.ligaments; `observed`: node indices; `threads` 0 = cores.
+  // `estimated`: indices into model.ligaments; `observed`: the observed points (node indices
+  // convert); `threads` 0 = cores.
   // Preconditioner::automatic is the factors; the conformance tests, which compare the
   // devices' Jacobi CG with it to the last digits, ask for Jacobi.
-  CpuEnsemble(const Model& model, std::vector<int> estimated, std::vector<int> observed,
+  CpuEnsemble(const Model& model, std::vector<int> estimated, ObservedPoints observed,
               int sigma_count, int threads = 0,
               Preconditioner preconditioner = Preconditioner::automatic);
 
@@ -62,7 +64,7 @@ class CpuEnsemble : public Ensemble {
  private:
   std::vector<ReferenceSimulation> simulations_;
   std::vector<int> estimated_;
-  std::vector<int> observed_;
+  ObservedPoints observed_;
   int threads_;
   Preconditioner preconditioner_;
   // Empty with Jacobi and before the first step; then one per sigma point, or one shared.

@@ -34,7 +34,7 @@ EffectEnsemble::EffectEnsemble(std::unique_ptr<Ensemble> inner, const std::vecto
 }
 
 std::unique_ptr<EffectEnsemble> EffectEnsemble::make(const std::string& backend, Model model,
-                                                     std::vector<int> estimated, const std::vector<int>& observed,
+                                                     std::vector<int> estimated, const ObservedPoints& observed,
                                                      int sigma_count, const DeviceOptions& options,
                                                      const std::vector<std::string>& effects) {
   for (const std::string& name : effects) {

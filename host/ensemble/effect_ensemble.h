@@ -22,6 +22,7 @@
 
 #include "filter/ensemble.h"
 #include "host/common/device_options.h"
+#include "host/mesh/observed_points.h"
 #include "host/model/model.h"
 #include "host/scenario/effect_catalogue.h"
 
@@ -40,7 +41,7 @@ class EffectEnsemble : public Ensemble {
   // The ensemble of `model` on `backend` (make_ensemble) with `effects` estimated: the
   // ligament of every ligament effect is appended to the model and to `estimated` first.
   static std::unique_ptr<EffectEnsemble> make(const std::string& backend, Model model, std::vector<int> estimated,
-                                              const std::vector<int>& observed, int sigma_count,
+                                              const ObservedPoints& observed, int sigma_count,
                                               const DeviceOptions& options, const std::vector<std::string>& effects);
 
   int sigma_count() const override { return inner_->sigma_count(); }

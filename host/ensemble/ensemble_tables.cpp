@@ -15,7 +15,7 @@ double device_cg_tolerance(const Model& model, Precision precision) {
 }
 
 void check_ensemble_arguments(const Model& model, const std::vector<int>& estimated,
-                              const std::vector<int>& observed, int S, const char* who) {
+                              const ObservedPoints& observed, int S, const char* who) {
   const std::string name(who);
   if (S < 1) throw std::invalid_argument(name + ": need at least one sigma point");
   if (static_cast<int>(estimated.size()) > kDeviceMaxParameters)
@@ -24,9 +24,7 @@ void check_ensemble_arguments(const Model& model, const std::vector<int>& estima
   for (int l : estimated)
     if (l < 0 || l >= static_cast<int>(model.ligaments.size()))
       throw std::invalid_argument(name + ": no ligament " + std::to_string(l));
-  for (int node : observed)
-    if (node < 0 || node >= model.node_count())
-      throw std::invalid_argument(name + ": no node " + std::to_string(node));
+  check_observed_points(observed, model.node_count(), who);
   // The kernels give every node of a ligament the same part of its stiffness (one number per
   // ligament and sigma point); the control's parts are per node and need no check.
   for (const SpringSet& ligament : model.ligaments)

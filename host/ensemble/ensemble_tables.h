@@ -14,10 +14,11 @@
 #include <vector>
 
 #include "filter/ensemble.h"
-#include "host/model/effects.h"
-#include "host/model/so_history.h"
 #include "host/common/device_options.h"
+#include "host/mesh/observed_points.h"
+#include "host/model/effects.h"
 #include "host/model/model.h"
+#include "host/model/so_history.h"
 
 namespace sigmafem {
 
@@ -44,7 +45,7 @@ struct EnsembleTables {
 
 // Checks an ensemble's arguments: std::invalid_argument naming `who`.
 void check_ensemble_arguments(const Model& model, const std::vector<int>& estimated,
-                              const std::vector<int>& observed, int sigma_count, const char* who);
+                              const ObservedPoints& observed, int sigma_count, const char* who);
 
 // The CG tolerance floor of a float32 device ensemble: about ten float32 epsilons (float32
 // cannot reach the scenario's 1e-10).

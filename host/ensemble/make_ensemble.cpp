@@ -12,7 +12,7 @@ std::vector<std::string> available_backends() { return {"cpu", "opencl", "vulkan
 
 std::unique_ptr<Ensemble> make_ensemble(const std::string& backend, const Model& model,
                                         const std::vector<int>& estimated,
-                                        const std::vector<int>& observed, int sigma_count,
+                                        const ObservedPoints& observed, int sigma_count,
                                         const DeviceOptions& options) {
   if (backend == "auto")
     return make_ensemble(resolve_backend(backend, model, sigma_count).backend, model, estimated,

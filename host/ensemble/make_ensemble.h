@@ -9,6 +9,7 @@
 #include "filter/ensemble.h"
 #include "host/common/device_error.h"
 #include "host/common/device_options.h"
+#include "host/mesh/observed_points.h"
 #include "host/model/model.h"
 
 namespace sigmafem {
@@ -22,7 +23,7 @@ std::vector<std::string> available_backends();
 // a device back end refuses Preconditioner::factorised with an InputError.
 std::unique_ptr<Ensemble> make_ensemble(const std::string& backend, const Model& model,
                                         const std::vector<int>& estimated,
-                                        const std::vector<int>& observed, int sigma_count,
+                                        const ObservedPoints& observed, int sigma_count,
                                         const DeviceOptions& options = {});
 
 }  // namespace sigmafem

@@ -48,14 +48,14 @@ nlohmann::ordered_json truth_mesh_json(const TruthMesh& truth, const TruthMeshOp
 // generate keeps the whole observation and truth tables in memory, then their text: refuse a
 // run whose tables could not fit before any allocation, naming the field that sets their size.
 void check_table_memory(const Scenario& scenario) {
-  const double columns = 5.0 + 3.0 * static_cast<double>(scenario.observations.nodes.size()) +
+  const double columns = 5.0 + 3.0 * static_cast<double>(scenario.observations.observed.size()) +
                          static_cast<double>(scenario.ligaments.size());
   constexpr double kBytesPerValue = 8.0 + 24.0;   // the double and its text
   const double needed = (scenario.time.steps + 1.0) * columns * kBytesPerValue;
   const double available = static_cast<double>(::sysconf(_SC_PHYS_PAGES)) * static_cast<double>(::sysconf(_SC_PAGE_SIZE));
   if (available > 0.0 && needed > 0.5 * available)
     throw InputError("scenario " + scenario.path + ": time.steps: " + std::to_string(scenario.time.steps) +
-                     " steps of " + std::to_string(scenario.observations.nodes.size()) +
+                     " steps of " + std::to_string(scenario.observations.observed.size()) +
                      " observed points need about " + format_number(std::ceil(needed / 1e9)) +
                      " GB for the tables, more than half of this machine's " +
                      format_number(std::floor(available / 1e9)) + " GB; generate fewer steps per run");
@@ -90,7 +90,7 @@ GenerateResult generate(const Scenario& scenario, const GenerateOptions& options
   const Model& model = simulation.model();
   const int steps = scenario.time.steps;
   const double dt = scenario.time.dt;
-  const std::vector<int>& observed = scenario.observations.nodes;
+  const ObservedPoints& observed = scenario.observations.observed;
   const int vtk_every = options.vtk_every >= 0 ? options.vtk_every : scenario.output.vtk_every;
 
   const std::vector<std::string> comments = {
@@ -116,7 +116,7 @@ GenerateResult generate(const Scenario& scenario, const GenerateOptions& options
     table.times.push_back(t);
     table.so.row(k) = scenario.control.trajectory.position(t, scenario.control.start).transpose();
     for (std::size_t p = 0; p < observed.size(); ++p) {
-      const Eigen::Vector3d point = truth_mesh.observed_position(p, positions);
+      const Eigen::Vector3d point = truth_mesh.observed[p].of(positions);
       for (int a = 0; a < 3; ++a)
         table.points(k, static_cast<Eigen::Index>(3 * p + a)) =
             point[a] + offset[a] + scenario.observations.noise_std * noise.next();

@@ -31,15 +31,6 @@ Mesh read_truth_mesh(const Scenario& scenario, const std::string& file) {
   }
 }
 
-double bounding_diagonal(const Mesh& mesh) {
-  Eigen::Vector3d low = mesh.nodes.front(), high = mesh.nodes.front();
-  for (const Eigen::Vector3d& p : mesh.nodes) {
-    low = low.cwiseMin(p);
-    high = high.cwiseMax(p);
-  }
-  return (high - low).norm();
-}
-
 // Puts `spread` (nodes and parts) into `set`; nothing when it is empty.
 void apply_spread(const std::vector<SpringShare>& spread, SpringSet& set) {
   if (spread.empty()) return;
@@ -61,20 +52,9 @@ Model TruthMesh::model() const {
   return model;
 }
 
-Eigen::Vector3d TruthMesh::observed_position(std::size_t p, const Eigen::VectorXd& x) const {
-  if (observed.empty()) return x.segment<3>(3 * observed_nodes[p]);
-  return interpolate(scenario.mesh, observed[p], x);
-}
-
 std::vector<int> TruthMesh::nearest_observed_nodes() const {
-  if (observed.empty()) return observed_nodes;
   std::vector<int> nodes;
-  for (const MeshLocation& location : observed) {
-    const auto largest = std::max_element(location.weights.begin(), location.weights.end()) -
-                         location.weights.begin();
-    nodes.push_back(scenario.mesh.tetrahedra[static_cast<std::size_t>(location.tetrahedron)]
-                                            [static_cast<std::size_t>(largest)]);
-  }
+  for (const ObservedPoint& point : observed) nodes.push_back(point.nearest_node());
   return nodes;
 }
 
@@ -87,7 +67,7 @@ TruthMesh make_truth_mesh(const Scenario& scenario, const TruthMeshOptions& opti
                      std::to_string(kMaxTruthRefine) +
                      " (levels of uniform refinement of the scenario's mesh, each x8 tetrahedra)");
   TruthMesh truth;
-  const std::vector<int>& observed = scenario.observations.nodes;
+  const ObservedPoints& observed = scenario.observations.observed;
   if (options.file) {
     truth.scenario = scenario_on_mesh(scenario, read_truth_mesh(scenario, *options.file),
                                       "--truth-mesh " + *options.file);
@@ -115,24 +95,25 @@ TruthMesh make_truth_mesh(const Scenario& scenario, const TruthMeshOptions& opti
     }
   }
   if (!options.refine && !options.file) {
-    truth.observed_nodes = observed;   // read directly: the data are bit for bit as before
+    truth.observed = observed;   // the model's own: the data are bit for bit as before
     return truth;
   }
-  const double limit = kMaxObservedOutsideShare * bounding_diagonal(truth.scenario.mesh);
+  const double limit = kMaxOutsideShare * bounding_diagonal(truth.scenario.mesh);
   for (std::size_t p = 0; p < observed.size(); ++p) {
-    const Eigen::Vector3d& rest = scenario.mesh.nodes[static_cast<std::size_t>(observed[p])];
+    const Eigen::Vector3d rest = observed[p].at_rest(scenario.mesh);
     const MeshLocation location = locate_point(truth.scenario.mesh, rest);
     if (location.outside_distance > limit) {
       std::ostringstream what;
-      what << (options.file ? "--truth-mesh " + *options.file : "--truth-refine") << ": observations.nodes["
-           << p << "] (node " << observed[p] << ") lies " << location.outside_distance * 1e3
-           << " mm outside the truth mesh, more than " << kMaxObservedOutsideShare * 100
+      what << (options.file ? "--truth-mesh " + *options.file : "--truth-refine")
+           << ": observed point " << p << " (" << observed_point_name(scenario.observations, p)
+           << ") lies " << location.outside_distance * 1e3
+           << " mm outside the truth mesh, more than " << kMaxOutsideShare * 100
            << "% of its size: do the meshes describe the same organ in the same frame (mesh.scale, "
               "mesh.translate)?";
       throw InputError(what.str());
     }
     truth.max_outside_distance = std::max(truth.max_outside_distance, location.outside_distance);
-    truth.observed.push_back(location);
+    truth.observed.push_back(ObservedPoint::at(truth.scenario.mesh, location));
   }
   return truth;
 }

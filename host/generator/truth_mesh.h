@@ -16,7 +16,7 @@
 //                      mesh (mesh.scale, mesh.translate; not mesh.refine), with the node sets
 //                      resolved again on it (host/scenario/scenario_on_mesh.h).
 // Either way an observed position is the truth interpolated at the rest position of the model's
-// observed node (host/mesh/mesh_locate.h), so observations.csv keeps the scenario's columns.
+// observed point (host/mesh/mesh_locate.h), so observations.csv keeps the scenario's columns.
 #pragma once
 
 #include <Eigen/Core>
@@ -26,23 +26,17 @@
 #include "host/generator/generate.h"
 #include "host/generator/spring_spread.h"
 #include "host/mesh/mesh_locate.h"
+#include "host/mesh/observed_points.h"
 #include "host/model/model.h"
 #include "host/scenario/scenario.h"
 
 namespace sigmafem {
 
-// An observed point farther outside the truth mesh than this share of the truth mesh's size
-// (bounding-box diagonal) is an error: faceting of a curved surface explains a fraction of a
-// millimetre, not this; the meshes are not of the same organ in the same frame.
-constexpr double kMaxObservedOutsideShare = 0.01;
-
 struct TruthMesh {
   Scenario scenario;                    // the scenario on the truth mesh
-  // Where the observed points are: on the scenario's mesh the observed nodes themselves;
-  // on another mesh each observed node's rest position located on it (then observed_nodes is
-  // empty).
-  std::vector<int> observed_nodes;
-  std::vector<MeshLocation> observed;
+  // The observed points on the truth mesh: on the scenario's mesh its own observed points; on
+  // another mesh the rest position of each located on it.
+  ObservedPoints observed;
   double max_outside_distance = 0.0;    // m, the farthest observed point outside the truth mesh
   std::string description;              // "the scenario's mesh", "the scenario's mesh refined 1 more level", "FILE"
   // With --truth-refine and spread springs: each ligament's, the control's and each candidate
@@ -53,8 +47,6 @@ struct TruthMesh {
   // The truth's model: make_model(scenario) with the springs spread as above.
   Model model() const;
 
-  // Observed point p at the truth positions x (3 per truth node).
-  Eigen::Vector3d observed_position(std::size_t p, const Eigen::VectorXd& x) const;
   // The truth node nearest each observed point (its largest weight), to mark it in the VTK.
   std::vector<int> nearest_observed_nodes() const;
 };

@@ -121,12 +121,13 @@ MeshLocation locate_point(const Mesh& mesh, const Eigen::Vector3d& point) {
   return found;
 }
 
-Eigen::Vector3d interpolate(const Mesh& mesh, const MeshLocation& location,
-                            const Eigen::VectorXd& field) {
-  const std::array<int, 4>& t = mesh.tetrahedra[static_cast<std::size_t>(location.tetrahedron)];
-  Eigen::Vector3d value = Eigen::Vector3d::Zero();
-  for (int k = 0; k < 4; ++k) value += location.weights[static_cast<std::size_t>(k)] * field.segment<3>(3 * t[static_cast<std::size_t>(k)]);
-  return value;
+double bounding_diagonal(const Mesh& mesh) {
+  Eigen::Vector3d low = mesh.nodes.front(), high = mesh.nodes.front();
+  for (const Eigen::Vector3d& p : mesh.nodes) {
+    low = low.cwiseMin(p);
+    high = high.cwiseMax(p);
+  }
+  return (high - low).norm();
 }
 
 }  // namespace sigmafem

@@ -1,7 +1,8 @@
 // Point location in a tetrahedral mesh: which tetrahedron holds a point, and the point's
 // barycentric weights there, so that a field given at the nodes (a displacement) can be
 // interpolated at any point of the body. `generate --truth-refine/--truth-mesh` uses it to
-// read the truth, simulated on another mesh, at the model's observed material points.
+// read the truth, simulated on another mesh, at the model's observed material points, and
+// scenarios place observed points anywhere on the mesh (host/mesh/observed_points.h).
 #pragma once
 
 #include <Eigen/Core>
@@ -26,6 +27,14 @@ struct MeshLocation {
   double outside_distance = 0.0;
 };
 
+// A point given on a mesh but farther outside it than this share of its size
+// (bounding_diagonal) is an error: faceting of a curved surface explains a fraction of a
+// millimetre, not this; the point and the mesh are not of the same organ in the same frame.
+constexpr double kMaxOutsideShare = 0.01;
+
+// The diagonal of the mesh's bounding box (m).
+double bounding_diagonal(const Mesh& mesh);
+
 // Locates `point` in `mesh` (which must have a tetrahedron). Inside: the tetrahedron that
 // holds it (on a shared face or edge, the one where it is deepest; any would interpolate
 // alike). Outside, as a point on a curved surface can be when the other mesh's facets cut
@@ -33,10 +42,5 @@ struct MeshLocation {
 // point's clamped ones. Every tetrahedron is tried (cheap next to a simulation step for the
 // few dozen observed points; no search structure to keep).
 MeshLocation locate_point(const Mesh& mesh, const Eigen::Vector3d& point);
-
-// The value at `location` of a field with 3 numbers per node (node i at 3i..3i+2), e.g.
-// positions or displacements: sum_k w_k field(node_k).
-Eigen::Vector3d interpolate(const Mesh& mesh, const MeshLocation& location,
-                            const Eigen::VectorXd& field);
 
 }  // namespace sigmafem

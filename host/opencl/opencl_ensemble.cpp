@@ -29,7 +29,7 @@ void set_args(cl::Kernel& kernel, const Args&... args) {
 }  // namespace
 
 OpenClEnsemble::OpenClEnsemble(const Model& model, std::vector<int> estimated,
-                               std::vector<int> observed, int sigma_count,
+                               ObservedPoints observed, int sigma_count,
                                const DeviceOptions& options)
     : device_(options.device, options.precision),
       model_(model),
@@ -101,8 +101,8 @@ OpenClEnsemble::OpenClEnsemble(const Model& model, std::vector<int> estimated,
     control_k_ = make_buffer(tables.control_k, "control springs");
     mass_ = make_buffer(tables.mass, "mass");
     rest_positions_ = make_buffer(tables.rest_positions, "rest positions");
-    observed_nodes_ = make_buffer(observed_.empty() ? std::vector<int>{0} : observed_,
-                                  "observed nodes");
+    observed_nodes_ = make_buffer(corner_nodes(observed_), "observed points");
+    observed_weights_ = make_buffer(corner_weights(observed_), "observed points");
     constants_ = make_buffer(step_constants_.size(), "step constants");
     ligament_k_buffer_ = make_buffer(ligament_k_, "ligament stiffness");
     x_ = make_buffer(tables.initial_positions, "positions");
@@ -197,7 +197,7 @@ OpenClEnsemble::OpenClEnsemble(const Model& model, std::vector<int> estimated,
                converged_, iterations_);
     set_args(k_state_update_, S, rows, constants_, bb_, dv_, x_, v_);
     set_args(k_observation_gather_, S, static_cast<cl_uint>(observed_.size()), observed_nodes_,
-             x_, observations_);
+             observed_weights_, x_, observations_);
     set_args(k_recenter_, S, rows, static_cast<cl_uint>(estimated_.size()), recenter_scalars_,
              directions_, weights_, x_, v_);
     device_.queue().finish();

@@ -26,8 +26,8 @@ class OpenClEnsemble : public DeviceEnsemble {
   static constexpr long long kWholeSolveWork = 32768;
 
   // `estimated`: indices into model.ligaments whose log-stiffness the parameters are;
-  // `observed`: node indices. Throws DeviceError (no device, build failure, too little memory).
-  OpenClEnsemble(const Model& model, std::vector<int> estimated, std::vector<int> observed,
+  // `observed`: the observed points (node indices convert). Throws DeviceError (no device, build failure, too little memory).
+  OpenClEnsemble(const Model& model, std::vector<int> estimated, ObservedPoints observed,
                  int sigma_count, const DeviceOptions& options);
 
   int sigma_count() const override { return S_; }
@@ -76,7 +76,8 @@ class OpenClEnsemble : public DeviceEnsemble {
   mutable OpenClDevice device_;
   Model model_;                             // a copy: the ensemble outlives its caller's model
   StepConstants step_constants_;            // per step, with the per-sigma effects
-  std::vector<int> estimated_, observed_;
+  std::vector<int> estimated_;
+  ObservedPoints observed_;
   int S_ = 0, nodes_ = 0, elements_ = 0;
   double tolerance_ = 0.0;
   std::size_t device_bytes_ = 0;
@@ -93,7 +94,7 @@ class OpenClEnsemble : public DeviceEnsemble {
   // Shared data.
   cl::Buffer element_nodes_, element_rest_, incidence_offsets_, incidence_;
   cl::Buffer ligament_offsets_, ligament_of_node_, control_k_, mass_, rest_positions_;
-  cl::Buffer observed_nodes_, constants_;
+  cl::Buffer observed_nodes_, observed_weights_, constants_;
   // Per-sigma data.
   cl::Buffer ligament_k_buffer_, x_, v_, dv_, rhs_, inverse_diagonal_, r_, z_, d_, q_;
   cl::Buffer frames_, element_out_, element_diagonal_, observations_;

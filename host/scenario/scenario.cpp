@@ -1,5 +1,6 @@
 // Scenario queries that the generator and the filter ask during a run: which ligament has
-// a name, and what stiffness every ligament has at a given time once events are applied.
+// a name, what stiffness every ligament has at a given time once events are applied, and
+// where an observed point was written.
 #include "host/scenario/scenario.h"
 
 namespace sigmafem {
@@ -50,6 +51,13 @@ std::vector<double> Scenario::ligament_stiffness_at(double t) const {
     stiffness[static_cast<size_t>(event.ligament)] = event.stiffness;
   }
   return stiffness;
+}
+
+std::string observed_point_name(const Observations& observations, std::size_t p) {
+  if (p < observations.nodes.size())
+    return "observations.nodes[" + std::to_string(p) + "] (node " +
+           std::to_string(observations.nodes[p]) + ")";
+  return "observations.points[" + std::to_string(p - observations.nodes.size()) + "]";
 }
 
 }  // namespace sigmafem

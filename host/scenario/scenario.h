@@ -11,6 +11,7 @@
 #include <vector>
 
 #include "host/mesh/mesh.h"
+#include "host/mesh/observed_points.h"
 #include "host/scenario/effect_catalogue.h"
 
 namespace sigmafem {
@@ -104,8 +105,16 @@ struct Event {
 
 struct Observations {
   std::vector<int> nodes;           // in scenario order (not sorted), unique
+  std::vector<Eigen::Vector3d> points;   // m, in the mesh's frame at rest, as written
+  // Every observed point: the nodes (each as itself), then the points located on the mesh.
+  // Their order is the column order of observations.csv (pK_x, pK_y, pK_z).
+  ObservedPoints observed;
   double noise_std = 0.0;           // m, >= 0, used by the generator
 };
+
+// Where observed point p was written: "observations.nodes[3] (node 17)" or
+// "observations.points[0]".
+std::string observed_point_name(const Observations& observations, std::size_t p);
 
 // filter.change_detection: settings of the filter's cut detector (filter/change_detector.h);
 // a field left out keeps the detector's default.

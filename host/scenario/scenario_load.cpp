@@ -20,6 +20,7 @@
 #include "host/common/input_error.h"
 #include "host/common/input_file.h"
 #include "host/common/physical_limits.h"
+#include "host/mesh/mesh_locate.h"
 #include "host/mesh/text_cursor.h"
 #include "host/scenario/scenario.h"
 #include "host/scenario/surface_regions.h"
@@ -705,10 +706,30 @@ void read_events(const Checker& c, const json& root, Scenario& s) {
 void read_observations(const Checker& c, const json& root, Scenario& s) {
   if (!root.contains("observations")) return;
   const json& observations = root.at("observations");
-  c.check_object(observations, "observations", {"nodes", "noise_std"}, {});
+  c.check_object(observations, "observations", {"nodes", "points", "noise_std"}, {});
   if (observations.contains("nodes")) {
     // Scenario order is kept: it is the column order of the observations CSV.
     s.observations.nodes = node_indices(c, observations.at("nodes"), "observations.nodes", s.mesh);
+  }
+  s.observations.observed = ObservedPoints(s.observations.nodes);
+  if (observations.contains("points")) {
+    // Each point is located on the mesh (host/mesh/mesh_locate.h) and observed as the material
+    // point there; one a little outside (a surface measured on a finer geometry) as the
+    // nearest point of the mesh.
+    const json& points = c.array(observations.at("points"), "observations.points");
+    const double limit = kMaxOutsideShare * bounding_diagonal(s.mesh);
+    for (size_t i = 0; i < points.size(); ++i) {
+      const std::string path = element("observations.points", i);
+      const Eigen::Vector3d point = c.vector3(points[i], path);
+      const MeshLocation location = locate_point(s.mesh, point);
+      c.require(location.outside_distance <= limit, path,
+                message_point(point) + " lies " + message_number(location.outside_distance * 1e3) +
+                    " mm outside the mesh, more than " + message_number(kMaxOutsideShare * 100) +
+                    "% of its size (give points in metres, in the mesh's frame after mesh.scale "
+                    "and mesh.translate, on or inside the organ at rest)");
+      s.observations.points.push_back(point);
+      s.observations.observed.push_back(ObservedPoint::at(s.mesh, location));
+    }
   }
   s.observations.noise_std = c.number_or(observations, "observations", "noise_std", 0.0);
   c.require(s.observations.noise_std >= 0.0 && s.observations.noise_std <= kMaxNoiseStd,
@@ -809,8 +830,8 @@ void read_filter(const Checker& c, const json& root, Scenario& s) {
     AdaptiveNoiseSpec& a = spec.adaptive_noise;
     read_windowed_test(c, adaptive, path, a.enabled, a.window, a.false_alarm);
   }
-  c.require(!s.observations.nodes.empty(), "filter",
-            "the filter needs observed nodes, and observations.nodes is empty");
+  c.require(!s.observations.observed.empty(), "filter",
+            "the filter needs observed points, and observations has neither nodes nor points");
   s.filter = std::move(spec);
 }
 

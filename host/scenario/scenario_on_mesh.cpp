@@ -121,7 +121,10 @@ Scenario scenario_on_mesh(const Scenario& scenario, Mesh mesh, const std::string
   s.control.nodes = resolver.resolve(s.control.selection, s.control.nodes);
   for (Ligament& region : s.candidate_regions) region.nodes = resolver.resolve(region.selection, region.nodes);
   resolve_automatic_regions(scenario, resolver, s);
+  // The observed points are located on the other mesh by the caller (host/generator/truth_mesh.h).
   s.observations.nodes.clear();
+  s.observations.points.clear();
+  s.observations.observed.clear();
   return s;
 }
 

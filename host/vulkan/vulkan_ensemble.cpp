@@ -21,7 +21,7 @@ std::uint32_t groups_for(std::size_t items) {
 }  // namespace
 
 VulkanEnsemble::VulkanEnsemble(const Model& model, std::vector<int> estimated,
-                               std::vector<int> observed, int sigma_count,
+                               ObservedPoints observed, int sigma_count,
                                const DeviceOptions& options)
     : device_(options.device, options.precision),
       model_(model),
@@ -67,7 +67,8 @@ VulkanEnsemble::VulkanEnsemble(const Model& model, std::vector<int> estimated,
   control_k_ = make_buffer(tables.control_k, "control springs");
   mass_ = make_buffer(tables.mass, "mass");
   rest_positions_ = make_buffer(tables.rest_positions, "rest positions");
-  observed_nodes_ = make_buffer(observed_.empty() ? std::vector<int>{0} : observed_, "observed nodes");
+  observed_nodes_ = make_buffer(corner_nodes(observed_), "observed points");
+  observed_weights_ = make_buffer(corner_weights(observed_), "observed points");
   constants_ = make_buffer(step_constants_.size(), "step constants");
   ligament_k_buffer_ = make_buffer(ligament_k_, "ligament stiffness");
   x_ = make_buffer(tables.initial_positions, "positions");
@@ -117,7 +118,7 @@ VulkanEnsemble::VulkanEnsemble(const Model& model, std::vector<int> estimated,
     k_cg_direction_ = device_.kernel("cg_direction", 17, cg_group_, partitions);
   }
   k_state_update_ = device_.kernel("state_update", 5);
-  k_observation_gather_ = device_.kernel("observation_gather", 3);
+  k_observation_gather_ = device_.kernel("observation_gather", 4);
   k_recenter_ = device_.kernel("recenter", 5);
 
   s_element_rhs_ = device_.bind(k_element_rhs_, {element_nodes_, element_rest_, frames_, x_, v_,
@@ -156,7 +157,8 @@ VulkanEnsemble::VulkanEnsemble(const Model& model, std::vector<int> estimated,
     s_cg_direction_ = device_.bind(k_cg_direction_, iteration_buffers);
   }
   s_state_update_ = device_.bind(k_state_update_, {constants_, bb_, dv_, x_, v_});
-  s_observation_gather_ = device_.bind(k_observation_gather_, {observed_nodes_, x_, observations_});
+  s_observation_gather_ =
+      device_.bind(k_observation_gather_, {observed_nodes_, observed_weights_, x_, observations_});
   s_recenter_ = device_.bind(k_recenter_, {recenter_scalars_, directions_, weights_, x_, v_});
 }
 

@@ -28,8 +28,8 @@ class VulkanEnsemble : public DeviceEnsemble {
  public:
 
   // `estimated`: indices into model.ligaments whose log-stiffness the parameters are;
-  // `observed`: node indices. Throws DeviceError (no device, shader failure, too little memory).
-  VulkanEnsemble(const Model& model, std::vector<int> estimated, std::vector<int> observed,
+  // `observed`: the observed points (node indices convert). Throws DeviceError (no device, shader failure, too little memory).
+  VulkanEnsemble(const Model& model, std::vector<int> estimated, ObservedPoints observed,
                  int sigma_count, const DeviceOptions& options);
 
   int sigma_count() const override { return S_; }
@@ -78,7 +78,8 @@ class VulkanEnsemble : public DeviceEnsemble {
   mutable VulkanDevice device_;
   Model model_;
   StepConstants step_constants_;            // per step, with the per-sigma effects
-  std::vector<int> estimated_, observed_;
+  std::vector<int> estimated_;
+  ObservedPoints observed_;
   int S_ = 0, nodes_ = 0, elements_ = 0;
   double tolerance_ = 0.0;
   std::size_t device_bytes_ = 0;
@@ -95,7 +96,7 @@ class VulkanEnsemble : public DeviceEnsemble {
   // Shared data.
   VulkanBuffer element_nodes_, element_rest_, incidence_offsets_, incidence_;
   VulkanBuffer ligament_offsets_, ligament_of_node_, control_k_, mass_, rest_positions_;
-  VulkanBuffer observed_nodes_, constants_;
+  VulkanBuffer observed_nodes_, observed_weights_, constants_;
   // Per-sigma data.
   VulkanBuffer ligament_k_buffer_, x_, v_, dv_, rhs_, inverse_diagonal_, r_, z_, d_, q_;
   VulkanBuffer frames_, element_out_, element_diagonal_, observations_;

@@ -1,13 +1,15 @@
-/* observation_gather: the observed nodes' positions of every sigma point, y[(3 k + axis) S + s]
- * (as kernels/opencl/observation_gather.cl). The only per-step read-back of the state. */
+/* observation_gather: the observed points' positions of every sigma point, y[(3 k + axis) S + s]
+ * (as kernels/opencl/observation_gather.cl): point k is sum_c w_c x(node_c) over its four
+ * corners. The only per-step read-back of the state. */
 #version 450
 #extension GL_GOOGLE_include_directive : require
 #include "ensemble_layout.h"
 
 layout(local_size_x = SF_ITEMS_PER_GROUP) in;
-layout(std430, binding = 0) restrict readonly buffer Observed { int observed[]; };
-layout(std430, binding = 1) restrict readonly buffer X { real x[]; };
-layout(std430, binding = 2) restrict writeonly buffer Y { real y[]; };
+layout(std430, binding = 0) restrict readonly buffer Nodes { int nodes[]; };
+layout(std430, binding = 1) restrict readonly buffer Weights { real weights[]; };
+layout(std430, binding = 2) restrict readonly buffer X { real x[]; };
+layout(std430, binding = 3) restrict writeonly buffer Y { real y[]; };
 
 void main() {
   uint S = sf_push.S;
@@ -17,5 +19,8 @@ void main() {
   uint row = gid / S;
   uint k = row / 3u;
   uint axis = row % 3u;
-  y[gid] = x[(3u * uint(observed[k]) + axis) * S + s];
+  real value = real(0);
+  for (uint c = 0u; c < 4u; ++c)
+    value += weights[4u * k + c] * x[(3u * uint(nodes[4u * k + c]) + axis) * S + s];
+  y[gid] = value;
 }

@@ -13,7 +13,9 @@
 #include <vector>
 
 #include "cli/sigmafem_command.h"
+#include "host/data/observation_table.h"
 #include "host/ensemble/choose_backend.h"
+#include "host/scenario/scenario.h"
 #include "requirement.h"
 #include "temp_path.h"
 
@@ -290,6 +292,42 @@ TEST_F(CliTest, EstimateWritesEstimatesSummaryResidualsAndPlots) {
     in.read(magic, 8);
     EXPECT_EQ(std::string(magic + 1, 3), "PNG") << png << " is a PNG file";
   }
+}
+
+// observations.points through the commands: generate writes a column triple per point after
+// the nodes' (noise-free, a point given at an observed node's position has that node's
+// columns, bit for bit), and estimate on OpenCL reads and predicts them all.
+TEST_F(CliTest, PointsAnywhereAreGeneratedAndEstimated) {
+  json scenario = box_;
+  scenario["time"]["steps"] = 30;   // the residual tests need more than 20
+  std::ofstream(dir_ / "plain.json") << scenario.dump(2);
+  const Scenario plain = load_scenario((dir_ / "plain.json").string());
+  const std::size_t nodes = plain.observations.nodes.size();
+  const Eigen::Vector3d at_node = plain.mesh.nodes[static_cast<std::size_t>(plain.observations.nodes[2])];
+  json points = json::array();
+  points.push_back(json::array({at_node.x(), at_node.y(), at_node.z()}));
+  points.push_back(json::array({0.15, 0.075, 0.15}));   // on the top face
+  points.push_back(json::array({0.1, 0.05, 0.06}));     // inside
+  scenario["observations"]["points"] = points;
+  std::ofstream(dir_ / "points.json") << scenario.dump(2);
+  const std::string points_json = (dir_ / "points.json").string();
+  const CommandRun generated = run_sigmafem("generate " + points_json + " --out " + (dir_ / "data").string() +
+                                            " --vtk-every 0 --noise-std 0 --quiet");
+  ASSERT_EQ(generated.exit_code, 0) << generated.output;
+  const ObservationTable table = read_observations_csv((dir_ / "data" / "observations.csv").string(),
+                                                       static_cast<int>(nodes + 3), 0.01);
+  const Eigen::Index first_point = 3 * static_cast<Eigen::Index>(nodes);
+  EXPECT_EQ(Eigen::MatrixXd(table.points.middleCols(first_point, 3)), Eigen::MatrixXd(table.points.middleCols(6, 3)))
+      << "the point at observed node 2's position is that node";
+  EXPECT_NEAR(table.points(0, first_point + 5), 0.15, 1e-12) << "the top-face point starts where it was given";
+  EXPECT_GT((table.points.row(20).segment<3>(first_point + 6) - table.points.row(0).segment<3>(first_point + 6)).norm(), 1e-5)
+      << "the interior point moves with the box";
+  const CommandRun estimated = run_sigmafem("estimate " + points_json + " --data " + (dir_ / "data").string() +
+                                            " --out " + (dir_ / "estimate").string() + " --backend opencl --quiet");
+  ASSERT_EQ(estimated.exit_code, 0) << estimated.output;
+  std::ifstream residual_file(dir_ / "estimate" / "residual.json");
+  const json residual = json::parse(residual_file);
+  EXPECT_EQ(residual["bias"]["rows"].size(), 3 * (nodes + 3)) << "every point's three axes";
 }
 
 TEST_F(CliTest, EstimateRejectsDataOfAnotherScenario) {

@@ -31,6 +31,7 @@
 #include "host/ensemble/cpu_ensemble.h"
 #include "host/ensemble/device_ensemble.h"
 #include "host/ensemble/make_ensemble.h"
+#include "host/mesh/mesh_locate.h"
 #include "host/model/model.h"
 #include "host/opencl/opencl_device.h"
 #include "host/vulkan/vulkan_device.h"
@@ -78,6 +79,9 @@ std::vector<BackendCase> backend_cases() {
   cases.push_back({"vulkan", Precision::double_precision, "VulkanDouble"});
   return cases;
 }
+
+// gtest prints a failing case with this, instead of its bytes.
+void PrintTo(const BackendCase& c, std::ostream* out) { *out << c.name; }
 
 // Why a back end cannot run here ("" when it can).
 std::string unavailable(const BackendCase& c) {
@@ -549,6 +553,64 @@ std::vector<Case> all_cases() {
 }
 
 INSTANTIATE_TEST_SUITE_P(Backends, EnsembleConformance, ::testing::ValuesIn(all_cases()), case_name);
+
+// Observed points anywhere (scenario observations.points; host/mesh/observed_points.h): on
+// every back end a node given as a point, the centre of a face and an interior point of a
+// liver tetrahedron follow the CPU reference over 10 steps as observed nodes do (the
+// trajectory tolerance), and the node given as a point is the node, bit for bit.
+class ObservedPointsConformance : public ::testing::TestWithParam<BackendCase> {};
+
+TEST_P(ObservedPointsConformance, PointsAnywhereFollowTheReference) {
+  const BackendCase& backend = GetParam();
+  const std::string why = unavailable(backend);
+  if (!why.empty()) SIGMAFEM_MISSING(why);
+  const Scenario scenario = conformance_scenario("liver");
+  const Model model = make_model(scenario);
+  const Mesh& mesh = scenario.mesh;
+  const std::vector<int>& estimated = scenario.filter->estimate;
+  const int S = 4;
+  const int node = scenario.observations.nodes[0];
+  const std::array<int, 4>& t = mesh.tetrahedra[mesh.tetrahedra.size() / 2];
+  ObservedPoints points(std::vector<int>{node});
+  for (const Eigen::Vector3d& p :
+       {mesh.nodes[node], Eigen::Vector3d((mesh.nodes[t[0]] + mesh.nodes[t[1]] + mesh.nodes[t[2]]) / 3.0),
+        Eigen::Vector3d(0.1 * mesh.nodes[t[0]] + 0.2 * mesh.nodes[t[1]] + 0.3 * mesh.nodes[t[2]] +
+                        0.4 * mesh.nodes[t[3]])})
+    points.push_back(ObservedPoint::at(mesh, locate_point(mesh, p)));
+  ASSERT_EQ(points[1].weights[0], 1.0) << "the node given as a point is the node";
+  DeviceOptions options;
+  options.precision = backend.precision;
+  options.solve_launch = backend.solve_launch;
+  options.kernel_form = backend.kernel_form;
+  options.cg_partitions = backend.cg_partitions;
+  auto device = make_ensemble(backend.backend, model, estimated, points, S, options);
+  CpuEnsemble reference(model, estimated, points, S, 0, Preconditioner::jacobi);
+  const Eigen::MatrixXd theta = sigma_theta(model, estimated, S);
+  device->set_parameters(theta);
+  reference.set_parameters(theta);
+  Eigen::MatrixXd y_device, y_reference;
+  double largest = 0.0;
+  for (int k = 1; k <= 10; ++k) {
+    ASSERT_EQ(device->advance(so_position(scenario, k)).unconverged_count(), 0) << "step " << k;
+    reference.advance(so_position(scenario, k));
+    device->predicted_observations(y_device);
+    reference.predicted_observations(y_reference);
+    ASSERT_EQ(y_device.rows(), 12);
+    EXPECT_EQ(Eigen::MatrixXd(y_device.topRows(3)), Eigen::MatrixXd(y_device.middleRows(3, 3)))
+        << "the node as a point, step " << k;
+    largest = std::max(largest, (y_device - y_reference).cwiseAbs().maxCoeff());
+  }
+  // The trajectory tolerances (TrajectoryWithACutFollowsTheReference): these points are
+  // weighted sums of nodes that follow the reference within them.
+  const bool single = backend.precision == Precision::single;
+  EXPECT_LT(largest, single ? 1e-6 : 3e-13);
+  std::cout << backend.name << ": largest observed-point difference over 10 steps " << largest << " m\n";
+}
+
+std::string backend_case_name(const ::testing::TestParamInfo<BackendCase>& info) { return info.param.name; }
+
+INSTANTIATE_TEST_SUITE_P(Backends, ObservedPointsConformance, ::testing::ValuesIn(backend_cases()),
+                         backend_case_name);
 
 // Vulkan against OpenCL: the same 100 steps with the cut on the box, S = 4, observed
 // positions compared at every step. Each back end is within the trajectory tolerance of the

@@ -6,6 +6,8 @@
 
 #include <cmath>
 
+#include "host/mesh/mesh_locate.h"
+#include "host/mesh/observed_points.h"
 #include "host/model/model.h"
 #include "host/reference/reference_simulation.h"
 #include "host/scenario/scenario.h"
@@ -51,6 +53,46 @@ TEST_F(CpuEnsembleTest, EachSigmaPointIsTheReferenceWithItsStiffness) {
                 alone.node_position(scenario_.observations.nodes[o]))
           << "observation " << o << " of sigma point " << s;
   }
+}
+
+// Observed points anywhere (host/mesh/observed_points.h): a point located at a node gives
+// that node's position bit for bit; a point at a face's centre stays at the centre of the
+// deformed face (the mean of its three nodes), and an interior point moves with its
+// tetrahedron, at every step.
+TEST_F(CpuEnsembleTest, ObservedPointsMoveWithTheirElements) {
+  const Mesh& mesh = scenario_.mesh;
+  const std::array<int, 4>& t = mesh.tetrahedra[100];
+  const Eigen::Vector3d face_centre = (mesh.nodes[t[0]] + mesh.nodes[t[1]] + mesh.nodes[t[2]]) / 3.0;
+  const Eigen::Vector3d interior =
+      0.1 * mesh.nodes[t[0]] + 0.2 * mesh.nodes[t[1]] + 0.3 * mesh.nodes[t[2]] + 0.4 * mesh.nodes[t[3]];
+  const int node = scenario_.observations.nodes[0];
+  ObservedPoints points(std::vector<int>{node});
+  for (const Eigen::Vector3d& p : {mesh.nodes[node], face_centre, interior})
+    points.push_back(ObservedPoint::at(mesh, locate_point(mesh, p)));
+  CpuEnsemble ensemble(model_, {0, 1, 2}, points, 2);
+  Eigen::MatrixXd theta(3, 2);
+  theta << std::log(100.0), std::log(300.0), std::log(80.0), std::log(200.0), std::log(300.0),
+      std::log(50.0);
+  ensemble.set_parameters(theta);
+  Eigen::MatrixXd y;
+  for (int k = 1; k <= 20; ++k) {
+    ensemble.advance(so(k));
+    ensemble.predicted_observations(y);
+    for (int s = 0; s < 2; ++s) {
+      const Eigen::VectorXd& x = ensemble.simulation(s).positions();
+      auto at = [&](int n) { return Eigen::Vector3d(x.segment<3>(3 * n)); };
+      const Eigen::Vector3d observed_at_node = y.block<3, 1>(3, s);
+      EXPECT_EQ(observed_at_node, Eigen::Vector3d(y.block<3, 1>(0, s))) << "step " << k;
+      EXPECT_LT((y.block<3, 1>(6, s) - (at(t[0]) + at(t[1]) + at(t[2])) / 3.0).norm(), 1e-14)
+          << "face centre, step " << k;
+      EXPECT_LT((y.block<3, 1>(9, s) -
+                 (0.1 * at(t[0]) + 0.2 * at(t[1]) + 0.3 * at(t[2]) + 0.4 * at(t[3])))
+                    .norm(),
+                1e-14)
+          << "interior point, step " << k;
+    }
+  }
+  EXPECT_GT((y.block<3, 1>(6, 0) - face_centre).norm(), 1e-5) << "the organ moved";
 }
 
 TEST_F(CpuEnsembleTest, RecenteringResamplesAroundTheCorrectedMean) {

@@ -123,7 +123,7 @@ TEST_F(TruthMeshTest, RefinedMeshKeepsEveryNodeSetAndReadsObservedNodesExactly) 
   Eigen::VectorXd x(3 * truth.scenario.mesh.node_count());
   for (Eigen::Index i = 0; i < x.size(); ++i) x[i] = normal(random);
   for (std::size_t p = 0; p < scenario_.observations.nodes.size(); ++p)
-    EXPECT_EQ(truth.observed_position(p, x), Eigen::Vector3d(x.segment<3>(3 * scenario_.observations.nodes[p])))
+    EXPECT_EQ(truth.observed[p].of(x), Eigen::Vector3d(x.segment<3>(3 * scenario_.observations.nodes[p])))
         << "observed point " << p;
 }
 

@@ -9,6 +9,7 @@
 #include <string>
 
 #include "host/mesh/mesh.h"
+#include "host/mesh/observed_points.h"
 
 namespace sigmafem {
 namespace {
@@ -53,7 +54,7 @@ TEST_F(MeshLocateTest, LinearFieldIsReproducedAtInteriorPoints) {
     const MeshLocation location = locate_point(mesh_, p);
     expect_valid_weights(location, "interior point " + std::to_string(n));
     EXPECT_EQ(location.outside_distance, 0.0) << "an interior point is inside";
-    EXPECT_LT((interpolate(mesh_, location, field_) - linear(p)).norm(), 1e-13)
+    EXPECT_LT((ObservedPoint::at(mesh_, location).of(field_) - linear(p)).norm(), 1e-13)
         << "a linear field is interpolated exactly at point " << n;
   }
 }
@@ -61,7 +62,7 @@ TEST_F(MeshLocateTest, LinearFieldIsReproducedAtInteriorPoints) {
 TEST_F(MeshLocateTest, NodesInterpolateToTheirValueBitForBit) {
   for (int i = 0; i < mesh_.node_count(); i += 7) {
     const MeshLocation location = locate_point(mesh_, mesh_.nodes[i]);
-    const Eigen::Vector3d value = interpolate(mesh_, location, field_);
+    const Eigen::Vector3d value = ObservedPoint::at(mesh_, location).of(field_);
     EXPECT_EQ(value, Eigen::Vector3d(field_.segment<3>(3 * i))) << "node " << i;
   }
 }
@@ -77,7 +78,7 @@ TEST_F(MeshLocateTest, PointsOnFacesAreInside) {
       const MeshLocation location = locate_point(mesh_, p);
       expect_valid_weights(location, "face point");
       EXPECT_EQ(location.outside_distance, 0.0) << "a face point of element " << e << " is inside";
-      EXPECT_LT((interpolate(mesh_, location, field_) - linear(p)).norm(), 1e-13);
+      EXPECT_LT((ObservedPoint::at(mesh_, location).of(field_) - linear(p)).norm(), 1e-13);
     }
   }
   // On an edge of the box and on its boundary faces.
@@ -86,7 +87,7 @@ TEST_F(MeshLocateTest, PointsOnFacesAreInside) {
     const MeshLocation location = locate_point(mesh_, p);
     expect_valid_weights(location, "boundary point");
     EXPECT_EQ(location.outside_distance, 0.0) << "a point on the surface is inside";
-    EXPECT_LT((interpolate(mesh_, location, field_) - linear(p)).norm(), 1e-13);
+    EXPECT_LT((ObservedPoint::at(mesh_, location).of(field_) - linear(p)).norm(), 1e-13);
   }
 }
 
@@ -96,7 +97,7 @@ TEST_F(MeshLocateTest, PointJustOutsideGoesToTheNearestSurfacePoint) {
   const MeshLocation location = locate_point(mesh_, outside);
   expect_valid_weights(location, "outside point");
   EXPECT_NEAR(location.outside_distance, 2e-4, 1e-12) << "the distance to the top face";
-  EXPECT_LT((interpolate(mesh_, location, field_) - linear(surface)).norm(), 1e-12)
+  EXPECT_LT((ObservedPoint::at(mesh_, location).of(field_) - linear(surface)).norm(), 1e-12)
       << "clamped weights give the nearest point of the surface";
 
   // Beyond a corner the nearest point is the corner.
@@ -104,7 +105,7 @@ TEST_F(MeshLocateTest, PointJustOutsideGoesToTheNearestSurfacePoint) {
   const MeshLocation beyond = locate_point(mesh_, corner + Eigen::Vector3d(1e-3, 1e-3, 1e-3));
   expect_valid_weights(beyond, "beyond a corner");
   EXPECT_NEAR(beyond.outside_distance, std::sqrt(3.0) * 1e-3, 1e-12);
-  EXPECT_LT((interpolate(mesh_, beyond, field_) - linear(corner)).norm(), 1e-12);
+  EXPECT_LT((ObservedPoint::at(mesh_, beyond).of(field_) - linear(corner)).norm(), 1e-12);
 }
 
 }  // namespace

@@ -170,6 +170,43 @@ TEST_F(ScenarioLoadTest, GivenOptionalFieldsAreRead) {
   EXPECT_EQ(estimation_options(load_scenario(write(j, "catch_up.json"))).detector.max_catch_up, 0);
 }
 
+// observations.points: each located on the mesh and observed as the material point there,
+// after the nodes; a point on a node is that node; one a hair outside, the nearest point.
+TEST_F(ScenarioLoadTest, ObservedPointsAreLocatedOnTheMeshAfterTheNodes) {
+  json j = valid_scenario();
+  const std::string plain = write(j, "plain.json");
+  const Mesh& mesh = load_scenario(plain).mesh;
+  const Eigen::Vector3d node = mesh.nodes[17];
+  const Eigen::Vector3d inside(0.1234, 0.0567, 0.0891);
+  const Eigen::Vector3d beside(0.3 + 1e-4, 0.075, 0.075);   // 0.1 mm past the face x = 0.3
+  j["observations"]["points"] = {{node.x(), node.y(), node.z()},
+                                 {inside.x(), inside.y(), inside.z()},
+                                 {beside.x(), beside.y(), beside.z()}};
+  const Scenario s = load_scenario(write(j));
+  ASSERT_EQ(s.observations.nodes.size(), 3u);
+  ASSERT_EQ(s.observations.points.size(), 3u);
+  ASSERT_EQ(s.observations.observed.size(), 6u);
+  for (std::size_t k = 0; k < 3; ++k) {
+    EXPECT_EQ(s.observations.observed[k].nodes[0], s.observations.nodes[k]);
+    EXPECT_EQ(s.observations.observed[k].weights[0], 1.0);
+  }
+  const ObservedPoint& at_node = s.observations.observed[3];
+  EXPECT_EQ(at_node.nodes, (std::array<int, 4>{17, 17, 17, 17}));
+  EXPECT_EQ(at_node.weights, (std::array<double, 4>{1.0, 0.0, 0.0, 0.0}));
+  const ObservedPoint& interior = s.observations.observed[4];
+  EXPECT_LT((interior.at_rest(s.mesh) - inside).norm(), 1e-12);
+  double sum = 0.0;
+  for (double w : interior.weights) {
+    EXPECT_GE(w, 0.0);
+    sum += w;
+  }
+  EXPECT_NEAR(sum, 1.0, 1e-12);
+  EXPECT_NEAR((s.observations.observed[5].at_rest(s.mesh) - beside).norm(), 1e-4, 1e-9)
+      << "a point just outside is observed at the nearest point of the mesh";
+  EXPECT_EQ(observed_point_name(s.observations, 1), "observations.nodes[1] (node 280)");
+  EXPECT_EQ(observed_point_name(s.observations, 4), "observations.points[1]");
+}
+
 TEST_F(ScenarioLoadTest, ControlStartIsTheCentroidOfTheControlNodes) {
   const Scenario s = load_scenario(write(valid_scenario()));
   Eigen::Vector3d sum = Eigen::Vector3d::Zero();
@@ -557,7 +594,16 @@ TEST_F(ScenarioLoadTest, BadFieldsAreNamed) {
        {"filter.sigma_points:", "did you mean \"simplex\""}},
       {"filter without observations",
        [](json& j) { j["observations"]["nodes"] = json::array(); },
-       {"filter:", "needs observed nodes"}},
+       {"filter:", "needs observed points"}},
+      {"observed point outside the mesh",
+       [](json& j) { j["observations"]["points"] = json::parse("[[0.1, 0.05, 0.05], [0.1, 0.05, 0.5]]"); },
+       {"observations.points[1]:", "mm outside the mesh", "mesh.scale"}},
+      {"observed point not a point",
+       [](json& j) { j["observations"]["points"] = json::parse("[[0.1, 0.05]]"); },
+       {"observations.points[0]:"}},
+      {"observed points not a list",
+       [](json& j) { j["observations"]["points"] = 0.1; },
+       {"observations.points:"}},
       {"filter observation std zero",
        [](json& j) { j["filter"]["observation_std"] = 0; },
        {"filter.observation_std:", "must be > 0"}},

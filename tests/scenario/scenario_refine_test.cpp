@@ -10,6 +10,7 @@
 #include <string>
 #include <vector>
 
+#include "scenario_directory.h"
 #include "temp_path.h"
 #include "host/common/input_error.h"
 #include "host/scenario/scenario.h"
@@ -20,7 +21,6 @@ namespace {
 using test::TempDir;
 using nlohmann::json;
 
-const std::string kSourceDir = SIGMAFEM_SOURCE_DIR;
 
 // A scenario on box.msh (403 nodes, 1344 tetrahedra) with a selected ligament, a listed one,
 // a selected control and listed observed nodes: both kinds of node set.
@@ -42,7 +42,7 @@ json box_scenario() {
 
 class ScenarioRefineTest : public ::testing::Test {
  protected:
-  void SetUp() override { dir_.copy(kSourceDir + "/scenarios/box.msh", "box.msh"); }
+  void SetUp() override { dir_.copy(kScenarios + "box.msh", "box.msh"); }
 
   Scenario load(const json& scenario) const {
     return load_scenario(dir_.write("case.json", scenario.dump(2)));
@@ -140,8 +140,8 @@ void expect_every_node_set_used(const Scenario& s) {
 }
 
 TEST(ShippedFineScenarioTest, LiverFineIsTheLiverRefinedTwice) {
-  const Scenario fine = load_scenario(kSourceDir + "/scenarios/liver_fine.json");
-  const Scenario coarse = load_scenario(kSourceDir + "/scenarios/liver.json");
+  const Scenario fine = load_scenario(kScenarios + "liver_fine.json");
+  const Scenario coarse = load_scenario(kScenarios + "liver.json");
   EXPECT_EQ(fine.name, "liver_fine");
   EXPECT_EQ(fine.mesh_spec.refine, 2);
   EXPECT_EQ(fine.mesh.tetrahedron_count(), 38144) << "596 x 64";
@@ -165,7 +165,7 @@ TEST(ShippedFineScenarioTest, LiverFineIsTheLiverRefinedTwice) {
 }
 
 TEST(ShippedFineScenarioTest, BoxLargeHasOverAHundredThousandElements) {
-  const Scenario s = load_scenario(kSourceDir + "/scenarios/box_large.json");
+  const Scenario s = load_scenario(kScenarios + "box_large.json");
   EXPECT_EQ(s.name, "box_large");
   EXPECT_EQ(s.mesh_spec.refine, 1);
   EXPECT_GE(s.mesh.tetrahedron_count(), 100000);
