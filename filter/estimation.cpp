@@ -48,6 +48,8 @@ EstimationRun run_estimation(Ensemble& ensemble, const EstimationOptions& option
     step.normalised_innovation = result.normalised_innovation;
     step.log_det_innovation_covariance = result.log_det_innovation_covariance;
     step.observed_rows = result.observed_rows;
+    step.outliers = static_cast<int>(result.outliers.size());
+    run.outliers += step.outliers;
     step.noise_scale = result.noise_scale;
     if (result.noise_scale > 1.0) {
       if (run.noise_scaled_steps++ == 0) run.first_noise_scaled_step = step.step;

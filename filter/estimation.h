@@ -62,6 +62,7 @@ struct EstimationStep {
   // filter/adaptive_noise.h).
   double noise_scale = 1.0;
   int observed_rows = 0;
+  int outliers = 0;                // points the outlier gate left out (filter/outlier_gate.h)
   bool change_detected = false;
   // The step lies in the catch-up after a detected change: from the first step of the
   // detector's window that fired until the innovations are back within the detector's
@@ -98,6 +99,7 @@ struct EstimationRun {
   // The adaptive observation noise (filter/adaptive_noise.h): the steps whose correction used
   // lambda > 1, the first of them (data row; 0: none) and the largest lambda.
   int noise_scaled_steps = 0;
+  int outliers = 0;                    // point-steps the outlier gate left out, summed
   int first_noise_scaled_step = 0;
   double max_noise_scale = 1.0;
   // theta's covariance after the last step (p x p): how the estimates are correlated, e.g.

@@ -114,9 +114,28 @@ RoukfStep Roukf::step(const Eigen::Vector3d& so_position, const Eigen::VectorXd&
   std::vector<int> rows;
   for (int k = 0; k < y.size(); ++k)
     if (!std::isnan(y[k])) rows.push_back(k);
+  Eigen::MatrixXd Z(static_cast<Eigen::Index>(rows.size()), r);
+  for (std::size_t j = 0; j < rows.size(); ++j)
+    Z.row(static_cast<Eigen::Index>(j)) = y[rows[j]] - predicted.row(rows[j]).array();
+  // Outliers (filter/outlier_gate.h), judged with the nominal S, leave with their rows.
+  if (options_.outlier_gate.enabled && !rows.empty()) {
+    const double variance = options_.observation_std * options_.observation_std;
+    const Eigen::VectorXd S_diag =
+        (alpha * Z * I.transpose()).rowwise().squaredNorm().array() + variance;
+    result.outliers = gate_outliers(options_.outlier_gate, rows, alpha * Z.rowwise().sum(), S_diag);
+    if (!result.outliers.empty()) {
+      std::vector<int> kept;
+      std::vector<Eigen::Index> kept_rows_of_Z;
+      for (std::size_t j = 0; j < rows.size(); ++j)
+        if (std::find(result.outliers.begin(), result.outliers.end(), rows[j] / 3) == result.outliers.end()) {
+          kept.push_back(rows[j]);
+          kept_rows_of_Z.push_back(static_cast<Eigen::Index>(j));
+        }
+      Z = Eigen::MatrixXd(Z(kept_rows_of_Z, Eigen::all));
+      rows = kept;
+    }
+  }
   const int m = static_cast<int>(rows.size());
-  Eigen::MatrixXd Z(m, r);
-  for (int j = 0; j < m; ++j) Z.row(j) = y[rows[j]] - predicted.row(rows[j]).array();
   result.observed_rows = m;
   result.observed_indices = rows;
 

@@ -9,7 +9,8 @@
 //   sampling   C = chol(U^-1), L <- L C; ensemble re-samples its states (Recentering);
 //              theta_i = theta_hat + L_theta I_i
 //   prediction every sigma point advances one step (ensemble)
-//   innovation Z_i = y - H(x_i^-), rows with missing data (NaN) dropped
+//   innovation Z_i = y - H(x_i^-), rows with missing data (NaN) dropped, and the rows of
+//              points the outlier gate rejects (filter/outlier_gate.h)
 //   correction simplex: HL = alpha sum Z_i I_i^T, U = I + HL^T R^-1 HL,
 //              k = -U^-1 HL^T R^-1 z_bar; theta_hat += L_theta k (the ensemble applies
 //              L_x k at the next re-sampling); star: the generalised correction of ROUKF.md.
@@ -20,6 +21,7 @@
 
 #include "filter/adaptive_noise.h"
 #include "filter/ensemble.h"
+#include "filter/outlier_gate.h"
 #include "filter/sigma_points.h"
 
 namespace sigmafem {
@@ -44,6 +46,9 @@ struct RoukfOptions {
   // The correction's R is lambda R when the innovations hold more than the parameters can
   // explain (filter/adaptive_noise.h): the filter stays stable under model error.
   AdaptiveNoiseOptions adaptive_noise;
+  // Observed points whose innovation is far outside its predicted band leave the step's
+  // correction (filter/outlier_gate.h; off by default).
+  OutlierGateOptions outlier_gate;
 };
 
 struct RoukfStep {
@@ -52,7 +57,8 @@ struct RoukfStep {
   Eigen::VectorXd innovation;           // z_bar on the observed rows (observed - predicted mean)
   Eigen::VectorXd innovation_variance;  // diag(S) on the observed rows, S = H P^- H^T + R
   std::vector<int> observed_indices;    // the rows of y that `innovation` holds, increasing
-  int observed_rows = 0;                // rows of y that were not missing
+  int observed_rows = 0;                // rows of y that were not missing, nor an outlier's
+  std::vector<int> outliers;            // points (row / 3) the outlier gate left out
   double innovation_rms = 0.0;          // sqrt(mean z_bar^2) over the observed rows (NaN if none)
   double normalised_innovation = 0.0;   // z_bar^T S^-1 z_bar, S = H P^- H^T + R (chi^2, m dof)
   // log det S: with the NIS, the step's Gaussian log-likelihood of the innovation

@@ -74,6 +74,7 @@ json run_estimation_job(const Scenario& scenario, const EstimationJob& job) {
   report.backend = backend.backend;
   report.backend_reason = backend.reason;
   report.sigma_points = to_string(options.roukf.sigma_points);
+  report.outlier_gate = options.roukf.outlier_gate.enabled;
   report.sigma_count = sigma_count;
   for (int l : spec.estimate) report.names.push_back(scenario.ligaments[l].name);
   report.truth = truth;
@@ -110,6 +111,9 @@ void print_estimation_summary(std::ostream& out, const json& summary, const std:
       out << '\n';
     }
   }
+  if (!summary["outliers_rejected"].is_null())
+    out << "  outliers: " << summary["outliers_rejected"].get<int>()
+        << " point-steps left out by the outlier gate\n";
   if (summary["adaptive_noise"]["engaged"].get<bool>())
     out << "  adaptive noise: engaged on " << summary["adaptive_noise"]["steps"].get<int>() << " steps from step "
         << summary["adaptive_noise"]["first_step"].get<int>() << ", noise variance scaled by up to "

@@ -211,6 +211,8 @@ nlohmann::ordered_json write_estimation_report(const EstimationReport& report, c
   summary["catch_up_steps"] = run.catch_up_steps;
   summary["cuts"] = cuts_json(run, report.names);
   summary["adaptive_noise"] = adaptive_noise_json(run);
+  // null when the gate is off (scenario filter.outlier_gate), else the point-steps it left out.
+  summary["outliers_rejected"] = report.outlier_gate ? json(run.outliers) : json(nullptr);
   if (truth) {
     Eigen::MatrixXd estimate(static_cast<Eigen::Index>(run.steps.size()),
                              static_cast<Eigen::Index>(report.names.size()));

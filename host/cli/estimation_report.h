@@ -30,6 +30,7 @@ struct EstimationReport {
   Eigen::MatrixX3d observed_positions;        // m x 3: mean observed position of each point (m),
                                               // the lever arms of the residual's rigid part
   ResidualDiagnosticsOptions residual;        // burn-in, lags, false-alarm rate
+  bool outlier_gate = false;                  // whether the run gated outliers
   double total_seconds = 0.0;
 };
 

@@ -42,6 +42,14 @@ Action add_generate_command(CLI::App& app) {
   sub->add_option("--noise-std", options->noise_std,
                   "Observation noise std in metres (default: the scenario's observations.noise_std)")
       ->check(finite_between(0.0, kMaxNoiseStd));
+  sub->add_option("--outliers", options->generate.outliers,
+                  "Share of the point-steps reported 1-2 cm from where the point is (random direction "
+                  "and length; measured data's outliers), from step 1 on. Recorded in truth.json")
+      ->check(finite_between(0.0, 0.5));
+  sub->add_option("--dropouts", options->generate.dropouts,
+                  "Share of the point-steps left missing (a tracker losing a point), from step 1 on. "
+                  "Recorded in truth.json")
+      ->check(finite_between(0.0, 0.9));
   sub->add_option("--inject", options->inject,
                   "Put an effect into the data without declaring it in the scenario, NAME=VALUE "
                   "(repeatable), e.g. gravity=0,-9.81,0, young_scale=1.5, camera_offset=0.5e-3,0,0, "
@@ -79,6 +87,10 @@ Action add_generate_command(CLI::App& app) {
       throw InputError("--truth-springs " + options->truth_springs + ": only with --truth-refine (on --truth-mesh the "
                        "node sets are selected again on the other mesh)");
     options->generate.truth_mesh.spread_springs = options->truth_springs == "spread";
+    if (options->generate.outliers + options->generate.dropouts > 1.0)
+      throw InputError("--outliers " + message_number(options->generate.outliers) + " and --dropouts " +
+                       message_number(options->generate.dropouts) +
+                       ": shares of the same point-steps, at most 1 together");
     Scenario scenario = load_scenario(options->scenario);
     for (const std::string& text : options->inject) {
       options->generate.inject.push_back(parse_effect_assignment(text, "--inject"));

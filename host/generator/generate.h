@@ -47,6 +47,12 @@ struct GenerateOptions {
   // a filter builds from the scenario lacks them. Recorded in truth.json.
   std::vector<EffectValue> inject;
   TruthMeshOptions truth_mesh;
+  // Measured data's faults (--outliers, --dropouts), from step 1 on, each point and step
+  // independently: with probability `outliers` a point is reported 1-2 cm from where it is
+  // (a uniformly random direction and length), with probability `dropouts` it is missing.
+  // Drawn from their own random stream, so that the noise is the same with and without them.
+  double outliers = 0.0;
+  double dropouts = 0.0;
 };
 
 struct GenerateResult {
@@ -56,6 +62,8 @@ struct GenerateResult {
   int max_cg_iterations = 0;       // the most in one step
   int unconverged_steps = 0;       // steps whose CG hit solver.cg_max_iterations
   int vtk_frames = 0;
+  int outliers = 0;                // point-steps moved 1-2 cm (GenerateOptions::outliers)
+  int dropouts = 0;                // point-steps left missing
   double max_displacement = 0.0;   // m, largest node displacement over the run
   // The mesh the truth ran on: "the scenario's mesh", "... refined N more levels" or the file.
   std::string truth_mesh;

@@ -35,7 +35,7 @@ double mean_edge_length(const Mesh& mesh, const std::array<int, 4>& t) {
   return sum / 6.0;
 }
 
-std::string format_number(double value) {
+std::string three_digits(double value) {
   char text[32];
   std::snprintf(text, sizeof text, "%.3g", value);
   return text;
@@ -74,7 +74,7 @@ MeshQualityReport orient_and_check(Mesh& mesh, const std::string& source) {
         first_degenerate = "tetrahedron " + std::to_string(e) + " (nodes " + std::to_string(t[0]) +
                            " " + std::to_string(t[1]) + " " + std::to_string(t[2]) + " " +
                            std::to_string(t[3]) + ") is degenerate: volume " +
-                           format_number(volume) + " m^3, mean edge " + format_number(edge) + " m";
+                           three_digits(volume) + " m^3, mean edge " + three_digits(edge) + " m";
       }
       continue;
     }

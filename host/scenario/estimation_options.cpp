@@ -21,6 +21,10 @@ EstimationOptions estimation_options(const Scenario& scenario) {
   if (detection.hold_off) options.detector.hold_off = *detection.hold_off;
   if (detection.inflation_log_std) options.detector.inflation_log_std = *detection.inflation_log_std;
   if (detection.max_catch_up) options.detector.max_catch_up = *detection.max_catch_up;
+  const OutlierGateSpec& gate = spec.outlier_gate;
+  if (gate.enabled) options.roukf.outlier_gate.enabled = *gate.enabled;
+  if (gate.false_alarm) options.roukf.outlier_gate.false_alarm = *gate.false_alarm;
+  if (gate.max_share) options.roukf.outlier_gate.max_share = *gate.max_share;
   const AdaptiveNoiseSpec& adaptive = spec.adaptive_noise;
   if (adaptive.enabled) options.roukf.adaptive_noise.enabled = *adaptive.enabled;
   if (adaptive.window) options.roukf.adaptive_noise.window = *adaptive.window;

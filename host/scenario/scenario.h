@@ -135,6 +135,14 @@ struct AdaptiveNoiseSpec {
   std::optional<double> false_alarm;
 };
 
+// filter.outlier_gate: leaves outlying points out of a step's correction
+// (filter/outlier_gate.h); a field left out keeps the default (off).
+struct OutlierGateSpec {
+  std::optional<bool> enabled;
+  std::optional<double> false_alarm;
+  std::optional<double> max_share;
+};
+
 struct FilterSpec {
   std::vector<int> estimate;        // indices into Scenario::ligaments
   std::vector<double> initial_stiffness;   // median prior stiffness per estimated ligament
@@ -144,6 +152,7 @@ struct FilterSpec {
   std::string sigma_points = "simplex";    // "simplex" or "star"
   ChangeDetectionSpec change_detection;
   AdaptiveNoiseSpec adaptive_noise;
+  OutlierGateSpec outlier_gate;
 };
 
 struct OutputSpec {

@@ -738,7 +738,8 @@ void read_observations(const Checker& c, const json& root, Scenario& s) {
 }
 
 // The fields the filter's windowed tests share (filter.change_detection,
-// filter.adaptive_noise): enabled, window (steps), false_alarm (a probability).
+// filter.adaptive_noise; filter.outlier_gate has no window): enabled, window (steps),
+// false_alarm (a probability).
 void read_windowed_test(const Checker& c, const json& object, const std::string& path,
                         std::optional<bool>& enabled, std::optional<int>& window,
                         std::optional<double>& false_alarm) {
@@ -763,7 +764,8 @@ void read_filter(const Checker& c, const json& root, Scenario& s) {
   const json& filter = root.at("filter");
   c.check_object(filter, "filter",
                  {"estimate", "initial_stiffness", "initial_log_std", "parameter_drift_log_std",
-                  "observation_std", "sigma_points", "change_detection", "adaptive_noise"},
+                  "observation_std", "sigma_points", "change_detection", "adaptive_noise",
+                  "outlier_gate"},
                  {"estimate", "initial_stiffness", "observation_std"});
   FilterSpec spec;
   const json& estimate = c.array(filter.at("estimate"), "filter.estimate");
@@ -829,6 +831,19 @@ void read_filter(const Checker& c, const json& root, Scenario& s) {
     c.check_object(adaptive, path, {"enabled", "window", "false_alarm"}, {});
     AdaptiveNoiseSpec& a = spec.adaptive_noise;
     read_windowed_test(c, adaptive, path, a.enabled, a.window, a.false_alarm);
+  }
+  if (filter.contains("outlier_gate")) {
+    const json& gate = filter.at("outlier_gate");
+    const std::string path = "filter.outlier_gate";
+    c.check_object(gate, path, {"enabled", "false_alarm", "max_share"}, {});
+    OutlierGateSpec& g = spec.outlier_gate;
+    std::optional<int> no_window;
+    read_windowed_test(c, gate, path, g.enabled, no_window, g.false_alarm);
+    if (gate.contains("max_share")) {
+      g.max_share = c.number(gate.at("max_share"), child(path, "max_share"));
+      c.require(*g.max_share > 0.0 && *g.max_share < 1.0, child(path, "max_share"),
+                "must be a share of the points in (0, 1)");
+    }
   }
   c.require(!s.observations.observed.empty(), "filter",
             "the filter needs observed points, and observations has neither nodes nor points");

@@ -330,6 +330,41 @@ TEST_F(CliTest, PointsAnywhereAreGeneratedAndEstimated) {
   EXPECT_EQ(residual["bias"]["rows"].size(), 3 * (nodes + 3)) << "every point's three axes";
 }
 
+// generate --outliers/--dropouts: some point-steps 1-2 cm off, some missing, counted in
+// truth.json; the noise is the same as without them (their own random stream).
+TEST_F(CliTest, GenerateAddsOutliersAndDropouts) {
+  json scenario = box_;
+  scenario["time"]["steps"] = 40;
+  std::ofstream(dir_ / "short.json") << scenario.dump(2);
+  const std::string short_json = (dir_ / "short.json").string();
+  const std::string common = " --vtk-every 0 --quiet --seed 7";
+  ASSERT_EQ(run_sigmafem("generate " + short_json + " --out " + (dir_ / "clean").string() + common).exit_code, 0);
+  const CommandRun faulty = run_sigmafem("generate " + short_json + " --out " + (dir_ / "faulty").string() +
+                                         common + " --outliers 0.1 --dropouts 0.2");
+  ASSERT_EQ(faulty.exit_code, 0) << faulty.output;
+  const ObservationTable clean = read_observations_csv((dir_ / "clean" / "observations.csv").string(), 12, 0.01);
+  const ObservationTable with = read_observations_csv((dir_ / "faulty" / "observations.csv").string(), 12, 0.01);
+  int missing = 0, moved = 0, same = 0;
+  for (Eigen::Index k = 0; k < with.points.rows(); ++k)
+    for (Eigen::Index c = 0; c < with.points.cols(); c += 3) {
+      const Eigen::Vector3d a = clean.points.row(k).segment<3>(c), b = with.points.row(k).segment<3>(c);
+      if (b.hasNaN()) ++missing;
+      else if ((b - a).norm() >= 0.01 - 1e-12 && (b - a).norm() <= 0.02 + 1e-12) ++moved;
+      else if (a == b) ++same;
+    }
+  std::ifstream truth_file(dir_ / "faulty" / "truth.json");
+  const json truth = json::parse(truth_file);
+  EXPECT_EQ(truth["faults"]["dropout_point_steps"].get<int>(), missing);
+  EXPECT_EQ(truth["faults"]["outlier_point_steps"].get<int>(), moved);
+  EXPECT_EQ(missing + moved + same, 41 * 12) << "every other point-step is the clean data, bit for bit";
+  EXPECT_NEAR(missing, 0.2 * 40 * 12, 40.0);
+  EXPECT_NEAR(moved, 0.1 * 40 * 12, 30.0);
+  const CommandRun too_many = run_sigmafem("generate " + short_json + " --out " + (dir_ / "x").string() +
+                                           common + " --outliers 0.5 --dropouts 0.6");
+  EXPECT_EQ(too_many.exit_code, 2);
+  EXPECT_NE(too_many.output.find("at most 1 together"), std::string::npos) << too_many.output;
+}
+
 TEST_F(CliTest, EstimateRejectsDataOfAnotherScenario) {
   // Liver data (12 points, other columns' values) against the box: the header matches in
   // count, so make the point count differ by dropping one observed node from the box.

@@ -207,6 +207,16 @@ TEST_F(ScenarioLoadTest, ObservedPointsAreLocatedOnTheMeshAfterTheNodes) {
   EXPECT_EQ(observed_point_name(s.observations, 4), "observations.points[1]");
 }
 
+TEST_F(ScenarioLoadTest, TheOutlierGateIsOffUnlessTheFilterAsks) {
+  json j = valid_scenario();
+  EXPECT_FALSE(estimation_options(load_scenario(write(j, "plain.json"))).roukf.outlier_gate.enabled);
+  j["filter"]["outlier_gate"] = {{"enabled", true}, {"false_alarm", 1e-5}, {"max_share", 0.3}};
+  const OutlierGateOptions gate = estimation_options(load_scenario(write(j))).roukf.outlier_gate;
+  EXPECT_TRUE(gate.enabled);
+  EXPECT_EQ(gate.false_alarm, 1e-5);
+  EXPECT_EQ(gate.max_share, 0.3);
+}
+
 TEST_F(ScenarioLoadTest, ControlStartIsTheCentroidOfTheControlNodes) {
   const Scenario s = load_scenario(write(valid_scenario()));
   Eigen::Vector3d sum = Eigen::Vector3d::Zero();
@@ -595,6 +605,12 @@ TEST_F(ScenarioLoadTest, BadFieldsAreNamed) {
       {"filter without observations",
        [](json& j) { j["observations"]["nodes"] = json::array(); },
        {"filter:", "needs observed points"}},
+      {"outlier gate share out of range",
+       [](json& j) { j["filter"]["outlier_gate"] = {{"enabled", true}, {"max_share", 1.5}}; },
+       {"filter.outlier_gate.max_share:", "in (0, 1)"}},
+      {"outlier gate unknown field",
+       [](json& j) { j["filter"]["outlier_gate"] = {{"window", 5}}; },
+       {"filter.outlier_gate.window: unknown field"}},
       {"observed point outside the mesh",
        [](json& j) { j["observations"]["points"] = json::parse("[[0.1, 0.05, 0.05], [0.1, 0.05, 0.5]]"); },
        {"observations.points[1]:", "mm outside the mesh", "mesh.scale"}},
