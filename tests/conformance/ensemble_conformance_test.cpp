@@ -139,23 +139,30 @@ constexpr int kMostSigmaPoints = 16;
 // SIGMAFEM_CONFORMANCE_REFERENCE; a case run alone computes the S columns it needs.
 using ObservedTrajectory = std::vector<Eigen::MatrixXd>;
 
-ObservedTrajectory reference_trajectory(const Scenario& scenario, const Model& model, int S) {
-  const std::vector<int>& estimated = scenario.filter->estimate;
-  // Jacobi CG, as the device kernels: the same iterates, so float64 agrees to rounding.
-  CpuEnsemble reference(model, estimated, scenario.observations.nodes, S, 0, Preconditioner::jacobi);
-  Eigen::MatrixXd theta = sigma_theta(model, estimated, S);
-  reference.set_parameters(theta);
+// An ensemble's observed positions over the trajectory, from theta with the middle
+// ligament cut at kCutStep; every step must converge.
+ObservedTrajectory run_trajectory(Ensemble& ensemble, const Scenario& scenario,
+                                  Eigen::MatrixXd theta) {
+  ensemble.set_parameters(theta);
   ObservedTrajectory y(kTrajectorySteps);
   for (int k = 1; k <= kTrajectorySteps; ++k) {
     if (k == kCutStep) {
       cut_middle_ligament(theta);
-      reference.set_parameters(theta);
+      ensemble.set_parameters(theta);
     }
-    const StepReport report = reference.advance(so_position(scenario, k));
-    EXPECT_EQ(report.unconverged_count(), 0) << "reference, step " << k;
-    reference.predicted_observations(y[k - 1]);
+    const StepReport report = ensemble.advance(so_position(scenario, k));
+    EXPECT_EQ(report.unconverged_count(), 0) << "step " << k;
+    if (report.unconverged_count() != 0) return {};
+    ensemble.predicted_observations(y[k - 1]);
   }
   return y;
+}
+
+ObservedTrajectory reference_trajectory(const Scenario& scenario, const Model& model, int S) {
+  const std::vector<int>& estimated = scenario.filter->estimate;
+  // Jacobi CG, as the device kernels: the same iterates, so float64 agrees to rounding.
+  CpuEnsemble reference(model, estimated, scenario.observations.nodes, S, 0, Preconditioner::jacobi);
+  return run_trajectory(reference, scenario, sigma_theta(model, estimated, S));
 }
 
 std::filesystem::path reference_file(const std::string& folder, const std::string& scenario) {
@@ -212,30 +219,13 @@ ObservedTrajectory shared_reference_trajectory(const Scenario& scenario, const M
   return y.empty() ? reference_trajectory(scenario, model, S) : y;
 }
 
-// A device ensemble's observed positions over the trajectory, from theta with the middle
-// ligament cut at kCutStep; every step must converge.
-ObservedTrajectory device_trajectory(Ensemble& device, const Scenario& scenario,
-                                     Eigen::MatrixXd theta) {
-  device.set_parameters(theta);
-  ObservedTrajectory y(kTrajectorySteps);
-  for (int k = 1; k <= kTrajectorySteps; ++k) {
-    if (k == kCutStep) {
-      cut_middle_ligament(theta);
-      device.set_parameters(theta);
-    }
-    const StepReport report = device.advance(so_position(scenario, k));
-    EXPECT_EQ(report.unconverged_count(), 0) << "step " << k;
-    if (report.unconverged_count() != 0) return {};
-    device.predicted_observations(y[k - 1]);
-  }
-  return y;
-}
 
 // The fixture: with SIGMAFEM_CONFORMANCE_REFERENCE set (by ctest) it writes the file;
 // alone, it checks that the reference converges on every step of the trajectory.
 void compute_reference(const std::string& name) {
   const Scenario scenario = conformance_scenario(name);
   const ObservedTrajectory y = reference_trajectory(scenario, make_model(scenario), kMostSigmaPoints);
+  ASSERT_EQ(static_cast<int>(y.size()), kTrajectorySteps) << "the reference did not converge";
   for (const Eigen::MatrixXd& m : y) ASSERT_TRUE(m.allFinite());
   if (const char* folder = std::getenv("SIGMAFEM_CONFORMANCE_REFERENCE"))
     write_reference(reference_file(folder, name), y);
@@ -410,7 +400,7 @@ TEST_P(EnsembleConformance, TrajectoryWithACutFollowsTheReference) {
   const ObservedTrajectory y_reference = shared_reference_trajectory(scenario_, model_, GetParam().scenario, S_);
   ASSERT_FALSE(HasFailure());
   auto device = device_ensemble(model_);
-  const ObservedTrajectory y_device = device_trajectory(*device, scenario_, theta_);
+  const ObservedTrajectory y_device = run_trajectory(*device, scenario_, theta_);
   ASSERT_FALSE(HasFailure());
   double largest = 0.0;
   int worst_step = 0;
@@ -641,7 +631,7 @@ TEST_P(VulkanAgainstOpenCl, TrajectoriesAgree) {
     options.precision = precision;
     auto device = make_ensemble(backend, model, scenario.filter->estimate,
                                 scenario.observations.nodes, S, options);
-    return device_trajectory(*device, scenario, sigma_theta(model, scenario.filter->estimate, S));
+    return run_trajectory(*device, scenario, sigma_theta(model, scenario.filter->estimate, S));
   };
   const ObservedTrajectory y_opencl = trajectory("opencl", "OpenCl");
   const ObservedTrajectory y_vulkan = trajectory("vulkan", "Vulkan");
