@@ -11,9 +11,11 @@
 #include <string>
 
 #include "bench/bench_scenarios.h"
+#include "filter/point_cloud_observation.h"
 #include "filter/roukf.h"
 #include "host/ensemble/cpu_ensemble.h"
 #include "host/ensemble/make_ensemble.h"
+#include "host/generator/surface_cloud_sampler.h"
 #include "host/model/model.h"
 #include "host/reference/reference_simulation.h"
 #include "host/scenario/estimation_options.h"
@@ -67,11 +69,13 @@ DeviceOptions device_options(const Backend& backend) {
   return options;
 }
 
-// make_ensemble, and the shared factor where the Backend asks for it.
+// make_ensemble, and the shared factor where the Backend asks for it; observing the
+// scenario's points, or `observed`.
 std::unique_ptr<Ensemble> make_bench_ensemble(const Backend& backend, const Scenario& s,
-                                              const Model& model, int S) {
-  auto ensemble = make_ensemble(backend.name, model, s.filter->estimate, s.observations.observed, S,
-                                device_options(backend));
+                                              const Model& model, int S,
+                                              const ObservedPoints* observed = nullptr) {
+  auto ensemble = make_ensemble(backend.name, model, s.filter->estimate,
+                                observed ? *observed : s.observations.observed, S, device_options(backend));
   if (backend.shared_factor) dynamic_cast<CpuEnsemble&>(*ensemble).set_own_factors_budget(0.0);
   return ensemble;
 }
@@ -165,6 +169,100 @@ void BM_filter_step(benchmark::State& state, const Backend& backend, const std::
   state.SetLabel(backend.label + ", " + name + ", simplex");
 }
 
+// A surface cloud of `points` points per frame (issue 15: the observation of 1000 points under
+// 20% of a liver filter step): the ensemble observes the liver's surface nodes and each
+// frame, sampled afresh from the truth, is observed by its distances to the surface
+// (filter/point_cloud_observation.h). BM_cloud_filter_step times whole filter steps, to set
+// beside BM_filter_step's tracked points; BM_cloud_observation the observation alone (the
+// surface nodes read back, the closest points on the mean surface, the distances), after an
+// advance.
+struct CloudBench {
+  const Scenario& s;
+  Model model;
+  BoundarySurface surface;
+  SurfaceCloudSampler sampler;
+  ReferenceSimulation truth;
+  PointCloudObservation* cloud = nullptr;
+  std::unique_ptr<Ensemble> ensemble;
+  int step = 0;
+
+  CloudBench(const Backend& backend, int points)
+      : s(bench::scenario("liver_cloud", 0)),
+        model(make_model(s)),
+        surface(boundary_surface(s.mesh)),
+        sampler(s.mesh, with_points(*s.observations.surface_cloud, points), 1),
+        truth(model) {
+    const ObservedPoints observed(surface.nodes);
+    auto wrapped = std::make_unique<PointCloudObservation>(
+        make_bench_ensemble(backend, s, model,
+                            sigma_point_count(SigmaPointSet::simplex, static_cast<int>(s.filter->estimate.size())),
+                            &observed),
+        surface.triangles, points);
+    cloud = wrapped.get();
+    ensemble = std::move(wrapped);
+  }
+  static SurfaceCloud with_points(SurfaceCloud spec, int points) {
+    spec.points_per_frame = points;
+    return spec;
+  }
+  // The truth's next step and its frame, handed to the observation; the SO position.
+  Eigen::Vector3d observe() {
+    const Eigen::Vector3d so = bench::so_position(s, ++step);
+    truth.step(so);
+    cloud->set_frame(sampler.sample(truth.positions()));
+    return so;
+  }
+};
+
+void BM_cloud_filter_step(benchmark::State& state, const Backend& backend) {
+  const int points = static_cast<int>(state.range(0));
+  std::unique_ptr<CloudBench> b;
+  try {
+    b = std::make_unique<CloudBench>(backend, points);
+  } catch (const std::exception& e) {
+    state.SkipWithError(e.what());
+    return;
+  }
+  RoukfOptions options = estimation_options(b->s).roukf;
+  options.sigma_points = SigmaPointSet::simplex;
+  Roukf filter(options, *b->ensemble);
+  const Eigen::VectorXd y = Eigen::VectorXd::Zero(points);
+  for (int i = 0; i < 5; ++i) filter.step(b->observe(), y);   // warm-up, untimed
+  for (auto _ : state) {
+    state.PauseTiming();
+    const Eigen::Vector3d so = b->observe();
+    state.ResumeTiming();
+    benchmark::DoNotOptimize(filter.step(so, y));
+  }
+  state.counters["points"] = points;
+  state.counters["surface_triangles"] = static_cast<double>(b->surface.triangles.size());
+  state.SetLabel(backend.label + ", liver_cloud, simplex");
+}
+
+void BM_cloud_observation(benchmark::State& state, const Backend& backend) {
+  const int points = static_cast<int>(state.range(0));
+  std::unique_ptr<CloudBench> b;
+  try {
+    b = std::make_unique<CloudBench>(backend, points);
+  } catch (const std::exception& e) {
+    state.SkipWithError(e.what());
+    return;
+  }
+  Eigen::MatrixXd theta(b->ensemble->parameter_count(), b->ensemble->sigma_count());
+  for (Eigen::Index j = 0; j < theta.rows(); ++j)
+    for (Eigen::Index k = 0; k < theta.cols(); ++k)
+      theta(j, k) = std::log(b->model.ligaments[b->s.filter->estimate[j]].stiffness) + 0.3 * std::sin(k + j);
+  b->ensemble->set_parameters(theta);
+  Eigen::MatrixXd h;
+  for (int i = 0; i < 5; ++i) b->ensemble->advance(b->observe());
+  for (auto _ : state) {
+    b->cloud->predicted_observations(h);
+    benchmark::DoNotOptimize(h.data());
+  }
+  state.counters["points"] = points;
+  state.SetLabel(backend.label + ", liver_cloud");
+}
+
 // Against S, on the liver refined once (4768 tetrahedra).
 BENCHMARK_CAPTURE(BM_ensemble_step, opencl_liver_4768, kOpenCl, std::string("liver"), 1)
     ->RangeMultiplier(2)->Range(1, 256)->Unit(benchmark::kMillisecond)->UseRealTime();
@@ -241,6 +339,13 @@ BENCHMARK_CAPTURE(BM_filter_step, cpu_shared, kCpuShared, std::string("liver"))
     ->Unit(benchmark::kMillisecond)->UseRealTime();
 BENCHMARK_CAPTURE(BM_filter_step, cpu_jacobi, kCpuJacobi, std::string("liver"))
     ->Unit(benchmark::kMillisecond)->UseRealTime();
+// The same steps observing a surface cloud of 1000 points instead, and that observation alone.
+BENCHMARK_CAPTURE(BM_cloud_filter_step, opencl, kOpenCl)->Arg(1000)->Unit(benchmark::kMillisecond)->UseRealTime();
+BENCHMARK_CAPTURE(BM_cloud_filter_step, vulkan, kVulkan)->Arg(1000)->Unit(benchmark::kMillisecond)->UseRealTime();
+BENCHMARK_CAPTURE(BM_cloud_filter_step, cpu, kCpu)->Arg(1000)->Unit(benchmark::kMillisecond)->UseRealTime();
+BENCHMARK_CAPTURE(BM_cloud_observation, opencl, kOpenCl)->Arg(1000)->Unit(benchmark::kMillisecond)->UseRealTime();
+BENCHMARK_CAPTURE(BM_cloud_observation, vulkan, kVulkan)->Arg(1000)->Unit(benchmark::kMillisecond)->UseRealTime();
+BENCHMARK_CAPTURE(BM_cloud_observation, cpu, kCpu)->Arg(1000)->Unit(benchmark::kMillisecond)->UseRealTime();
 // And on the 38k liver (issue 18: under 5 ms on a GPU), device back ends only. A fixed count
 // of steps: the truth beside it is the CPU reference on 38k tetrahedra, about half a second a
 // step outside the timing.

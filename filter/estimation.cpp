@@ -12,7 +12,8 @@ namespace sigmafem {
 EstimationRun run_estimation(Ensemble& ensemble, const EstimationOptions& options,
                              const std::vector<double>& times, const Eigen::MatrixX3d& so,
                              const Eigen::MatrixXd& points,
-                             const std::function<void(const EstimationStep&)>& on_step) {
+                             const std::function<void(const EstimationStep&)>& on_step,
+                             const std::function<void(Eigen::Index row)>& before_step) {
   Roukf filter(options.roukf, ensemble);
   ChangeDetector detector(options.detector);
   RecoveryCheck recovery(options.recovery);
@@ -32,6 +33,7 @@ EstimationRun run_estimation(Ensemble& ensemble, const EstimationOptions& option
     step.step = static_cast<int>(k);
     step.time = times[static_cast<std::size_t>(k)];
     RoukfStep result;
+    if (before_step) before_step(k);
     try {
       result = filter.step(so.row(k).transpose(), points.row(k).transpose());
     } catch (const std::runtime_error& e) {

@@ -107,11 +107,15 @@ struct EstimationRun {
   Eigen::MatrixXd final_theta_covariance;
 };
 
-// `times` (rows), `so` (rows x 3) and `points` (rows x 3m, NaN = missing) are the data;
-// `on_step` (may be empty) sees every step as it is made, e.g. for a progress line.
+// `times` (rows), `so` (rows x 3) and `points` (rows x the ensemble's observation count, NaN =
+// missing) are the data;
+// `on_step` (may be empty) sees every step as it is made, e.g. for a progress line;
+// `before_step` (may be empty) is called with the data row before its step, e.g. to hand a
+// point-cloud frame to the observation (filter/point_cloud_observation.h).
 EstimationRun run_estimation(Ensemble& ensemble, const EstimationOptions& options,
                              const std::vector<double>& times, const Eigen::MatrixX3d& so,
                              const Eigen::MatrixXd& points,
-                             const std::function<void(const EstimationStep&)>& on_step);
+                             const std::function<void(const EstimationStep&)>& on_step,
+                             const std::function<void(Eigen::Index row)>& before_step = {});
 
 }  // namespace sigmafem

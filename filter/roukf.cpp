@@ -127,7 +127,7 @@ RoukfStep Roukf::step(const Eigen::Vector3d& so_position, const Eigen::VectorXd&
       std::vector<int> kept;
       std::vector<Eigen::Index> kept_rows_of_Z;
       for (std::size_t j = 0; j < rows.size(); ++j)
-        if (std::find(result.outliers.begin(), result.outliers.end(), rows[j] / 3) == result.outliers.end()) {
+        if (std::find(result.outliers.begin(), result.outliers.end(), rows[j] / options_.outlier_gate.rows_per_point) == result.outliers.end()) {
           kept.push_back(rows[j]);
           kept_rows_of_Z.push_back(static_cast<Eigen::Index>(j));
         }

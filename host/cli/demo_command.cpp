@@ -1,4 +1,4 @@
-// `sigmafem demo [box|liver] [--out DIR]`: the main job on a shipped scenario, from a build
+// `sigmafem demo [box|liver|liver_cloud] [--out DIR]`: the main job on a shipped scenario, from a build
 // or an installed copy: generate the scenario's synthetic data into <out>/data, estimate the
 // ligament stiffnesses from it into <out>/estimate, and print where the plots are.
 #include <cstdlib>
@@ -50,7 +50,7 @@ Action add_demo_command(CLI::App& app) {
   auto options = std::make_shared<Options>();
   CLI::App* sub = app.add_subcommand("demo", "Run the main job on a shipped scenario");
   sub->add_option("scenario", options->scenario, "Shipped scenario")
-      ->check(CLI::IsMember({"box", "liver"}))
+      ->check(CLI::IsMember({"box", "liver", "liver_cloud"}))
       ->capture_default_str();
   sub->add_option("--out", options->out_dir, "Output folder (default: sigmafem-demo/<scenario>)");
   sub->add_option("--seed", options->seed, "Seed of the observation noise")

@@ -65,6 +65,9 @@ Action add_diagnose_command(CLI::App& app) {
     const Scenario scenario = load_scenario(options->scenario);
     if (!scenario.filter)
       throw InputError("scenario " + scenario.path + ": filter: missing; diagnose needs a filter block");
+    if (scenario.observations.surface_cloud)
+      throw InputError("scenario " + scenario.path + ": observations.surface_cloud: diagnose works on tracked "
+                       "points (observations.nodes, observations.points) so far; `estimate` takes surface clouds");
     const fs::path data(options->data_dir);
     const ObservationTable table = read_observations_csv(
         (data / "observations.csv").string(), static_cast<int>(scenario.observations.observed.size()), scenario.time.dt);

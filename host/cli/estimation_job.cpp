@@ -2,6 +2,7 @@
 
 #include <chrono>
 #include <cmath>
+#include <algorithm>
 #include <cstdio>
 #include <filesystem>
 #include <iostream>
@@ -15,9 +16,11 @@
 #include "host/common/input_error.h"
 #include "host/common/progress.h"
 #include "host/data/observation_table.h"
+#include "host/data/point_cloud_table.h"
 #include "host/data/truth_table.h"
 #include "host/ensemble/choose_backend.h"
 #include "host/ensemble/make_ensemble.h"
+#include "host/ensemble/surface_cloud_estimation.h"
 #include "host/model/effects.h"
 #include "host/model/model.h"
 #include "host/scenario/estimation_options.h"
@@ -56,14 +59,39 @@ json run_estimation_job(const Scenario& scenario, const EstimationJob& job) {
   const Model model = make_model(scenario);
   const BackendDecision backend = resolve_backend(job.backend, model, sigma_count);
   if (job.out) *job.out << "backend: " << backend.backend << " (" << backend.reason << ")\n" << std::flush;
-  std::unique_ptr<Ensemble> ensemble = make_ensemble(
-      backend.backend, model, scenario.filter->estimate, scenario.observations.observed, sigma_count, job.device);
+  // A surface cloud (observations.surface_cloud): the ensemble observes the surface's nodes
+  // and each frame's points are observed by their distance to it
+  // (host/ensemble/surface_cloud_estimation.h).
+  std::optional<SurfaceCloudEstimation> cloud;
+  std::unique_ptr<Ensemble> tracked;
+  nlohmann::ordered_json observations = {{"kind", "tracked_points"}, {"points", table.point_count()}};
+  if (scenario.observations.surface_cloud) {
+    const std::string cloud_path = (data / "pointcloud.csv").string();
+    PointCloudTable cloud_table = read_point_cloud_csv(cloud_path);
+    for (PointCloudFrame& frame : cloud_table.frames) frame.points.colwise() -= offset;
+    cloud = make_surface_cloud_estimation(backend.backend, model, scenario.mesh, spec.estimate, sigma_count,
+                                          job.device, cloud_table, scenario.time.dt, table.row_count(), cloud_path);
+    options.roukf.outlier_gate.rows_per_point = 1;   // one distance per point
+    observations = {{"kind", "surface_cloud"},
+                    {"frames", cloud_table.frames.size()},
+                    {"points", cloud_table.point_count()},
+                    {"max_points_per_step", cloud->measured.cols()},
+                    {"surface_triangles", cloud->surface_triangles}};
+  } else {
+    tracked = make_ensemble(backend.backend, model, spec.estimate, scenario.observations.observed, sigma_count,
+                            job.device);
+  }
   Progress progress("estimate " + scenario.name + ": step", table.row_count() - 1, job.progress);
   const EstimationRun run = run_estimation(
-      *ensemble, options, table.times, table.so, table.points, [&](const EstimationStep& step) {
+      cloud ? static_cast<Ensemble&>(*cloud->ensemble) : *tracked, options, table.times, table.so,
+      cloud ? cloud->measured : table.points,
+      [&](const EstimationStep& step) {
         char detail[160];
         std::snprintf(detail, sizeof detail, "innovation %.3f mm", 1e3 * step.innovation_rms);
         progress.update(step.step, detail);
+      },
+      [&](Eigen::Index row) {
+        if (cloud) cloud->before_step(row);
       });
   progress.finish();
 
@@ -78,7 +106,10 @@ json run_estimation_job(const Scenario& scenario, const EstimationJob& job) {
   report.sigma_count = sigma_count;
   for (int l : spec.estimate) report.names.push_back(scenario.ligaments[l].name);
   report.truth = truth;
-  report.observed_positions = mean_observed_positions(table.points);
+  // The residual diagnostics' lever arms: tracked points only (for a cloud the rows are not
+  // the same points from one step to the next, and the report leaves them out).
+  if (!cloud) report.observed_positions = mean_observed_positions(table.points);
+  report.observations = observations;
   report.total_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   return write_estimation_report(report, run);
 }

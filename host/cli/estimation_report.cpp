@@ -181,6 +181,7 @@ nlohmann::ordered_json write_estimation_report(const EstimationReport& report, c
   summary["complete"] = run.complete;
   summary["stop_reason"] = run.complete ? json(nullptr) : json(run.stop_reason);
   summary["filter_steps"] = run.steps.size();
+  summary["observations"] = report.observations;
   json final_estimates = json::object();
   double max_seconds = 0.0, sum_seconds = 0.0;
   int max_cg = 0, unconverged = 0;

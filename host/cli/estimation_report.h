@@ -31,6 +31,7 @@ struct EstimationReport {
                                               // the lever arms of the residual's rigid part
   ResidualDiagnosticsOptions residual;        // burn-in, lags, false-alarm rate
   bool outlier_gate = false;                  // whether the run gated outliers
+  nlohmann::ordered_json observations;        // summary.json's "observations": their kind and count
   double total_seconds = 0.0;
 };
 

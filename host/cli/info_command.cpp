@@ -51,6 +51,11 @@ Action add_info_command(CLI::App& app) {
     for (const Event& event : s.events)
       std::cout << "  event t=" << event.time << " s: " << event.ligament_name << " -> "
                 << event.stiffness << " N/m\n";
+    if (const auto& cloud = s.observations.surface_cloud) {
+      std::cout << "  observed: a surface cloud of " << cloud->points_per_frame << " points per frame, view direction "
+                << message_point(cloud->view_direction) << ", coverage " << cloud->coverage << " of the depth\n";
+      return 0;
+    }
     std::cout << "  observed: ";
     print_nodes(std::cout, s.observations.nodes);
     for (std::size_t k = 0; k < s.observations.points.size(); ++k) {

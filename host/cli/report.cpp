@@ -29,9 +29,16 @@ void print_generate_summary(std::ostream& out, const Scenario& scenario,
   if (result.unconverged_steps > 0)
     out << "  warning: CG hit its iteration cap in " << result.unconverged_steps
         << " steps (see the messages above)\n";
-  out << "  " << (dir / "observations.csv").string() << "  ("
-      << scenario.observations.observed.size() << " observed points, noise "
-      << scenario.observations.noise_std * 1e3 << " mm, seed " << options.seed << ")\n";
+  if (scenario.observations.surface_cloud) {
+    out << "  " << (dir / "observations.csv").string() << "  (the SO's positions)\n";
+    out << "  " << (dir / "pointcloud.csv").string() << "  (" << result.steps << " frames of "
+        << scenario.observations.surface_cloud->points_per_frame << " surface points, noise "
+        << scenario.observations.noise_std * 1e3 << " mm, seed " << options.seed << ")\n";
+  } else {
+    out << "  " << (dir / "observations.csv").string() << "  ("
+        << scenario.observations.observed.size() << " observed points, noise "
+        << scenario.observations.noise_std * 1e3 << " mm, seed " << options.seed << ")\n";
+  }
   out << "  " << (dir / "truth.csv").string() << '\n';
   if (result.vtk_frames > 0)
     out << "  " << (dir / (scenario.name + ".pvd")).string() << "  (" << result.vtk_frames

@@ -17,5 +17,8 @@ constexpr double kMaxPositionMagnitude = 1e3;
 constexpr double kMaxNoiseStd = 1.0;
 // time.steps: 1e7 steps of a 10 ms scenario are 28 hours of surgery.
 constexpr int kMaxSteps = 10'000'000;
+// Points in one point-cloud frame: a depth camera's full frame (640 x 480) is 307200; the
+// filter wants hundreds to a few thousand, sampled from it.
+constexpr int kMaxCloudPoints = 1'000'000;
 
 }  // namespace sigmafem

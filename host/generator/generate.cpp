@@ -5,6 +5,7 @@
 #include <cmath>
 #include <filesystem>
 #include <memory>
+#include <optional>
 #include <ostream>
 #include <random>
 #include <vector>
@@ -17,8 +18,10 @@
 #include "host/common/progress.h"
 #include "host/data/csv_format.h"
 #include "host/data/observation_table.h"
+#include "host/data/point_cloud_table.h"
 #include "host/data/truth_table.h"
 #include "host/generator/gaussian_noise.h"
+#include "host/generator/surface_cloud_sampler.h"
 #include "host/generator/vtk_series.h"
 #include "host/model/effects.h"
 #include "host/model/model.h"
@@ -49,7 +52,9 @@ nlohmann::ordered_json truth_mesh_json(const TruthMesh& truth, const TruthMeshOp
 // generate keeps the whole observation and truth tables in memory, then their text: refuse a
 // run whose tables could not fit before any allocation, naming the field that sets their size.
 void check_table_memory(const Scenario& scenario) {
-  const double columns = 5.0 + 3.0 * static_cast<double>(scenario.observations.observed.size()) +
+  const double cloud_columns =
+      scenario.observations.surface_cloud ? 4.0 * scenario.observations.surface_cloud->points_per_frame : 0.0;
+  const double columns = 5.0 + 3.0 * static_cast<double>(scenario.observations.observed.size()) + cloud_columns +
                          static_cast<double>(scenario.ligaments.size());
   constexpr double kBytesPerValue = 8.0 + 24.0;   // the double and its text
   const double needed = (scenario.time.steps + 1.0) * columns * kBytesPerValue;
@@ -80,7 +85,8 @@ GenerateResult generate(const Scenario& scenario, const GenerateOptions& options
                      ": the springs spread over the refined mesh give each node its own part of a ligament, which the "
                      "device back ends do not hold; use --backend cpu, or --truth-springs nodes");
   // observations.csv, what estimate reads, is the set's marker: published last.
-  OutputSet output(options.out_dir, {"observations.csv", "truth.csv", "truth.json", scenario.name + ".pvd", "vtk"},
+  OutputSet output(options.out_dir,
+                   {"observations.csv", "pointcloud.csv", "truth.csv", "truth.json", scenario.name + ".pvd", "vtk"},
                    "observations.csv");
 
   Model truth_model = truth_mesh.model();   // declared effects included
@@ -115,7 +121,37 @@ GenerateResult generate(const Scenario& scenario, const GenerateOptions& options
   std::uniform_real_distribution<double> uniform(0.0, 1.0);
   GaussianNoise direction(options.seed ^ 0x6a09e667f3bcc909ULL);
 
+  // A surface cloud (observations.surface_cloud) instead of tracked points: sampled on the
+  // truth mesh's own surface, from a stream of its own.
+  std::optional<SurfaceCloudSampler> sampler;
+  PointCloudTable cloud;
+  if (scenario.observations.surface_cloud) {
+    const SurfaceCloud& spec = *scenario.observations.surface_cloud;
+    sampler.emplace(truth_mesh.scenario.mesh, spec, options.seed ^ 0xbb67ae8584caa73bULL);
+    cloud.comments = comments;
+    cloud.comments.push_back("surface cloud: " + std::to_string(spec.points_per_frame) +
+                             " points per frame before dropouts, coverage " + format_number(spec.coverage) +
+                             ", view direction " + format_number(spec.view_direction.x()) + " " +
+                             format_number(spec.view_direction.y()) + " " + format_number(spec.view_direction.z()));
+  }
+
   GenerateResult result;
+  // One measured point's faults from step 1 on (GenerateOptions::outliers): moved 1-2 cm, or
+  // dropped (false).
+  auto keep_with_faults = [&](Eigen::Vector3d& point) {
+    if (options.outliers <= 0.0 && options.dropouts <= 0.0) return true;
+    const double draw = uniform(faults);
+    if (draw < options.dropouts) {
+      ++result.dropouts;
+      return false;
+    }
+    if (draw < options.dropouts + options.outliers) {
+      Eigen::Vector3d away(direction.next(), direction.next(), direction.next());
+      point += away * (0.01 + 0.01 * uniform(faults)) / away.norm();
+      ++result.outliers;
+    }
+    return true;
+  };
   Eigen::VectorXd positions;
   auto record = [&](int k) {
     positions = simulation.positions();
@@ -123,22 +159,26 @@ GenerateResult generate(const Scenario& scenario, const GenerateOptions& options
     table.steps.push_back(k);
     table.times.push_back(t);
     table.so.row(k) = scenario.control.trajectory.position(t, scenario.control.start).transpose();
+    auto measured = [&](const Eigen::Vector3d& point) {
+      Eigen::Vector3d m = point + offset;
+      for (int a = 0; a < 3; ++a) m[a] += scenario.observations.noise_std * noise.next();
+      return m;
+    };
     for (std::size_t p = 0; p < observed.size(); ++p) {
-      const Eigen::Vector3d point = truth_mesh.observed[p].of(positions);
-      for (int a = 0; a < 3; ++a)
-        table.points(k, static_cast<Eigen::Index>(3 * p + a)) =
-            point[a] + offset[a] + scenario.observations.noise_std * noise.next();
-      if (k == 0 || (options.outliers <= 0.0 && options.dropouts <= 0.0)) continue;
-      const double draw = uniform(faults);
-      if (draw < options.dropouts) {
-        table.points.row(k).segment<3>(static_cast<Eigen::Index>(3 * p)).setConstant(std::nan(""));
-        ++result.dropouts;
-      } else if (draw < options.dropouts + options.outliers) {
-        Eigen::Vector3d away(direction.next(), direction.next(), direction.next());
-        away *= (0.01 + 0.01 * uniform(faults)) / away.norm();
-        table.points.row(k).segment<3>(static_cast<Eigen::Index>(3 * p)) += away.transpose();
-        ++result.outliers;
+      Eigen::Vector3d point = measured(truth_mesh.observed[p].of(positions));
+      if (k > 0 && !keep_with_faults(point)) point.setConstant(std::nan(""));
+      table.points.row(k).segment<3>(static_cast<Eigen::Index>(3 * p)) = point.transpose();
+    }
+    if (sampler && k > 0) {
+      const Eigen::Matrix3Xd sampled = sampler->sample(positions);
+      PointCloudFrame frame{t, Eigen::Matrix3Xd(3, sampled.cols())};
+      Eigen::Index kept = 0;
+      for (Eigen::Index i = 0; i < sampled.cols(); ++i) {
+        Eigen::Vector3d point = measured(sampled.col(i));
+        if (keep_with_faults(point)) frame.points.col(kept++) = point;
       }
+      frame.points.conservativeResize(3, kept);
+      cloud.frames.push_back(std::move(frame));
     }
     truth.steps.push_back(k);
     truth.times.push_back(t);
@@ -195,6 +235,7 @@ GenerateResult generate(const Scenario& scenario, const GenerateOptions& options
   progress.finish();
 
   write_file_atomically(output.staged("observations.csv"), format_observations_csv(table));
+  if (sampler) write_file_atomically(output.staged("pointcloud.csv"), format_point_cloud_csv(cloud));
   write_file_atomically(output.staged("truth.csv"), format_truth_csv(truth));
   auto effects_json = [](const std::vector<EffectValue>& effects) {
     nlohmann::ordered_json list = nlohmann::ordered_json::array();
@@ -211,6 +252,13 @@ GenerateResult generate(const Scenario& scenario, const GenerateOptions& options
                                                    {"dropouts", options.dropouts},
                                                    {"outlier_point_steps", result.outliers},
                                                    {"dropout_point_steps", result.dropouts}}}};
+  if (sampler)
+    truth_json["surface_cloud"] = {{"points_per_frame", scenario.observations.surface_cloud->points_per_frame},
+                                   {"coverage", scenario.observations.surface_cloud->coverage},
+                                   {"visible_triangles", sampler->visible_triangles().size()},
+                                   {"visible_area_m2", sampler->visible_area_at_rest()},
+                                   {"frames", cloud.frames.size()},
+                                   {"points", cloud.point_count()}};
   write_file_atomically(output.staged("truth.json"), truth_json.dump(2) + "\n");
   if (vtk) {
     vtk->finish();

@@ -4,6 +4,9 @@
 // and writes what a tracking system would have measured:
 //   <out>/observations.csv  SO position and observed node positions per step, with Gaussian
 //                           noise of the scenario's noise_std (docs/FORMATS.md)
+//   <out>/pointcloud.csv    with observations.surface_cloud: the surface points of each frame
+//                           (host/generator/surface_cloud_sampler.h), with the same noise
+//                           (docs/FORMATS.md, "Point clouds")
 //   <out>/truth.csv         each ligament's true stiffness per step
 //   <out>/truth.json        the effects in the data: declared in the scenario, and injected
 //                           (--inject) without being declared; the mesh the truth ran on

@@ -57,6 +57,15 @@ std::vector<std::array<int, 3>> boundary_faces(const Mesh& mesh);
 // Sorted, unique indices of the nodes on the boundary surface.
 std::vector<int> boundary_nodes(const Mesh& mesh);
 
+// The boundary surface on its own nodes: `nodes` = boundary_nodes(mesh), and the faces of
+// boundary_faces(mesh) with each corner an index into `nodes` (what an ensemble observing
+// those nodes returns, in that order).
+struct BoundarySurface {
+  std::vector<int> nodes;
+  std::vector<std::array<int, 3>> triangles;
+};
+BoundarySurface boundary_surface(const Mesh& mesh);
+
 // Uniform refinement: each tetrahedron into eight (edge midpoints added as new nodes after
 // the old ones, old nodes keep their indices; the interior octahedron split along its
 // shortest diagonal). All children positively oriented.

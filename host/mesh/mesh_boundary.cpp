@@ -73,4 +73,15 @@ std::vector<int> boundary_nodes(const Mesh& mesh) {
   return nodes;
 }
 
+BoundarySurface boundary_surface(const Mesh& mesh) {
+  BoundarySurface surface;
+  surface.nodes = boundary_nodes(mesh);
+  for (std::array<int, 3> face : boundary_faces(mesh)) {
+    for (int& v : face)
+      v = static_cast<int>(std::lower_bound(surface.nodes.begin(), surface.nodes.end(), v) - surface.nodes.begin());
+    surface.triangles.push_back(face);
+  }
+  return surface;
+}
+
 }  // namespace sigmafem

@@ -103,6 +103,20 @@ struct Event {
   double stiffness = 0.0;
 };
 
+// observations.surface_cloud: the organ seen as a cloud of surface points per frame, with no
+// identity from one frame to the next (a depth camera or a laser scanner; issue 15, item 2).
+// `generate` samples the frames from the visible patch (docs/FORMATS.md, "Point clouds");
+// `estimate` reads them and observes each point's distance to the model's whole surface
+// (filter/point_cloud_observation.h).
+struct SurfaceCloud {
+  int points_per_frame = 300;                        // sampled per frame, before dropouts
+  Eigen::Vector3d view_direction{0.0, 0.0, -1.0};    // unit, from the camera towards the organ
+  // The visible patch: the surface triangles that face the camera (rest normal . view < 0)
+  // and whose rest centroid lies in this share of the organ's depth along the view, from
+  // the side nearest the camera.
+  double coverage = 1.0 / 3.0;
+};
+
 struct Observations {
   std::vector<int> nodes;           // in scenario order (not sorted), unique
   std::vector<Eigen::Vector3d> points;   // m, in the mesh's frame at rest, as written
@@ -110,6 +124,8 @@ struct Observations {
   // Their order is the column order of observations.csv (pK_x, pK_y, pK_z).
   ObservedPoints observed;
   double noise_std = 0.0;           // m, >= 0, used by the generator
+  // Set: the observations are surface point clouds (and `observed` is empty).
+  std::optional<SurfaceCloud> surface_cloud;
 };
 
 // Where observed point p was written: "observations.nodes[3] (node 17)" or

@@ -703,10 +703,39 @@ void read_events(const Checker& c, const json& root, Scenario& s) {
                    [](const Event& a, const Event& b) { return a.time < b.time; });
 }
 
+// observations.surface_cloud (SurfaceCloud). A scenario observes tracked points or a cloud:
+// the two kinds of data are not combined.
+void read_surface_cloud(const Checker& c, const json& observations, Scenario& s) {
+  const std::string path = "observations.surface_cloud";
+  const json& cloud = observations.at("surface_cloud");
+  c.check_object(cloud, path, {"points_per_frame", "view_direction", "coverage"}, {});
+  c.require(s.observations.observed.empty(), path,
+            "a scenario observes either tracked points (observations.nodes, observations.points) or a surface "
+            "cloud, not both; remove one");
+  SurfaceCloud spec;
+  if (cloud.contains("points_per_frame")) {
+    spec.points_per_frame = c.integer(cloud.at("points_per_frame"), child(path, "points_per_frame"));
+    c.require(spec.points_per_frame >= 1 && spec.points_per_frame <= kMaxCloudPoints, child(path, "points_per_frame"),
+              "must be 1 to " + std::to_string(kMaxCloudPoints) + " points per frame, found " +
+                  std::to_string(spec.points_per_frame));
+  }
+  if (cloud.contains("view_direction")) {
+    const Eigen::Vector3d view = c.vector3(cloud.at("view_direction"), child(path, "view_direction"));
+    c.require(view.norm() > 0.0, child(path, "view_direction"), "must not be zero: it is the direction the camera looks in");
+    spec.view_direction = view.normalized();
+  }
+  if (cloud.contains("coverage")) {
+    spec.coverage = c.number(cloud.at("coverage"), child(path, "coverage"));
+    c.require(spec.coverage > 0.0 && spec.coverage <= 1.0, child(path, "coverage"),
+              "must be a share of the organ's depth in (0, 1], found " + message_number(spec.coverage));
+  }
+  s.observations.surface_cloud = spec;
+}
+
 void read_observations(const Checker& c, const json& root, Scenario& s) {
   if (!root.contains("observations")) return;
   const json& observations = root.at("observations");
-  c.check_object(observations, "observations", {"nodes", "points", "noise_std"}, {});
+  c.check_object(observations, "observations", {"nodes", "points", "surface_cloud", "noise_std"}, {});
   if (observations.contains("nodes")) {
     // Scenario order is kept: it is the column order of the observations CSV.
     s.observations.nodes = node_indices(c, observations.at("nodes"), "observations.nodes", s.mesh);
@@ -731,6 +760,7 @@ void read_observations(const Checker& c, const json& root, Scenario& s) {
       s.observations.observed.push_back(ObservedPoint::at(s.mesh, location));
     }
   }
+  if (observations.contains("surface_cloud")) read_surface_cloud(c, observations, s);
   s.observations.noise_std = c.number_or(observations, "observations", "noise_std", 0.0);
   c.require(s.observations.noise_std >= 0.0 && s.observations.noise_std <= kMaxNoiseStd,
             "observations.noise_std",
@@ -845,8 +875,8 @@ void read_filter(const Checker& c, const json& root, Scenario& s) {
                 "must be a share of the points in (0, 1)");
     }
   }
-  c.require(!s.observations.observed.empty(), "filter",
-            "the filter needs observed points, and observations has neither nodes nor points");
+  c.require(!s.observations.observed.empty() || s.observations.surface_cloud, "filter",
+            "the filter needs observations, and observations has no nodes, points or surface_cloud");
   s.filter = std::move(spec);
 }
 

@@ -330,6 +330,42 @@ TEST_F(CliTest, PointsAnywhereAreGeneratedAndEstimated) {
   EXPECT_EQ(residual["bias"]["rows"].size(), 3 * (nodes + 3)) << "every point's three axes";
 }
 
+// observations.surface_cloud (issue 15, item 2): generate writes pointcloud.csv, estimate
+// reads it on a device back end and says so in summary.json; a data folder without it, or a
+// frame after the SO's last row, is refused naming the file.
+TEST_F(CliTest, SurfaceCloudsAreGeneratedAndEstimated) {
+  json scenario = box_;
+  scenario["time"]["steps"] = 30;
+  scenario["observations"] = {{"surface_cloud", {{"points_per_frame", 200}}}, {"noise_std", 0.0005}};
+  std::ofstream(dir_ / "cloud.json") << scenario.dump(2);
+  const std::string cloud_json = (dir_ / "cloud.json").string();
+  const CommandRun generated =
+      run_sigmafem("generate " + cloud_json + " --out " + (dir_ / "data").string() + " --vtk-every 0 --dropouts 0.1");
+  ASSERT_EQ(generated.exit_code, 0) << generated.output;
+  EXPECT_NE(generated.output.find("pointcloud.csv"), std::string::npos) << generated.output;
+  const CommandRun estimated = run_sigmafem("estimate " + cloud_json + " --data " + (dir_ / "data").string() +
+                                            " --out " + (dir_ / "estimate").string() + " --backend opencl --quiet");
+  ASSERT_EQ(estimated.exit_code, 0) << estimated.output;
+  std::ifstream summary_file(dir_ / "estimate" / "summary.json");
+  const json summary = json::parse(summary_file);
+  EXPECT_TRUE(summary["complete"].get<bool>());
+  EXPECT_EQ(summary["observations"]["kind"], "surface_cloud");
+  EXPECT_EQ(summary["observations"]["frames"], 30);
+  EXPECT_LT(summary["observations"]["points"].get<int>(), 30 * 200) << "dropouts thin the frames";
+  EXPECT_TRUE(summary["residual"].is_null()) << "the residual tests are for tracked points";
+
+  fs::remove(dir_ / "data" / "pointcloud.csv");
+  const CommandRun missing = run_sigmafem("estimate " + cloud_json + " --data " + (dir_ / "data").string() +
+                                          " --out " + (dir_ / "estimate2").string() + " --quiet");
+  EXPECT_NE(missing.exit_code, 0);
+  EXPECT_NE(missing.output.find("pointcloud.csv"), std::string::npos) << missing.output;
+  std::ofstream(dir_ / "data" / "pointcloud.csv") << "time,x,y,z\n0.2,0.1,0.05,0.15\n0.5,0.1,0.05,0.15\n";
+  const CommandRun late = run_sigmafem("estimate " + cloud_json + " --data " + (dir_ / "data").string() +
+                                       " --out " + (dir_ / "estimate3").string() + " --quiet");
+  EXPECT_NE(late.exit_code, 0);
+  EXPECT_NE(late.output.find("the frame at 0.5 s lies after the last row"), std::string::npos) << late.output;
+}
+
 // generate --outliers/--dropouts: some point-steps 1-2 cm off, some missing, counted in
 // truth.json; the noise is the same as without them (their own random stream).
 TEST_F(CliTest, GenerateAddsOutliersAndDropouts) {

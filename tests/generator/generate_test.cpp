@@ -12,6 +12,7 @@
 #include <string>
 #include <vector>
 
+#include "host/data/point_cloud_table.h"
 #include "host/scenario/scenario.h"
 
 namespace sigmafem {
@@ -164,6 +165,45 @@ TEST_F(GenerateTest, ADivergingSimulationNamesItsStepAndWritesNothing) {
   EXPECT_FALSE(fs::exists(dir_ / "diverged" / "truth.csv"));
   EXPECT_FALSE(fs::exists(dir_ / "diverged" / (scenario_.name + ".pvd")));
   EXPECT_FALSE(fs::exists(dir_ / "diverged" / ".sigmafem-partial")) << "the staging folder is removed";
+}
+
+// A surface cloud (observations.surface_cloud): pointcloud.csv holds one frame per step from
+// step 1, the same bytes for the same seed; the noise is the scenario's (the points are drawn
+// from their own stream, so a noise-free run samples the same places); dropouts thin the
+// frames and are counted.
+TEST_F(GenerateTest, SurfaceCloudsHaveAFramePerStepWithTheScenarioNoise) {
+  scenario_ = load_scenario(std::string(SIGMAFEM_SOURCE_DIR) + "/scenarios/liver_cloud.json");
+  scenario_.time.steps = 20;
+  scenario_.observations.noise_std = 0.0;
+  run("clean", 4);
+  scenario_.observations.noise_std = 0.001;
+  run("noisy", 4);
+  run("again", 4);
+  EXPECT_EQ(read_text(dir_ / "noisy/pointcloud.csv"), read_text(dir_ / "again/pointcloud.csv"));
+  const PointCloudTable clean = read_point_cloud_csv((dir_ / "clean/pointcloud.csv").string());
+  const PointCloudTable noisy = read_point_cloud_csv((dir_ / "noisy/pointcloud.csv").string());
+  ASSERT_EQ(clean.frames.size(), 20u);
+  ASSERT_EQ(noisy.frames.size(), 20u);
+  double sum_squares = 0.0;
+  for (std::size_t f = 0; f < clean.frames.size(); ++f) {
+    EXPECT_NEAR(clean.frames[f].time, 0.01 * static_cast<double>(f + 1), 1e-12);
+    ASSERT_EQ(clean.frames[f].points.cols(), scenario_.observations.surface_cloud->points_per_frame);
+    sum_squares += (noisy.frames[f].points - clean.frames[f].points).squaredNorm();
+  }
+  const double std_dev = std::sqrt(sum_squares / (3.0 * clean.point_count()));
+  EXPECT_NEAR(std_dev, 0.001, 0.00005) << "18000 samples: the sample std within 5%";
+
+  GenerateOptions options;
+  options.out_dir = (dir_ / "faulty").string();
+  options.vtk_every = 0;
+  options.dropouts = 0.1;
+  options.outliers = 0.05;
+  std::ostringstream log;
+  const GenerateResult faulty = generate(scenario_, options, log);
+  const PointCloudTable thinned = read_point_cloud_csv((dir_ / "faulty/pointcloud.csv").string());
+  EXPECT_EQ(thinned.point_count(), clean.point_count() - faulty.dropouts);
+  EXPECT_NEAR(faulty.dropouts, 0.1 * clean.point_count(), 5.0 * std::sqrt(0.09 * clean.point_count()));
+  EXPECT_NEAR(faulty.outliers, 0.05 * clean.point_count(), 5.0 * std::sqrt(0.0475 * clean.point_count()));
 }
 
 }  // namespace

@@ -24,7 +24,7 @@ const std::string kNodes41 =
 const std::string kElements41 = "$Elements\n1 1 1 1\n3 1 4 1\n1 1 2 3 4\n$EndElements\n";
 const std::string kHeader41 = "$MeshFormat\n4.1 0 8\n$EndMeshFormat\n";
 
-void expect_error(const std::string& content, const std::string& expected) {
+void expect_gmsh_error(const std::string& content, const std::string& expected) {
   test::expect_read_error("bad.msh", content, expected);
 }
 using test::replace;
@@ -66,25 +66,25 @@ TEST(GmshReader, UnknownNodeIdNamesLineElementAndNode) {
             std::string::npos)
       << message;
   // In a triangle too: a broken reference is a broken file whatever the element type.
-  expect_error(
+  expect_gmsh_error(
       kHeader22 + kNodes22 + "$Elements\n2\n5 2 0 1 2 7\n1 4 2 1 1 1 2 3 4\n$EndElements\n",
       "line 13: element 5 refers to node 7");
-  expect_error(kHeader41 + kNodes41 + replace(kElements41, "1 1 2 3 4", "1 1 2 3 0"),
+  expect_gmsh_error(kHeader41 + kNodes41 + replace(kElements41, "1 1 2 3 4", "1 1 2 3 0"),
                "line 19: element 1 refers to node 0");
 }
 
 TEST(GmshReader, NonNumericFieldsNameLineAndField) {
-  expect_error(kHeader22 + replace(kNodes22, "2 1 0 0", "2 1 abc 0") + kElements22,
+  expect_gmsh_error(kHeader22 + replace(kNodes22, "2 1 0 0", "2 1 abc 0") + kElements22,
                "line 7: expected a y coordinate, found \"abc\"");
-  expect_error(kHeader22 + replace(kNodes22, "2 1 0 0", "2 nan 0 0") + kElements22,
+  expect_gmsh_error(kHeader22 + replace(kNodes22, "2 1 0 0", "2 nan 0 0") + kElements22,
                "line 7: expected an x coordinate, found \"nan\"");
-  expect_error(kHeader22 + replace(kNodes22, "2 1 0 0", "2 1 0 1.5x") + kElements22,
+  expect_gmsh_error(kHeader22 + replace(kNodes22, "2 1 0 0", "2 1 0 1.5x") + kElements22,
                "line 7: expected a z coordinate, found \"1.5x\"");
-  expect_error(kHeader22 + replace(kNodes22, "3 0 1 0", "3e0 0 1 0") + kElements22,
+  expect_gmsh_error(kHeader22 + replace(kNodes22, "3 0 1 0", "3e0 0 1 0") + kElements22,
                "line 8: expected a node id, found \"3e0\"");
-  expect_error(kHeader22 + replace(kNodes22, "$Nodes\n4", "$Nodes\nfour") + kElements22,
+  expect_gmsh_error(kHeader22 + replace(kNodes22, "$Nodes\n4", "$Nodes\nfour") + kElements22,
                "line 5: expected the number of nodes, found \"four\"");
-  expect_error(kHeader22 + replace(kNodes22, "$Nodes\n4", "$Nodes\n99999999999") + kElements22,
+  expect_gmsh_error(kHeader22 + replace(kNodes22, "$Nodes\n4", "$Nodes\n99999999999") + kElements22,
                "line 5: expected the number of nodes between 0 and 2147483647");
 }
 
@@ -92,72 +92,72 @@ TEST(GmshReader, LineNumbersCountWindowsLineEndsOnce) {
   std::string text = kHeader22 + replace(kNodes22, "2 1 0 0", "2 1 x 0") + kElements22;
   std::string crlf;
   for (const char c : text) crlf += c == '\n' ? std::string("\r\n") : std::string(1, c);
-  expect_error(crlf, "line 7: expected a y coordinate");
+  expect_gmsh_error(crlf, "line 7: expected a y coordinate");
 }
 
 TEST(GmshReader, TruncatedFilesSayWhatWasExpected) {
   const std::string full = kHeader22 + kNodes22 + kElements22;
-  expect_error(full.substr(0, full.find("3 0 1 0")),
+  expect_gmsh_error(full.substr(0, full.find("3 0 1 0")),
                "file ends after line 7 (truncated?): expected node line");
-  expect_error(kHeader22 + kNodes22 + "$Elements\n1\n1 4 2 1 1 1 2 3 4\n",
+  expect_gmsh_error(kHeader22 + kNodes22 + "$Elements\n1\n1 4 2 1 1 1 2 3 4\n",
                "file ends after line 13 (truncated?): expected $EndElements to close $Elements");
-  expect_error(kHeader22 + kNodes22, "no $Elements section");
-  expect_error(kHeader22 + kElements22, "line 4: $Elements comes before the nodes section");
-  expect_error("$MeshFormat\n", "expected the format line");
-  expect_error(kHeader22 + "$PhysicalNames\n1\n3 1 \"organ\"\n" + kNodes22,
+  expect_gmsh_error(kHeader22 + kNodes22, "no $Elements section");
+  expect_gmsh_error(kHeader22 + kElements22, "line 4: $Elements comes before the nodes section");
+  expect_gmsh_error("$MeshFormat\n", "expected the format line");
+  expect_gmsh_error(kHeader22 + "$PhysicalNames\n1\n3 1 \"organ\"\n" + kNodes22,
                "expected $EndPhysicalNames to close $PhysicalNames (opened on line 4)");
-  expect_error(kHeader41 + kNodes41.substr(0, kNodes41.find("0 1 0")),
+  expect_gmsh_error(kHeader41 + kNodes41.substr(0, kNodes41.find("0 1 0")),
                "file ends after line 12 (truncated?): expected node coordinates");
 }
 
 TEST(GmshReader, CountsThatDisagreeWithTheLinesAreErrors) {
-  expect_error(kHeader22 + replace(kNodes22, "$Nodes\n4", "$Nodes\n3") + kElements22,
+  expect_gmsh_error(kHeader22 + replace(kNodes22, "$Nodes\n4", "$Nodes\n3") + kElements22,
                "line 9: expected $EndNodes to close $Nodes, found \"4 0 0 1\"");
-  expect_error(kHeader22 + replace(kNodes22, "$Nodes\n4", "$Nodes\n5") + kElements22,
+  expect_gmsh_error(kHeader22 + replace(kNodes22, "$Nodes\n4", "$Nodes\n5") + kElements22,
                "line 10: expected a node line \"id x y z\", found 1 fields");
-  expect_error(kHeader41 + replace(kNodes41, "1 4 1 4", "1 5 1 5") + kElements41,
+  expect_gmsh_error(kHeader41 + replace(kNodes41, "1 4 1 4", "1 5 1 5") + kElements41,
                "the node blocks hold 4 nodes, the header said 5");
-  expect_error(kHeader41 + kNodes41 + replace(kElements41, "1 1 1 1", "1 2 1 2"),
+  expect_gmsh_error(kHeader41 + kNodes41 + replace(kElements41, "1 1 1 1", "1 2 1 2"),
                "the element blocks hold 1 elements, the header said 2");
-  expect_error(kHeader41 + replace(kNodes41, "3 1 0 4", "3 1 0 9") + kElements41,
+  expect_gmsh_error(kHeader41 + replace(kNodes41, "3 1 0 4", "3 1 0 9") + kElements41,
                "line 6: expected the block's node count between 0 and 4, found 9");
-  expect_error(
+  expect_gmsh_error(
       "$NOD\n4\n1 0 0 0\n2 1 0 0\n3 0 1 0\n4 0 0 1\n$ENDNOD\n"
       "$ELM\n1\n1 4 1 1 5 1 2 3 4\n$ENDELM\n",
       "line 10: element 1 says it has 5 nodes, the line lists 4");
 }
 
 TEST(GmshReader, MalformedElementsAndNodes) {
-  expect_error(kHeader22 + kNodes22 + replace(kElements22, "1 4 2 1 1 1 2 3 4", "1 4 2 1 1 1 2 3"),
+  expect_gmsh_error(kHeader22 + kNodes22 + replace(kElements22, "1 4 2 1 1 1 2 3 4", "1 4 2 1 1 1 2 3"),
                "line 13: element 1 is a tetrahedron (type 4) but has 3 nodes, expected 4");
-  expect_error(kHeader22 + kNodes22 + replace(kElements22, "1 4 2 1 1 1 2 3 4", "1 4 9 1 2 3"),
+  expect_gmsh_error(kHeader22 + kNodes22 + replace(kElements22, "1 4 2 1 1 1 2 3 4", "1 4 9 1 2 3"),
                "line 13: element 1 says it has 9 tags, the line is shorter");
-  expect_error(kHeader22 + replace(kNodes22, "3 0 1 0", "2 0 1 0") + kElements22,
+  expect_gmsh_error(kHeader22 + replace(kNodes22, "3 0 1 0", "2 0 1 0") + kElements22,
                "line 8: node 2 is defined twice");
-  expect_error(kHeader22 + replace(kNodes22, "3 0 1 0", "3 0 1") + kElements22,
+  expect_gmsh_error(kHeader22 + replace(kNodes22, "3 0 1 0", "3 0 1") + kElements22,
                "line 8: expected a node line \"id x y z\", found 3 fields");
-  expect_error(kHeader41 + replace(kNodes41, "3 1 0 4", "3 1 1 4") + kElements41,
+  expect_gmsh_error(kHeader41 + replace(kNodes41, "3 1 0 4", "3 1 1 4") + kElements41,
                "line 11: expected 6 coordinates for a node of this block, found 3 fields");
-  expect_error(kHeader22 + "garbage here\n" + kNodes22 + kElements22,
+  expect_gmsh_error(kHeader22 + "garbage here\n" + kNodes22 + kElements22,
                "line 4: expected a section header ($Name), found \"garbage here\"");
 }
 
 TEST(GmshReader, NoTetrahedraIsAnError) {
-  expect_error(kHeader22 + kNodes22 + "$Elements\n2\n1 2 0 1 2 3\n2 1 0 1 2\n$EndElements\n",
+  expect_gmsh_error(kHeader22 + kNodes22 + "$Elements\n2\n1 2 0 1 2 3\n2 1 0 1 2\n$EndElements\n",
                "no tetrahedra (Gmsh element type 4): the file has 2 elements of other types");
-  expect_error(kHeader22 + kNodes22 + "$Elements\n0\n$EndElements\n", "no tetrahedra");
+  expect_gmsh_error(kHeader22 + kNodes22 + "$Elements\n0\n$EndElements\n", "no tetrahedra");
 }
 
 TEST(GmshReader, UnsupportedVersionsAndBinaryAreRefused) {
   for (const std::string version : {"3.0", "4", "4.0", "1.0", "5.1"}) {
-    expect_error(replace(kHeader22, "2.2", version) + kNodes22 + kElements22,
+    expect_gmsh_error(replace(kHeader22, "2.2", version) + kNodes22 + kElements22,
                  "line 2: Gmsh format version " + version + " is not supported");
   }
-  expect_error(replace(kHeader22, "2.2 0 8", "2.2 1 8") + kNodes22 + kElements22,
+  expect_gmsh_error(replace(kHeader22, "2.2 0 8", "2.2 1 8") + kNodes22 + kElements22,
                "binary Gmsh files are not supported");
-  expect_error(replace(kHeader22, "2.2 0 8", "2.2 0") + kNodes22 + kElements22,
+  expect_gmsh_error(replace(kHeader22, "2.2 0 8", "2.2 0") + kNodes22 + kElements22,
                "line 2: expected \"version file-type data-size\"");
-  expect_error("$Comments\nhello\n$EndComments\n" + kNodes22,
+  expect_gmsh_error("$Comments\nhello\n$EndComments\n" + kNodes22,
                "line 1: expected $MeshFormat or $NOD (a Gmsh file), found \"$Comments\"");
 }
 

@@ -26,7 +26,7 @@ Mesh one_tetrahedron() {
   return mesh;
 }
 
-void expect_error(const std::string& content, const std::string& expected) {
+void expect_vtk_error(const std::string& content, const std::string& expected) {
   test::expect_read_error("bad.vtk", content, expected);
 }
 using test::replace;
@@ -45,54 +45,54 @@ TEST(VtkReader, MinimalAsciiFileReads) {
 }
 
 TEST(VtkReader, DatasetsOtherThanUnstructuredGridAreRefused) {
-  expect_error(replace(kAscii, "UNSTRUCTURED_GRID", "POLYDATA"),
+  expect_vtk_error(replace(kAscii, "UNSTRUCTURED_GRID", "POLYDATA"),
                "line 4: DATASET POLYDATA is not supported: sigmafem needs a volume mesh");
-  expect_error(replace(kAscii, "ASCII", "TEXT"), "line 3: expected ASCII or BINARY on line 3");
-  expect_error(replace(kAscii, "# vtk DataFile Version 3.0", "# vtk DataFile Version x"),
+  expect_vtk_error(replace(kAscii, "ASCII", "TEXT"), "line 3: expected ASCII or BINARY on line 3");
+  expect_vtk_error(replace(kAscii, "# vtk DataFile Version 3.0", "# vtk DataFile Version x"),
                "line 1: expected the VTK file version, found \"x\"");
 }
 
 TEST(VtkReader, CellsMustReferToExistingPoints) {
-  expect_error(replace(kAscii, "4 0 1 2 3", "4 0 1 2 7"),
+  expect_vtk_error(replace(kAscii, "4 0 1 2 3", "4 0 1 2 7"),
                "line 8: cell 0 refers to point 7, but POINTS (line 5) defines 4 points");
-  expect_error(replace(kAscii, "4 0 1 2 3", "4 0 -1 2 3"), "cell 0 refers to point -1");
+  expect_vtk_error(replace(kAscii, "4 0 1 2 3", "4 0 -1 2 3"), "cell 0 refers to point -1");
 }
 
 TEST(VtkReader, MalformedCellsAreErrors) {
-  expect_error(replace(replace(kAscii, "CELLS 1 5", "CELLS 1 4"), "4 0 1 2 3", "3 0 1 2"),
+  expect_vtk_error(replace(replace(kAscii, "CELLS 1 5", "CELLS 1 4"), "4 0 1 2 3", "3 0 1 2"),
                "line 8: cell 0 is a tetrahedron (type 10) but has 3 points, expected 4");
-  expect_error(replace(kAscii, "4 0 1 2 3", "9 0 1 2 3"),
+  expect_vtk_error(replace(kAscii, "4 0 1 2 3", "9 0 1 2 3"),
                "CELLS: cell 0 says it has 9 points, more than the list holds");
-  expect_error(replace(replace(kAscii, "CELLS 1 5", "CELLS 1 6"), "4 0 1 2 3", "4 0 1 2 3 3"),
+  expect_vtk_error(replace(replace(kAscii, "CELLS 1 5", "CELLS 1 6"), "4 0 1 2 3", "4 0 1 2 3 3"),
                "CELLS: the header says 6 values, the 1 cells use 5");
-  expect_error(
+  expect_vtk_error(
       replace(replace(kAscii, "CELLS 1 5", "CELLS 2 5"), "CELL_TYPES 1\n10", "CELL_TYPES 2\n10 10"),
       "CELLS: the list of 5 values ends before cell 1");
-  expect_error(replace(kAscii, "CELL_TYPES 1\n10", "CELL_TYPES 2\n10 10"),
+  expect_vtk_error(replace(kAscii, "CELL_TYPES 1\n10", "CELL_TYPES 2\n10 10"),
                "line 10: CELL_TYPES lists 2 types for 1 cells");
-  expect_error(replace(replace(replace(kAscii, "4 0 1 2 3", "3 0 1 2"), "CELLS 1 5", "CELLS 1 4"),
+  expect_vtk_error(replace(replace(replace(kAscii, "4 0 1 2 3", "3 0 1 2"), "CELLS 1 5", "CELLS 1 4"),
                        "CELL_TYPES 1\n10", "CELL_TYPES 1\n5"),
                "no tetrahedra (VTK cell type 10): the file has 1 cells of other types");
 }
 
 TEST(VtkReader, NumbersAndKeywordsAreChecked) {
-  expect_error(replace(kAscii, "0 0 0 1 0 0", "0 0 0 1 x 0"),
+  expect_vtk_error(replace(kAscii, "0 0 0 1 0 0", "0 0 0 1 x 0"),
                "line 6: expected POINTS coordinates, found \"x\"");
-  expect_error(replace(kAscii, "POINTS 4 float", "POINTS 4 long"),
+  expect_vtk_error(replace(kAscii, "POINTS 4 float", "POINTS 4 long"),
                "line 5: data type \"long\" is not supported");
-  expect_error(replace(kAscii, "POINTS 4 float", "POINTS 4 int"),
+  expect_vtk_error(replace(kAscii, "POINTS 4 float", "POINTS 4 int"),
                "POINTS must be float or double, found int");
-  expect_error(replace(kAscii, "POINTS 4 float", "POINTS 99999999999 float"),
+  expect_vtk_error(replace(kAscii, "POINTS 4 float", "POINTS 99999999999 float"),
                "line 5: expected the number of points between 0 and 2147483647");
-  expect_error(replace(kAscii, "CELL_TYPES", "POLYGONS"),
+  expect_vtk_error(replace(kAscii, "CELL_TYPES", "POLYGONS"),
                "line 10: expected POINTS, CELLS or CELL_TYPES, found \"POLYGONS\"");
-  expect_error(replace(kAscii, "CELLS 1 5\n4 0 1 2 3\n", ""), "no CELLS block");
+  expect_vtk_error(replace(kAscii, "CELLS 1 5\n4 0 1 2 3\n", ""), "no CELLS block");
 }
 
 TEST(VtkReader, TruncatedAsciiSaysWhere) {
-  expect_error(kAscii.substr(0, kAscii.find("0 1 0 0 0 1")),
+  expect_vtk_error(kAscii.substr(0, kAscii.find("0 1 0 0 0 1")),
                "file ends after line 6 (truncated?): expected POINTS coordinates");
-  expect_error(kAscii.substr(0, kAscii.find("DATASET")),
+  expect_vtk_error(kAscii.substr(0, kAscii.find("DATASET")),
                "file ends after line 3 (truncated?): expected DATASET");
 }
 
@@ -100,32 +100,32 @@ TEST(VtkReader, BinaryBlocksAreBoundsChecked) {
   const std::string binary = test::vtk_binary_text(one_tetrahedron());
   // Cut in the middle of the POINTS block (after the 6th of its 12 doubles).
   const std::size_t points = binary.find("POINTS 4 double\n") + 16;
-  expect_error(binary.substr(0, points + 6 * 8),
+  expect_vtk_error(binary.substr(0, points + 6 * 8),
                "(truncated?): expected 12 double values of POINTS coordinates");
   // A huge count must fail at once, not allocate for it.
-  expect_error(replace(binary, "POINTS 4 double", "POINTS 2000000000 double"),
+  expect_vtk_error(replace(binary, "POINTS 4 double", "POINTS 2000000000 double"),
                "expected 6000000000 double values");
-  expect_error(replace(binary, "POINTS 4 double", "POINTS 4 double extra"), "unexpected \"extra");
+  expect_vtk_error(replace(binary, "POINTS 4 double", "POINTS 4 double extra"), "unexpected \"extra");
   // A NaN coordinate (big-endian quiet NaN 7ff8...).
   std::string nan = binary;
   nan[points] = '\x7f';
   nan[points + 1] = '\xf8';
-  expect_error(nan, "POINTS coordinates: value 0 is not a finite number");
+  expect_vtk_error(nan, "POINTS coordinates: value 0 is not a finite number");
 }
 
 TEST(VtkReader, Version51OffsetsAreChecked) {
   const std::string ascii = test::vtk51_text(one_tetrahedron(), false);
-  expect_error(replace(ascii, "OFFSETS vtktypeint64\n0\n4", "OFFSETS vtktypeint64\n1\n4"),
+  expect_vtk_error(replace(ascii, "OFFSETS vtktypeint64\n0\n4", "OFFSETS vtktypeint64\n1\n4"),
                "CELLS: OFFSETS must rise from 0 to the CONNECTIVITY size 4");
-  expect_error(replace(ascii, "OFFSETS vtktypeint64", "OFFSETS float"),
+  expect_vtk_error(replace(ascii, "OFFSETS vtktypeint64", "OFFSETS float"),
                "expected an integer data type, found float");
-  expect_error(replace(ascii, "CONNECTIVITY", "CONNECTIONS"),
+  expect_vtk_error(replace(ascii, "CONNECTIVITY", "CONNECTIONS"),
                "expected CONNECTIVITY, found \"CONNECTIONS\"");
   // One cell, but its 64-bit connectivity names a point far outside the mesh.
   std::string binary = test::vtk51_text(one_tetrahedron(), true);
   const std::size_t connectivity = binary.find("CONNECTIVITY vtktypeint64\n") + 26;
   binary[connectivity] = '\x7f';
-  expect_error(binary, "cell 0 refers to point 9151314442816847872");
+  expect_vtk_error(binary, "cell 0 refers to point 9151314442816847872");
 }
 
 }  // namespace

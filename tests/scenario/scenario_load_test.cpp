@@ -207,6 +207,21 @@ TEST_F(ScenarioLoadTest, ObservedPointsAreLocatedOnTheMeshAfterTheNodes) {
   EXPECT_EQ(observed_point_name(s.observations, 4), "observations.points[1]");
 }
 
+// observations.surface_cloud: its fields, the defaults for those left out, the view made a
+// unit vector; no tracked points beside it.
+TEST_F(ScenarioLoadTest, ASurfaceCloudReplacesTheTrackedPoints) {
+  json j = valid_scenario();
+  j["observations"].erase("nodes");
+  j["observations"]["surface_cloud"] = {{"points_per_frame", 250}, {"view_direction", {0, 2, 0}}};
+  const Scenario s = load_scenario(write(j));
+  ASSERT_TRUE(s.observations.surface_cloud.has_value());
+  EXPECT_EQ(s.observations.surface_cloud->points_per_frame, 250);
+  EXPECT_EQ(s.observations.surface_cloud->view_direction, Eigen::Vector3d(0, 1, 0));
+  EXPECT_NEAR(s.observations.surface_cloud->coverage, 1.0 / 3.0, 1e-15) << "left out: a third";
+  EXPECT_TRUE(s.observations.observed.empty());
+  ASSERT_TRUE(s.filter.has_value()) << "a cloud is what the filter observes";
+}
+
 TEST_F(ScenarioLoadTest, TheOutlierGateIsOffUnlessTheFilterAsks) {
   json j = valid_scenario();
   EXPECT_FALSE(estimation_options(load_scenario(write(j, "plain.json"))).roukf.outlier_gate.enabled);
@@ -604,7 +619,34 @@ TEST_F(ScenarioLoadTest, BadFieldsAreNamed) {
        {"filter.sigma_points:", "did you mean \"simplex\""}},
       {"filter without observations",
        [](json& j) { j["observations"]["nodes"] = json::array(); },
-       {"filter:", "needs observed points"}},
+       {"filter:", "needs observations", "surface_cloud"}},
+      {"surface cloud beside tracked nodes",
+       [](json& j) { j["observations"]["surface_cloud"] = json::object(); },
+       {"observations.surface_cloud:", "either tracked points", "not both"}},
+      {"surface cloud coverage zero",
+       [](json& j) {
+         j["observations"].erase("nodes");
+         j["observations"]["surface_cloud"] = {{"coverage", 0}};
+       },
+       {"observations.surface_cloud.coverage:", "(0, 1]"}},
+      {"surface cloud without a view",
+       [](json& j) {
+         j["observations"].erase("nodes");
+         j["observations"]["surface_cloud"] = {{"view_direction", {0, 0, 0}}};
+       },
+       {"observations.surface_cloud.view_direction:", "must not be zero"}},
+      {"surface cloud of no points",
+       [](json& j) {
+         j["observations"].erase("nodes");
+         j["observations"]["surface_cloud"] = {{"points_per_frame", 0}};
+       },
+       {"observations.surface_cloud.points_per_frame:", "must be 1 to 1000000"}},
+      {"surface cloud unknown field",
+       [](json& j) {
+         j["observations"].erase("nodes");
+         j["observations"]["surface_cloud"] = {{"points", 300}};
+       },
+       {"observations.surface_cloud.points: unknown field", "points_per_frame"}},
       {"outlier gate share out of range",
        [](json& j) { j["filter"]["outlier_gate"] = {{"enabled", true}, {"max_share", 1.5}}; },
        {"filter.outlier_gate.max_share:", "in (0, 1)"}},

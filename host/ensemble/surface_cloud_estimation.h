@@ -1,0 +1,40 @@
+// SurfaceCloudEstimation: what run_estimation needs for point-cloud data (scenario
+// observations.surface_cloud, issue 15 item 2), built in one place for `estimate`, the tests
+// and the benchmarks: the ensemble of the organ observing its surface nodes, wrapped in the
+// point-cloud observation (filter/point_cloud_observation.h), the frames by data row, and the
+// data matrix (0 for each point of a row's frame, NaN beyond).
+#pragma once
+
+#include <Eigen/Core>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "filter/point_cloud_observation.h"
+#include "host/common/device_options.h"
+#include "host/data/point_cloud_table.h"
+#include "host/mesh/mesh.h"
+#include "host/model/model.h"
+
+namespace sigmafem {
+
+struct SurfaceCloudEstimation {
+  std::unique_ptr<PointCloudObservation> ensemble;
+  std::vector<Eigen::Matrix3Xd> frames;   // by data row (frames_by_step); empty: no frame
+  Eigen::MatrixXd measured;               // rows x the most points of a row
+  int surface_triangles = 0;
+
+  // For run_estimation's before_step: hands row `row`'s frame to the observation.
+  void before_step(Eigen::Index row) { ensemble->set_frame(frames[static_cast<std::size_t>(row)]); }
+};
+
+// The estimation of `model` (on `mesh`'s boundary surface) from `cloud` over `rows` data rows
+// of `dt`, on `backend` (make_ensemble). Throws InputError naming `path` when no frame lies
+// after the rest state, or one lies after the last row.
+SurfaceCloudEstimation make_surface_cloud_estimation(const std::string& backend, const Model& model,
+                                                     const Mesh& mesh, const std::vector<int>& estimated,
+                                                     int sigma_count, const DeviceOptions& device,
+                                                     const PointCloudTable& cloud, double dt, int rows,
+                                                     const std::string& path);
+
+}  // namespace sigmafem
