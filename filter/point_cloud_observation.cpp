@@ -23,11 +23,24 @@ PointCloudObservation::PointCloudObservation(std::unique_ptr<Ensemble> surface,
                                     " of " + std::to_string(nodes));
 }
 
-void PointCloudObservation::set_frame(const Eigen::Matrix3Xd& points) {
+void PointCloudObservation::set_frame(const Eigen::Matrix3Xd& points, const Eigen::VectorXd& share) {
   if (points.cols() > max_points_)
     throw std::invalid_argument("PointCloudObservation: a frame of " + std::to_string(points.cols()) +
                                 " points, more than the " + std::to_string(max_points_) + " it was made for");
+  if (share.size() != 0 && share.size() != points.cols())
+    throw std::invalid_argument("PointCloudObservation: " + std::to_string(share.size()) + " times for " +
+                                std::to_string(points.cols()) + " points");
+  if (share.size() != 0 && !(share.array() > 0.0 && share.array() <= 1.0).all())
+    throw std::invalid_argument("PointCloudObservation: a point's share of the step must lie in (0, 1]");
   frame_ = points;
+  share_ = share.size() != 0 ? share : Eigen::VectorXd::Ones(points.cols());
+  between_steps_ = (share_.array() < 1.0).any();
+}
+
+StepReport PointCloudObservation::advance(const Eigen::Vector3d& so_position) {
+  // The re-sampled state the sigma points start the step from, for points taken inside it.
+  if (between_steps_) surface_->predicted_observations(start_positions_);
+  return surface_->advance(so_position);
 }
 
 void PointCloudObservation::predicted_observations(Eigen::MatrixXd& y) const {
@@ -41,9 +54,15 @@ void PointCloudObservation::predicted_observations(Eigen::MatrixXd& y) const {
     const Eigen::Vector3d p = frame_.col(i);
     const SurfacePoint at = search.closest(p);
     const std::array<int, 3>& tri = triangles_[static_cast<std::size_t>(at.triangle)];
+    const double u = share_[i];
     for (Eigen::Index s = 0; s < S; ++s) {
+      // Corner c of sigma point s's triangle when p was taken.
       const auto corner = [&](int c) -> Eigen::Vector3d {
-        return surface_positions_.col(s).segment<3>(3 * static_cast<Eigen::Index>(tri[static_cast<std::size_t>(c)]));
+        const Eigen::Index row = 3 * static_cast<Eigen::Index>(tri[static_cast<std::size_t>(c)]);
+        const Eigen::Vector3d end = surface_positions_.col(s).segment<3>(row);
+        if (u == 1.0) return end;
+        const Eigen::Vector3d start = start_positions_.col(s).segment<3>(row);
+        return start + u * (end - start);
       };
       const Eigen::Vector3d a = corner(0), b = corner(1), c = corner(2);
       const Eigen::Vector3d x = at.weights[0] * a + at.weights[1] * b + at.weights[2] * c;

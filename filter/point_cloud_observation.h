@@ -21,6 +21,12 @@
 //
 // A frame may hold any number of points up to max_points: the data leaves the rows beyond its
 // count out (NaN there, as for missing tracked points).
+//
+// Frames at their own times (a camera's clock, not the simulation's): a point taken at a
+// share u of the coming step (0 at its start, 1 at its end) is observed on each sigma point's
+// surface interpolated linearly in time between the step's start (the re-sampled state,
+// read before the advance) and its end, so that the filter corrects at the frame's time; the
+// match on the mean surface is made at the step's end.
 #pragma once
 
 #include <Eigen/Core>
@@ -39,14 +45,15 @@ class PointCloudObservation : public Ensemble {
   PointCloudObservation(std::unique_ptr<Ensemble> surface, std::vector<std::array<int, 3>> triangles,
                         int max_points);
 
-  // The measured points of the coming step (3 x n, n <= max_points; n = 0: nothing measured).
-  void set_frame(const Eigen::Matrix3Xd& points);
+  // The measured points of the coming step (3 x n, n <= max_points; n = 0: nothing measured)
+  // and when in it each was taken (n shares in (0, 1]; empty: all at the step's end).
+  void set_frame(const Eigen::Matrix3Xd& points, const Eigen::VectorXd& share = {});
 
   int sigma_count() const override { return surface_->sigma_count(); }
   int parameter_count() const override { return surface_->parameter_count(); }
   int observation_count() const override { return max_points_; }
   void set_parameters(const Eigen::MatrixXd& theta) override { surface_->set_parameters(theta); }
-  StepReport advance(const Eigen::Vector3d& so_position) override { return surface_->advance(so_position); }
+  StepReport advance(const Eigen::Vector3d& so_position) override;
   // max_points x S: h_s(p) for the frame's points, 0 beyond them.
   void predicted_observations(Eigen::MatrixXd& y) const override;
   void recenter(const Recentering& recentering) override { surface_->recenter(recentering); }
@@ -56,6 +63,9 @@ class PointCloudObservation : public Ensemble {
   std::vector<std::array<int, 3>> triangles_;
   int max_points_;
   Eigen::Matrix3Xd frame_;
+  Eigen::VectorXd share_;                       // per point of the frame, (0, 1]
+  bool between_steps_ = false;                  // a point of the frame was taken before the step's end
+  Eigen::MatrixXd start_positions_;             // 3n x S, the surface at the step's start
   mutable Eigen::MatrixXd surface_positions_;   // 3n x S, the surface's nodes (reused)
 };
 

@@ -50,6 +50,24 @@ Action add_generate_command(CLI::App& app) {
                   "Share of the point-steps left missing (a tracker losing a point), from step 1 on. "
                   "Recorded in truth.json")
       ->check(finite_between(0.0, 0.9));
+  sub->add_option("--gap-steps", options->generate.gap_steps,
+                  "With --dropouts: tracked points are lost for runs of steps of this mean length (a "
+                  "tracker losing a point for a while), the missing share staying --dropouts")
+      ->check(finite_between(1.0, 1e6))
+      ->type_name("N");
+  sub->add_option("--frame-rate", options->generate.frame_rate,
+                  "Surface clouds: frames at this rate (Hz) instead of one per step, each taken and "
+                  "stamped at its own time (the organ interpolated between steps). Recorded in truth.json")
+      ->check(finite_between(1e-3, 1e4))
+      ->type_name("HZ");
+  sub->add_option("--frame-jitter", options->generate.frame_jitter,
+                  "With --frame-rate: each frame taken at its nominal time plus Gaussian jitter of this "
+                  "std (s)")
+      ->check(finite_between(0.0, 1.0))
+      ->type_name("S");
+  sub->add_flag("--frames-on-steps", options->generate.frames_on_steps,
+                "With --frame-rate: each frame taken at the step nearest its nominal time (no jitter), "
+                "to compare with frames at their own times");
   sub->add_option("--inject", options->inject,
                   "Put an effect into the data without declaring it in the scenario, NAME=VALUE "
                   "(repeatable), e.g. gravity=0,-9.81,0, young_scale=1.5, camera_offset=0.5e-3,0,0, "
@@ -91,7 +109,14 @@ Action add_generate_command(CLI::App& app) {
       throw InputError("--outliers " + message_number(options->generate.outliers) + " and --dropouts " +
                        message_number(options->generate.dropouts) +
                        ": shares of the same point-steps, at most 1 together");
+    if ((sub->count("--frame-jitter") > 0 || options->generate.frames_on_steps) && sub->count("--frame-rate") == 0)
+      throw InputError("--frame-jitter and --frames-on-steps: only with --frame-rate");
+    if (options->generate.frames_on_steps && options->generate.frame_jitter > 0.0)
+      throw InputError("--frames-on-steps takes frames at the steps, without jitter: leave out --frame-jitter");
     Scenario scenario = load_scenario(options->scenario);
+    if (sub->count("--frame-rate") > 0 && !scenario.observations.surface_cloud)
+      throw InputError("--frame-rate: frames at their own times are for surface clouds (observations.surface_cloud); "
+                       "tracked points are written per step in observations.csv");
     for (const std::string& text : options->inject) {
       options->generate.inject.push_back(parse_effect_assignment(text, "--inject"));
       const std::string& name = options->generate.inject.back().name;

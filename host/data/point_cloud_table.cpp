@@ -70,20 +70,25 @@ PointCloudTable read_point_cloud_csv(const std::string& path) {
   return table;
 }
 
-std::vector<Eigen::Matrix3Xd> frames_by_step(const PointCloudTable& table, double dt, int rows,
-                                             const std::string& path) {
-  std::vector<Eigen::Matrix3Xd> by_step(static_cast<std::size_t>(rows), Eigen::Matrix3Xd(3, 0));
+std::vector<StepFrames> frames_by_step(const PointCloudTable& table, double dt, int rows, const std::string& path) {
+  std::vector<StepFrames> by_step(static_cast<std::size_t>(rows));
   for (const PointCloudFrame& frame : table.frames) {
-    const double step = std::round(frame.time / dt);
+    // The step whose interval ((k-1) dt, k dt] holds the frame; a time on the grid, up to
+    // rounding, belongs to the step it ends.
+    const double step = std::ceil(frame.time / dt - 1e-9);
     if (step >= rows)
       throw InputError("point cloud " + path + ": the frame at " + format_number(frame.time) +
                        " s lies after the last row of observations.csv (step " + std::to_string(rows - 1) + ", " +
                        format_number((rows - 1) * dt) + " s): the SO's positions must cover every frame");
     if (step < 1.0) continue;
-    Eigen::Matrix3Xd& slot = by_step[static_cast<std::size_t>(step)];
-    const Eigen::Index before = slot.cols();
-    slot.conservativeResize(3, before + frame.points.cols());
-    slot.rightCols(frame.points.cols()) = frame.points;
+    double share = (frame.time - (step - 1.0) * dt) / dt;
+    share = std::abs(share - 1.0) < 1e-9 ? 1.0 : std::clamp(share, 1e-9, 1.0);
+    StepFrames& slot = by_step[static_cast<std::size_t>(step)];
+    const Eigen::Index before = slot.points.cols(), added = frame.points.cols();
+    slot.points.conservativeResize(3, before + added);
+    slot.points.rightCols(added) = frame.points;
+    slot.share.conservativeResize(before + added);
+    slot.share.tail(added).setConstant(share);
   }
   return by_step;
 }

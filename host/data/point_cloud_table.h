@@ -32,13 +32,20 @@ struct PointCloudTable {
 // points, or a file with no row.
 PointCloudTable read_point_cloud_csv(const std::string& path);
 
+// The points measured during one simulation step, from one frame or several.
+struct StepFrames {
+  Eigen::Matrix3Xd points = Eigen::Matrix3Xd(3, 0);
+  // Per point: when in the step it was taken, in (0, 1]: (t - (k-1) dt) / dt for step k
+  // (1: at the step's end, on the grid).
+  Eigen::VectorXd share;
+};
+
 // The frames by simulation step, for a run of `rows` data rows at steps of `dt`: element k
-// holds the points of the frames whose time is nearest to k dt (frames of two cameras, or at
-// a rate above the step rate, may share a step: their points are put together). Row 0 is
-// the rest state, where the filter makes no step: a frame there is left out. Throws
-// InputError naming `path` and the frame for one nearer to a step after the last row.
-std::vector<Eigen::Matrix3Xd> frames_by_step(const PointCloudTable& table, double dt, int rows,
-                                             const std::string& path);
+// holds the frames taken in ((k-1) dt, k dt] (frames of a camera faster than the steps share
+// a step: their points are put together), with where in the step each was taken. Row 0 is
+// the rest state, where the filter makes no step: a frame at time 0 is left out. Throws
+// InputError naming `path` and the frame for one taken after the last row.
+std::vector<StepFrames> frames_by_step(const PointCloudTable& table, double dt, int rows, const std::string& path);
 
 // The CSV text of the table.
 std::string format_point_cloud_csv(const PointCloudTable& table);

@@ -16,13 +16,13 @@ SurfaceCloudEstimation make_surface_cloud_estimation(const std::string& backend,
   SurfaceCloudEstimation estimation;
   estimation.frames = frames_by_step(cloud, dt, rows, path);
   Eigen::Index max_points = 0;
-  for (const Eigen::Matrix3Xd& frame : estimation.frames) max_points = std::max(max_points, frame.cols());
+  for (const StepFrames& step : estimation.frames) max_points = std::max(max_points, step.points.cols());
   if (max_points == 0)
-    throw InputError("point cloud " + path + ": no frame after the rest state (t > dt/2); nothing to compare the "
+    throw InputError("point cloud " + path + ": no frame after the rest state (t > 0); nothing to compare the "
                      "model with");
   estimation.measured = Eigen::MatrixXd::Constant(rows, max_points, std::nan(""));
   for (std::size_t k = 0; k < estimation.frames.size(); ++k)
-    estimation.measured.row(static_cast<Eigen::Index>(k)).head(estimation.frames[k].cols()).setZero();
+    estimation.measured.row(static_cast<Eigen::Index>(k)).head(estimation.frames[k].points.cols()).setZero();
   const BoundarySurface surface = boundary_surface(mesh);
   estimation.surface_triangles = static_cast<int>(surface.triangles.size());
   estimation.ensemble = std::make_unique<PointCloudObservation>(

@@ -20,12 +20,15 @@ namespace sigmafem {
 
 struct SurfaceCloudEstimation {
   std::unique_ptr<PointCloudObservation> ensemble;
-  std::vector<Eigen::Matrix3Xd> frames;   // by data row (frames_by_step); empty: no frame
+  std::vector<StepFrames> frames;         // by data row (frames_by_step); no point: no frame
   Eigen::MatrixXd measured;               // rows x the most points of a row
   int surface_triangles = 0;
 
   // For run_estimation's before_step: hands row `row`'s frame to the observation.
-  void before_step(Eigen::Index row) { ensemble->set_frame(frames[static_cast<std::size_t>(row)]); }
+  void before_step(Eigen::Index row) {
+    const StepFrames& step = frames[static_cast<std::size_t>(row)];
+    ensemble->set_frame(step.points, step.share);
+  }
 };
 
 // The estimation of `model` (on `mesh`'s boundary surface) from `cloud` over `rows` data rows

@@ -67,6 +67,23 @@ void check_table_memory(const Scenario& scenario) {
                      format_number(std::floor(available / 1e9)) + " GB; generate fewer steps per run");
 }
 
+// When each frame of a cloud at options.frame_rate is taken (GenerateOptions::frame_rate):
+// within (0, steps dt], increasing.
+std::vector<double> cloud_frame_times(const GenerateOptions& options, int steps, double dt, std::uint64_t seed) {
+  std::vector<double> times;
+  GaussianNoise jitter(seed);
+  const double end = steps * dt;
+  for (long f = 1;; ++f) {
+    const double nominal = static_cast<double>(f) / options.frame_rate;
+    if (nominal > end + 1e-12 * dt) break;
+    double t = options.frames_on_steps ? std::round(nominal / dt) * dt : nominal + options.frame_jitter * jitter.next();
+    t = std::min(t, end);
+    if (t <= 0.0 || (!times.empty() && t <= times.back())) continue;   // jittered out of order or range
+    times.push_back(t);
+  }
+  return times;
+}
+
 // The start of the message when the truth simulation fails at step k.
 std::string diverged_at(int k, double t) {
   return "the truth simulation diverged at step " + std::to_string(k) + " (t = " + format_number(t) + " s): ";
@@ -79,6 +96,16 @@ GenerateResult generate(const Scenario& scenario, const GenerateOptions& options
   const auto start = std::chrono::steady_clock::now();
   // Before the output folder: bad truth mesh options leave nothing behind.
   check_table_memory(scenario);
+  if (!(options.frame_rate >= 0.0 && options.frame_jitter >= 0.0))
+    throw InputError("generate: the frame rate and the frame jitter must not be negative");
+  if (!(options.gap_steps >= 1.0))
+    throw InputError("generate: the mean gap length is at least 1 step, found " + format_number(options.gap_steps));
+  if (options.gap_steps > 1.0 && scenario.observations.surface_cloud)
+    throw InputError("scenario " + scenario.path + ": gaps of several steps are for tracked points; a cloud's points "
+                     "have no identity to lose (use --dropouts alone)");
+  if (options.frame_rate > 0.0 && !scenario.observations.surface_cloud)
+    throw InputError("scenario " + scenario.path + ": a frame rate is for surface clouds (observations.surface_cloud); "
+                     "tracked points are written per step");
   const TruthMesh truth_mesh = make_truth_mesh(scenario, options.truth_mesh);
   if (!truth_mesh.ligament_spread.empty() && options.backend != "cpu")
     throw InputError("--truth-refine with --backend " + options.backend +
@@ -125,6 +152,10 @@ GenerateResult generate(const Scenario& scenario, const GenerateOptions& options
   // truth mesh's own surface, from a stream of its own.
   std::optional<SurfaceCloudSampler> sampler;
   PointCloudTable cloud;
+  std::vector<double> frame_times;   // with a frame rate: when each frame is taken
+  std::size_t next_frame = 0;
+  if (scenario.observations.surface_cloud && options.frame_rate > 0.0)
+    frame_times = cloud_frame_times(options, steps, dt, options.seed ^ 0x3c6ef372fe94f82bULL);
   if (scenario.observations.surface_cloud) {
     const SurfaceCloud& spec = *scenario.observations.surface_cloud;
     sampler.emplace(truth_mesh.scenario.mesh, spec, options.seed ^ 0xbb67ae8584caa73bULL);
@@ -137,10 +168,32 @@ GenerateResult generate(const Scenario& scenario, const GenerateOptions& options
 
   GenerateResult result;
   // One measured point's faults from step 1 on (GenerateOptions::outliers): moved 1-2 cm, or
-  // dropped (false).
-  auto keep_with_faults = [&](Eigen::Vector3d& point) {
+  // dropped (false). `lost_for`: a tracked point's steps left in its gap (gap_steps > 1).
+  std::vector<int> lost_for(observed.size(), 0);
+  // Tracked runs of mean (1 - g) / g steps between gaps of mean L: missing share
+  // g L / (1 - g + g L) = dropouts.
+  const double gap_start =
+      options.dropouts / (options.gap_steps * (1.0 - options.dropouts) + options.dropouts);
+  auto keep_with_faults = [&](Eigen::Vector3d& point, int* lost) {
     if (options.outliers <= 0.0 && options.dropouts <= 0.0) return true;
     const double draw = uniform(faults);
+    if (lost && options.gap_steps > 1.0) {
+      // Gaps: a lost point stays lost; else it is lost now with probability gap_start, for a
+      // geometric number of steps of mean gap_steps (this one included).
+      if (*lost == 0 && draw < gap_start)
+        *lost = 1 + static_cast<int>(std::floor(std::log1p(-uniform(faults)) / std::log1p(-1.0 / options.gap_steps)));
+      if (*lost > 0) {
+        --*lost;
+        ++result.dropouts;
+        return false;
+      }
+      if (draw < gap_start + options.outliers) {
+        Eigen::Vector3d away(direction.next(), direction.next(), direction.next());
+        point += away * (0.01 + 0.01 * uniform(faults)) / away.norm();
+        ++result.outliers;
+      }
+      return true;
+    }
     if (draw < options.dropouts) {
       ++result.dropouts;
       return false;
@@ -152,33 +205,44 @@ GenerateResult generate(const Scenario& scenario, const GenerateOptions& options
     }
     return true;
   };
-  Eigen::VectorXd positions;
+  // What the camera or tracker reports for a point: the offset and the noise added.
+  auto measured = [&](const Eigen::Vector3d& point) {
+    Eigen::Vector3d m = point + offset;
+    for (int a = 0; a < 3; ++a) m[a] += scenario.observations.noise_std * noise.next();
+    return m;
+  };
+  Eigen::VectorXd positions, previous_positions;
+  // One frame of the cloud, of the organ at `at`, taken at time t.
+  auto take_frame = [&](double t, const Eigen::VectorXd& at) {
+    const Eigen::Matrix3Xd sampled = sampler->sample(at);
+    PointCloudFrame frame{t, Eigen::Matrix3Xd(3, sampled.cols())};
+    Eigen::Index kept = 0;
+    for (Eigen::Index i = 0; i < sampled.cols(); ++i) {
+      Eigen::Vector3d point = measured(sampled.col(i));
+      if (keep_with_faults(point, nullptr)) frame.points.col(kept++) = point;
+    }
+    frame.points.conservativeResize(3, kept);
+    cloud.frames.push_back(std::move(frame));
+  };
   auto record = [&](int k) {
+    previous_positions = positions;
     positions = simulation.positions();
     const double t = k * dt;
     table.steps.push_back(k);
     table.times.push_back(t);
     table.so.row(k) = scenario.control.trajectory.position(t, scenario.control.start).transpose();
-    auto measured = [&](const Eigen::Vector3d& point) {
-      Eigen::Vector3d m = point + offset;
-      for (int a = 0; a < 3; ++a) m[a] += scenario.observations.noise_std * noise.next();
-      return m;
-    };
     for (std::size_t p = 0; p < observed.size(); ++p) {
       Eigen::Vector3d point = measured(truth_mesh.observed[p].of(positions));
-      if (k > 0 && !keep_with_faults(point)) point.setConstant(std::nan(""));
+      if (k > 0 && !keep_with_faults(point, &lost_for[p])) point.setConstant(std::nan(""));
       table.points.row(k).segment<3>(static_cast<Eigen::Index>(3 * p)) = point.transpose();
     }
-    if (sampler && k > 0) {
-      const Eigen::Matrix3Xd sampled = sampler->sample(positions);
-      PointCloudFrame frame{t, Eigen::Matrix3Xd(3, sampled.cols())};
-      Eigen::Index kept = 0;
-      for (Eigen::Index i = 0; i < sampled.cols(); ++i) {
-        Eigen::Vector3d point = measured(sampled.col(i));
-        if (keep_with_faults(point)) frame.points.col(kept++) = point;
-      }
-      frame.points.conservativeResize(3, kept);
-      cloud.frames.push_back(std::move(frame));
+    if (sampler && k > 0 && options.frame_rate <= 0.0) take_frame(t, positions);   // a frame per step
+    // Frames at their own times: those taken in ((k-1) dt, k dt], of the organ interpolated
+    // between the two steps.
+    for (; sampler && k > 0 && next_frame < frame_times.size() && frame_times[next_frame] <= t + 1e-12 * dt;
+         ++next_frame) {
+      const double share = (frame_times[next_frame] - (t - dt)) / dt;
+      take_frame(frame_times[next_frame], previous_positions + share * (positions - previous_positions));
     }
     truth.steps.push_back(k);
     truth.times.push_back(t);
@@ -250,10 +314,15 @@ GenerateResult generate(const Scenario& scenario, const GenerateOptions& options
                                        {"truth_mesh", truth_mesh_json(truth_mesh, options.truth_mesh)},
                                        {"faults", {{"outliers", options.outliers},
                                                    {"dropouts", options.dropouts},
+                                                   {"gap_steps", options.gap_steps},
                                                    {"outlier_point_steps", result.outliers},
                                                    {"dropout_point_steps", result.dropouts}}}};
   if (sampler)
     truth_json["surface_cloud"] = {{"points_per_frame", scenario.observations.surface_cloud->points_per_frame},
+                                   {"frame_rate_hz", options.frame_rate > 0.0 ? nlohmann::ordered_json(options.frame_rate)
+                                                                               : nlohmann::ordered_json(nullptr)},
+                                   {"frame_jitter_s", options.frame_jitter},
+                                   {"frames_on_steps", options.frames_on_steps},
                                    {"coverage", scenario.observations.surface_cloud->coverage},
                                    {"visible_triangles", sampler->visible_triangles().size()},
                                    {"visible_area_m2", sampler->visible_area_at_rest()},

@@ -56,6 +56,22 @@ struct GenerateOptions {
   // Drawn from their own random stream, so that the noise is the same with and without them.
   double outliers = 0.0;
   double dropouts = 0.0;
+  // --gap-steps: tracked points are lost for runs of steps, not step by step: a point that
+  // drops out stays missing for a run whose length is geometric with this mean (1: each
+  // step on its own), and runs start so often that the share of missing point-steps is
+  // still `dropouts` (a tracked point is lost with probability
+  // dropouts / (gap_steps (1 - dropouts) + dropouts) at each step). Tracked points only.
+  double gap_steps = 1.0;
+  // A surface cloud's frames (observations.surface_cloud; --frame-rate, --frame-jitter,
+  // --frames-on-steps): 0, one frame at every step's time; else frames at `frame_rate` Hz
+  // from 1/frame_rate on, each taken at its nominal time plus Gaussian jitter of std
+  // `frame_jitter` s (kept in order, within the run) and stamped with the time it was taken,
+  // the organ there interpolated linearly between the two steps around it. With
+  // `frames_on_steps` each frame is taken and stamped at the step nearest its nominal time
+  // instead (no jitter): the same frames on the simulation's grid, to compare with.
+  double frame_rate = 0.0;
+  double frame_jitter = 0.0;
+  bool frames_on_steps = false;
 };
 
 struct GenerateResult {

@@ -14,6 +14,7 @@
 
 #include "cli/sigmafem_command.h"
 #include "host/data/observation_table.h"
+#include "host/data/point_cloud_table.h"
 #include "host/ensemble/choose_backend.h"
 #include "host/scenario/scenario.h"
 #include "requirement.h"
@@ -364,6 +365,45 @@ TEST_F(CliTest, SurfaceCloudsAreGeneratedAndEstimated) {
                                        " --out " + (dir_ / "estimate3").string() + " --quiet");
   EXPECT_NE(late.exit_code, 0);
   EXPECT_NE(late.output.find("the frame at 0.5 s lies after the last row"), std::string::npos) << late.output;
+}
+
+// generate --frame-rate: a cloud's frames at their own times (jittered, off the step grid),
+// which estimate takes; the frame options only for clouds and only together as they make sense.
+TEST_F(CliTest, CloudFramesAtTheirOwnTimesAreGeneratedAndEstimated) {
+  json scenario = box_;
+  scenario["time"]["steps"] = 30;
+  const std::string tracked_json = (dir_ / "tracked.json").string();
+  std::ofstream(tracked_json) << scenario.dump(2);
+  scenario["observations"] = {{"surface_cloud", {{"points_per_frame", 100}}}, {"noise_std", 0.0005}};
+  const std::string cloud_json = (dir_ / "cloud.json").string();
+  std::ofstream(cloud_json) << scenario.dump(2);
+  const std::string out = " --out " + (dir_ / "data").string() + " --vtk-every 0 --quiet";
+  ASSERT_EQ(run_sigmafem("generate " + cloud_json + out + " --frame-rate 30 --frame-jitter 0.003").exit_code, 0);
+  const PointCloudTable cloud = read_point_cloud_csv((dir_ / "data" / "pointcloud.csv").string());
+  ASSERT_GE(cloud.frames.size(), 8u);
+  ASSERT_LE(cloud.frames.size(), 9u) << "30 Hz over 0.3 s";
+  int off_grid = 0;
+  for (const PointCloudFrame& frame : cloud.frames) {
+    off_grid += std::abs(frame.time / 0.01 - std::round(frame.time / 0.01)) > 1e-6;
+    EXPECT_EQ(frame.points.cols(), 100);
+  }
+  EXPECT_GE(off_grid, 7) << "taken at their own times, not the steps'";
+  const CommandRun estimated = run_sigmafem("estimate " + cloud_json + " --data " + (dir_ / "data").string() +
+                                            " --out " + (dir_ / "estimate").string() + " --backend cpu --quiet");
+  EXPECT_EQ(estimated.exit_code, 0) << estimated.output;
+
+  const std::vector<std::pair<std::string, std::string>> refused = {
+      {tracked_json + out + " --frame-rate 30", "for surface clouds"},
+      {cloud_json + out + " --frames-on-steps", "only with --frame-rate"},
+      {cloud_json + out + " --frame-rate 30 --frames-on-steps --frame-jitter 0.001", "leave out --frame-jitter"},
+      {cloud_json + out + " --frame-rate 0", "--frame-rate"},
+      {cloud_json + out + " --dropouts 0.1 --gap-steps 5", "for tracked points"},
+  };
+  for (const auto& [arguments, message] : refused) {
+    const CommandRun run = run_sigmafem("generate " + arguments);
+    EXPECT_NE(run.exit_code, 0) << arguments;
+    EXPECT_NE(run.output.find(message), std::string::npos) << arguments << ": " << run.output;
+  }
 }
 
 // generate --outliers/--dropouts: some point-steps 1-2 cm off, some missing, counted in

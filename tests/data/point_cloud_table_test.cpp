@@ -1,5 +1,5 @@
 // The point-cloud file (host/data/point_cloud_table.h): what is written reads back frame by
-// frame; frames go to their nearest simulation step; a bad file is refused naming the file,
+// frame; frames go to the simulation step they were taken in, with their share of it; a bad file is refused naming the file,
 // the line and what is wrong.
 #include "host/data/point_cloud_table.h"
 
@@ -37,18 +37,26 @@ TEST(PointCloudTableTest, WrittenFramesReadBack) {
   }
 }
 
-TEST(PointCloudTableTest, FramesGoToTheirNearestStepAndShareOne) {
-  PointCloudTable table = two_frames();
-  table.frames.insert(table.frames.begin(), {0.004, Eigen::Matrix3Xd::Zero(3, 2)});   // nearest to row 0
-  table.frames.insert(table.frames.end() - 1, {0.0649, Eigen::Matrix3Xd::Ones(3, 2)});   // row 6
-  const std::vector<Eigen::Matrix3Xd> by_step = frames_by_step(table, 0.01, 8, "cloud.csv");
+TEST(PointCloudTableTest, FramesGoToTheStepTheyWereTakenInWithTheirShareOfIt) {
+  PointCloudTable table;
+  table.frames.push_back({0.0, Eigen::Matrix3Xd::Zero(3, 2)});      // the rest state
+  table.frames.push_back({0.0333, Eigen::Matrix3Xd::Random(3, 3)});  // in (0.03, 0.04]
+  table.frames.push_back({0.05, Eigen::Matrix3Xd::Ones(3, 1)});      // on the grid
+  table.frames.push_back({0.0649, Eigen::Matrix3Xd::Ones(3, 2)});    // two frames in (0.06, 0.07]
+  table.frames.push_back({0.0667, Eigen::Matrix3Xd::Ones(3, 1)});
+  const std::vector<StepFrames> by_step = frames_by_step(table, 0.01, 8, "cloud.csv");
   ASSERT_EQ(by_step.size(), 8u);
-  EXPECT_EQ(by_step[0].cols(), 0) << "the rest state takes no frame";
-  EXPECT_EQ(by_step[3].cols(), 3);
-  EXPECT_EQ(by_step[6].cols(), 2);
-  EXPECT_EQ(by_step[7].cols(), 1);
-  EXPECT_EQ(by_step[3], table.frames[1].points);
-  EXPECT_THROW(frames_by_step(table, 0.01, 7, "cloud.csv"), InputError) << "0.0667 s is nearest to row 7 of 0..6";
+  EXPECT_EQ(by_step[0].points.cols(), 0) << "the rest state takes no frame";
+  EXPECT_EQ(by_step[3].points.cols(), 0);
+  ASSERT_EQ(by_step[4].points.cols(), 3);
+  EXPECT_EQ(by_step[4].points, table.frames[1].points);
+  EXPECT_NEAR(by_step[4].share[0], 0.33, 1e-9);
+  ASSERT_EQ(by_step[5].points.cols(), 1);
+  EXPECT_EQ(by_step[5].share[0], 1.0) << "a frame on the grid is at its step's end exactly";
+  ASSERT_EQ(by_step[7].points.cols(), 3);
+  EXPECT_NEAR(by_step[7].share[1], 0.49, 1e-9);
+  EXPECT_NEAR(by_step[7].share[2], 0.67, 1e-9);
+  EXPECT_THROW(frames_by_step(table, 0.01, 7, "cloud.csv"), InputError) << "0.0649 s lies in step 7 of 0..6";
 }
 
 TEST(PointCloudTableTest, BadFilesAreRefusedWithTheLineAndTheReason) {

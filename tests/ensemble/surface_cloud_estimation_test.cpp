@@ -5,7 +5,8 @@
 //   noise-free, every stiffness within 2% of the truth;
 //   at 0.5 mm noise with 5% outliers at 1-2 cm and 10% dropouts, with the outlier gate: the
 //   error within 1.5x of the same data without the faults, the truth inside +-2 std on 90%
-//   of the scored steps.
+//   of the scored steps;
+//   frames at 30 Hz with 3 ms jitter as good as the same frames on the step grid.
 #include "host/ensemble/surface_cloud_estimation.h"
 
 #include <gtest/gtest.h>
@@ -33,21 +34,18 @@ struct CloudRun {
   GenerateResult generated;
 };
 
-// Generates liver_cloud's first `step_count` steps (no cut) with `noise` and, if asked, the faults,
-// and estimates them on the CPU back end with the filter told `observation_std`.
-CloudRun run_liver_cloud(double noise, double observation_std, bool faults, bool gate, int step_count = 1000) {
+// Generates liver_cloud's first `step_count` steps (no cut) with `noise`, the faults and frame
+// times of `generate_options` and estimates them on the CPU back end with the filter told
+// `observation_std`.
+CloudRun run_liver_cloud(double noise, double observation_std, GenerateOptions generate_options, bool gate,
+                         int step_count = 1000) {
   Scenario s = load_scenario(std::string(SIGMAFEM_SOURCE_DIR) + "/scenarios/liver_cloud.json");
   s.events.clear();
   s.time.steps = step_count;
   s.observations.noise_std = noise;
   const test::TempDir dir("sigmafem_surface_cloud_estimation_test");
-  GenerateOptions generate_options;
   generate_options.out_dir = dir.path();
   generate_options.vtk_every = 0;
-  if (faults) {
-    generate_options.outliers = 0.05;
-    generate_options.dropouts = 0.10;
-  }
   std::ostringstream log;
   CloudRun result;
   result.generated = generate(s, generate_options, log);
@@ -83,9 +81,27 @@ CloudRun run_liver_cloud(double noise, double observation_std, bool faults, bool
   return result;
 }
 
+// Measured data's faults (issue 15): 5% of the points 1-2 cm off, 10% missing.
+GenerateOptions with_faults() {
+  GenerateOptions options;
+  options.outliers = 0.05;
+  options.dropouts = 0.10;
+  return options;
+}
+
+// Frames at 30 Hz against the 100 Hz simulation, taken at their own times with 3 ms jitter,
+// or at the steps nearest their nominal times.
+GenerateOptions at_30_hz(bool own_times) {
+  GenerateOptions options;
+  options.frame_rate = 30.0;
+  options.frame_jitter = own_times ? 0.003 : 0.0;
+  options.frames_on_steps = !own_times;
+  return options;
+}
+
 // On noise-free data the filter is told of a small observation noise (issue 3): 0.1 mm.
 TEST(LiverCloudEstimation, NoiseFreeCloudsGiveEveryStiffnessWithinTwoPercent) {
-  const CloudRun cloud = run_liver_cloud(0.0, 1e-4, false, false);
+  const CloudRun cloud = run_liver_cloud(0.0, 1e-4, {}, false);
   ASSERT_TRUE(cloud.run.complete) << cloud.run.stop_reason;
   EXPECT_LT(cloud.relative_error, 0.02);
   std::cout << "liver, noise-free clouds: largest mean relative error " << 100.0 * cloud.relative_error
@@ -93,8 +109,8 @@ TEST(LiverCloudEstimation, NoiseFreeCloudsGiveEveryStiffnessWithinTwoPercent) {
 }
 
 TEST(LiverCloudEstimation, OutliersAndDropoutsCostLittleWithTheOutlierGate) {
-  const CloudRun clean = run_liver_cloud(5e-4, 5e-4, false, true);
-  const CloudRun faulty = run_liver_cloud(5e-4, 5e-4, true, true);
+  const CloudRun clean = run_liver_cloud(5e-4, 5e-4, {}, true);
+  const CloudRun faulty = run_liver_cloud(5e-4, 5e-4, with_faults(), true);
   ASSERT_TRUE(clean.run.complete && faulty.run.complete) << clean.run.stop_reason << faulty.run.stop_reason;
   EXPECT_LE(faulty.phase.mean_abs_error, 1.5 * clean.phase.mean_abs_error);
   EXPECT_GE(faulty.phase.coverage, 0.9);
@@ -102,6 +118,20 @@ TEST(LiverCloudEstimation, OutliersAndDropoutsCostLittleWithTheOutlierGate) {
             << 100.0 * clean.phase.coverage << "%), " << faulty.phase.mean_abs_error << " N/m with them (coverage "
             << 100.0 * faulty.phase.coverage << "%); outliers generated " << faulty.generated.outliers
             << ", left out " << faulty.run.outliers << "; left out of the clean data " << clean.run.outliers << "\n";
+}
+
+// Frames at their own times (issue 15, item 3): 30 Hz with 3 ms jitter are as good as the
+// same frames on the step grid, within 10%, because each point is observed on the surface of
+// the moment it was taken (filter/point_cloud_observation.h). Noise-free, where a timing
+// error shows most: given to the nearest step instead, the error was 2.46 N/m against
+// 0.20 on the grid (measured at stop 34).
+TEST(LiverCloudEstimation, FramesAtTheirOwnTimesAreAsGoodAsFramesOnTheStepGrid) {
+  const CloudRun own_times = run_liver_cloud(0.0, 1e-4, at_30_hz(true), false);
+  const CloudRun on_grid = run_liver_cloud(0.0, 1e-4, at_30_hz(false), false);
+  ASSERT_TRUE(own_times.run.complete && on_grid.run.complete) << own_times.run.stop_reason << on_grid.run.stop_reason;
+  EXPECT_LE(own_times.phase.mean_abs_error, 1.1 * on_grid.phase.mean_abs_error);
+  std::cout << "liver clouds at 30 Hz, noise-free: mean |error| " << own_times.phase.mean_abs_error
+            << " N/m with 3 ms jitter, " << on_grid.phase.mean_abs_error << " N/m on the step grid\n";
 }
 
 }  // namespace

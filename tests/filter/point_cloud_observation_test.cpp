@@ -31,6 +31,22 @@ class FixedSurface : public Ensemble {
   Eigen::MatrixXd positions_;
 };
 
+// A FixedSurface whose every sigma point moves by `velocity` in each advance.
+class MovingSurface : public FixedSurface {
+ public:
+  MovingSurface(Eigen::MatrixXd positions, const Eigen::Vector3d& velocity)
+      : FixedSurface(positions), positions_(std::move(positions)), velocity_(velocity) {}
+  StepReport advance(const Eigen::Vector3d&) override {
+    for (Eigen::Index i = 0; i < positions_.rows(); i += 3) positions_.middleRows(i, 3).colwise() += velocity_;
+    return {};
+  }
+  void predicted_observations(Eigen::MatrixXd& y) const override { y = positions_; }
+
+ private:
+  Eigen::MatrixXd positions_;
+  Eigen::Vector3d velocity_;
+};
+
 // The unit tetrahedron's surface nodes, the same for `S` sigma points.
 Eigen::MatrixXd tetrahedron_positions(const BoundarySurface& surface, int S) {
   const Mesh mesh = unit_tetrahedron();
@@ -80,6 +96,33 @@ TEST(PointCloudObservationTest, EachSigmaPointMovesItsObservationByItsOwnDisplac
   EXPECT_NEAR(h(0, 2), h(0, 0), 1e-15);
 }
 
+// A point taken 40% into a step in which the organ moves 1 mm along z is observed on the
+// surface where it was then, not where it is at the step's end.
+TEST(PointCloudObservationTest, APointTakenInsideAStepIsObservedOnTheSurfaceOfItsTime) {
+  const BoundarySurface surface = boundary_surface(unit_tetrahedron());
+  PointCloudObservation cloud(std::make_unique<MovingSurface>(tetrahedron_positions(surface, 2),
+                                                              Eigen::Vector3d(0.0, 0.0, 1e-3)),
+                              surface.triangles, 2);
+  Eigen::Matrix3Xd frame(3, 2);
+  frame.col(0) = Eigen::Vector3d(0.25, 0.25, 0.4e-3);   // on the face z = 0 at 40% of the step
+  frame.col(1) = Eigen::Vector3d(0.25, 0.25, 1e-3);     // on it at the step's end
+  cloud.set_frame(frame, Eigen::Vector2d(0.4, 1.0));
+  cloud.advance(Eigen::Vector3d::Zero());
+  Eigen::MatrixXd h;
+  cloud.predicted_observations(h);
+  EXPECT_NEAR(h(0, 0), 0.0, 1e-15);
+  EXPECT_NEAR(h(1, 0), 0.0, 1e-15);
+  // Taken as at the step's end, the first point would lie 0.6 mm outside (below) the face,
+  // now at z = 1 mm: h = n . (x - p) = -0.6 mm with n = -z.
+  PointCloudObservation at_end(std::make_unique<MovingSurface>(tetrahedron_positions(surface, 2),
+                                                               Eigen::Vector3d(0.0, 0.0, 1e-3)),
+                               surface.triangles, 2);
+  at_end.set_frame(frame);
+  at_end.advance(Eigen::Vector3d::Zero());
+  at_end.predicted_observations(h);
+  EXPECT_NEAR(h(0, 0), -0.6e-3, 1e-15);
+}
+
 TEST(PointCloudObservationTest, AnEmptyFrameObservesNothingAndBadInputIsRefused) {
   const BoundarySurface surface = boundary_surface(unit_tetrahedron());
   PointCloudObservation cloud(std::make_unique<FixedSurface>(tetrahedron_positions(surface, 2)), surface.triangles, 2);
@@ -88,6 +131,9 @@ TEST(PointCloudObservationTest, AnEmptyFrameObservesNothingAndBadInputIsRefused)
   cloud.predicted_observations(h);
   EXPECT_TRUE(h.isZero());
   EXPECT_THROW(cloud.set_frame(Eigen::Matrix3Xd::Zero(3, 3)), std::invalid_argument) << "3 points, made for 2";
+  EXPECT_THROW(cloud.set_frame(Eigen::Matrix3Xd::Zero(3, 2), Eigen::Vector2d(0.5, 0.0)), std::invalid_argument)
+      << "a share of 0 is the step before's end";
+  EXPECT_THROW(cloud.set_frame(Eigen::Matrix3Xd::Zero(3, 2), Eigen::Vector3d::Ones()), std::invalid_argument);
   std::vector<std::array<int, 3>> bad = surface.triangles;
   bad[0][1] = 4;   // the tetrahedron has 4 surface nodes: 0..3
   EXPECT_THROW(PointCloudObservation(std::make_unique<FixedSurface>(tetrahedron_positions(surface, 2)), bad, 2),

@@ -12,6 +12,7 @@
 #include <string>
 #include <vector>
 
+#include "host/common/input_error.h"
 #include "host/data/point_cloud_table.h"
 #include "host/scenario/scenario.h"
 
@@ -204,6 +205,38 @@ TEST_F(GenerateTest, SurfaceCloudsHaveAFramePerStepWithTheScenarioNoise) {
   EXPECT_EQ(thinned.point_count(), clean.point_count() - faulty.dropouts);
   EXPECT_NEAR(faulty.dropouts, 0.1 * clean.point_count(), 5.0 * std::sqrt(0.09 * clean.point_count()));
   EXPECT_NEAR(faulty.outliers, 0.05 * clean.point_count(), 5.0 * std::sqrt(0.0475 * clean.point_count()));
+}
+
+// --gap-steps: a tracked point is lost for runs of steps of the given mean length, the
+// missing share staying --dropouts. The liver's twelve points over 2000 steps: about 120 gaps.
+TEST_F(GenerateTest, GapsLastTheirMeanLengthAndKeepTheMissingShare) {
+  scenario_ = load_scenario(std::string(SIGMAFEM_SOURCE_DIR) + "/scenarios/liver.json");
+  scenario_.events.clear();
+  GenerateOptions options;
+  options.out_dir = (dir_ / "gaps").string();
+  options.vtk_every = 0;
+  options.dropouts = 0.1;
+  options.gap_steps = 20.0;
+  std::ostringstream log;
+  const GenerateResult result = generate(scenario_, options, log);
+  const auto rows = read_rows(dir_ / "gaps" / "observations.csv");
+  int gaps = 0, missing = 0, point_steps = 0;
+  for (std::size_t p = 0; p < 12; ++p) {
+    bool in_gap = false;
+    for (std::size_t k = 1; k < rows.size(); ++k) {
+      const bool lost = std::isnan(rows[k][5 + 3 * p]);
+      gaps += lost && !in_gap;
+      missing += lost;
+      ++point_steps;
+      in_gap = lost;
+    }
+  }
+  EXPECT_EQ(missing, result.dropouts);
+  EXPECT_NEAR(static_cast<double>(missing) / point_steps, 0.1, 0.03);
+  EXPECT_NEAR(static_cast<double>(missing) / gaps, 20.0, 5.0) << gaps << " gaps";
+  scenario_ = load_scenario(std::string(SIGMAFEM_SOURCE_DIR) + "/scenarios/liver_cloud.json");
+  options.out_dir = (dir_ / "cloud").string();
+  EXPECT_THROW(generate(scenario_, options, log), InputError) << "a cloud's points have no identity to lose";
 }
 
 }  // namespace
