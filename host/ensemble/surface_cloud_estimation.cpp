@@ -3,7 +3,10 @@
 #include <algorithm>
 #include <cmath>
 
+#include <unistd.h>
+
 #include "host/common/input_error.h"
+#include "host/data/csv_format.h"
 #include "host/ensemble/make_ensemble.h"
 
 namespace sigmafem {
@@ -20,6 +23,14 @@ SurfaceCloudEstimation make_surface_cloud_estimation(const std::string& backend,
   if (max_points == 0)
     throw InputError("point cloud " + path + ": no frame after the rest state (t > 0); nothing to compare the "
                      "model with");
+  // The data matrix and the run's innovations and their stds are rows x max_points each:
+  // refuse what would not fit in half the memory before allocating it.
+  const double needed = 3.0 * 8.0 * static_cast<double>(rows) * static_cast<double>(max_points);
+  const double available = static_cast<double>(::sysconf(_SC_PHYS_PAGES)) * static_cast<double>(::sysconf(_SC_PAGE_SIZE));
+  if (available > 0.0 && needed > 0.5 * available)
+    throw InputError("point cloud " + path + ": " + std::to_string(rows) + " steps of up to " + std::to_string(max_points) +
+                     " points need about " + format_number(std::ceil(needed / 1e9)) + " GB, more than half of this "
+                     "machine's memory; sample the frames down or estimate fewer steps per run");
   estimation.measured = Eigen::MatrixXd::Constant(rows, max_points, std::nan(""));
   for (std::size_t k = 0; k < estimation.frames.size(); ++k)
     estimation.measured.row(static_cast<Eigen::Index>(k)).head(estimation.frames[k].points.cols()).setZero();

@@ -33,7 +33,8 @@ struct SurfaceCloudEstimation {
 
 // The estimation of `model` (on `mesh`'s boundary surface) from `cloud` over `rows` data rows
 // of `dt`, on `backend` (make_ensemble). Throws InputError naming `path` when no frame lies
-// after the rest state, or one lies after the last row.
+// after the rest state, one lies after the last row, or the run's tables (rows x the most
+// points of a step, three of them) would take more than half the machine's memory.
 SurfaceCloudEstimation make_surface_cloud_estimation(const std::string& backend, const Model& model,
                                                      const Mesh& mesh, const std::vector<int>& estimated,
                                                      int sigma_count, const DeviceOptions& device,

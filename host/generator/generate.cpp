@@ -177,28 +177,22 @@ GenerateResult generate(const Scenario& scenario, const GenerateOptions& options
   auto keep_with_faults = [&](Eigen::Vector3d& point, int* lost) {
     if (options.outliers <= 0.0 && options.dropouts <= 0.0) return true;
     const double draw = uniform(faults);
+    bool dropped = draw < options.dropouts;
+    double outliers_from = options.dropouts;   // draws in [from, from + outliers): an outlier
     if (lost && options.gap_steps > 1.0) {
       // Gaps: a lost point stays lost; else it is lost now with probability gap_start, for a
       // geometric number of steps of mean gap_steps (this one included).
       if (*lost == 0 && draw < gap_start)
         *lost = 1 + static_cast<int>(std::floor(std::log1p(-uniform(faults)) / std::log1p(-1.0 / options.gap_steps)));
-      if (*lost > 0) {
-        --*lost;
-        ++result.dropouts;
-        return false;
-      }
-      if (draw < gap_start + options.outliers) {
-        Eigen::Vector3d away(direction.next(), direction.next(), direction.next());
-        point += away * (0.01 + 0.01 * uniform(faults)) / away.norm();
-        ++result.outliers;
-      }
-      return true;
+      dropped = *lost > 0;
+      if (dropped) --*lost;
+      outliers_from = gap_start;
     }
-    if (draw < options.dropouts) {
+    if (dropped) {
       ++result.dropouts;
       return false;
     }
-    if (draw < options.dropouts + options.outliers) {
+    if (draw >= outliers_from && draw < outliers_from + options.outliers) {
       Eigen::Vector3d away(direction.next(), direction.next(), direction.next());
       point += away * (0.01 + 0.01 * uniform(faults)) / away.norm();
       ++result.outliers;

@@ -47,8 +47,8 @@ struct ExperimentData {
   GenerateResult generated;
 };
 
-// Measured data's faults in the data of OutliersDropoutsAndGaps (issue 15): 5% of the
-// point-steps 1-2 cm off, 10% missing.
+// Measured data's faults in the data of OutliersAndDropouts and LongGaps (issue 15): 5% of
+// the point-steps 1-2 cm off, 10% missing.
 constexpr double kOutliers = 0.05;
 constexpr double kDropouts = 0.10;
 
@@ -287,12 +287,11 @@ INSTANTIATE_TEST_SUITE_P(HalfAMillimetre, NoisyEstimationTest, ::testing::Values
                          });
 
 // Measured data's faults (issue 15): the box at 0.5 mm noise, its first 600 steps (before the
-// cut), with 5% of the point-steps 1-2 cm off and 10% missing, step by step or in gaps. With
-// the outlier gate (filter/outlier_gate.h) the error stays within 1.5x of that on the same
+// cut), with 5% of the point-steps 1-2 cm off and 10% missing. With the outlier gate (filter/outlier_gate.h) the error stays within 1.5x of that on the same
 // data without the faults and the truth inside +-2 std on 90% of the steps; the gate leaves
 // out nearly every outlier and none of the clean data; without it the outliers pull the
 // estimates away.
-TEST(BoxEstimation, OutliersDropoutsAndGapsCostLittleWithTheOutlierGate) {
+TEST(BoxEstimation, OutliersAndDropoutsCostLittleWithTheOutlierGate) {
   constexpr int kSteps = 600;
   const ExperimentData& clean = experiment_data("box", false, false, false, kSteps);
   const ExperimentData& faulty = experiment_data("box", false, false, true, kSteps);
@@ -323,17 +322,28 @@ TEST(BoxEstimation, OutliersDropoutsAndGapsCostLittleWithTheOutlierGate) {
   EXPECT_TRUE(!(without_gate <= 1.2 * with_gate.mean_abs_error))
       << "the outliers did not matter without the gate: the test shows nothing";
 
-  // Gaps: the same 10% missing in runs of 50 steps on average (a tracker losing a point for
-  // half a second; generate --gap-steps), with the outliers. Measured at stop 34 (seed 1):
-  // 12.7 N/m; seeds 2 and 3 by hand 13.2 against 13.9 clean, 12.9 against 13.1 (README).
-  const ExperimentData& gaps = experiment_data("box", false, false, true, kSteps, 50.0);
+}
+
+// Gaps (issue 15, item 3): the liver's first 1000 steps at 0.5 mm noise with its 10% of
+// point-steps missing in runs of 50 steps on average (a tracker losing a point for half a
+// second; generate --gap-steps) and the 5% outliers, the gate on: the error within 1.5x of
+// the clean data's, the truth inside +-2 std on 90% of the steps. Measured at stop 34,
+// seed 1: 25.2 against 24.7 N/m; seeds 2 and 3 by hand 25.7 against 29.1, 19.6 against 17.6.
+TEST(LiverEstimation, LongGapsCostLittle) {
+  constexpr int kSteps = 1000;
+  const ExperimentData& clean = experiment_data("liver", false, false, false, kSteps);
+  const ExperimentData& gaps = experiment_data("liver", false, false, true, kSteps, 50.0);
+  const double sigma = clean.scenario.filter->observation_std;
+  const ExperimentRun reference = run_experiment(clean, SigmaPointSet::simplex, sigma, clean.observations.points, true);
   const ExperimentRun gapped = run_experiment(gaps, SigmaPointSet::simplex, sigma, gaps.observations.points, true);
-  ASSERT_TRUE(gapped.run.complete) << gapped.run.stop_reason;
-  const PhaseErrors with_gaps = phase_of(gapped);
-  EXPECT_LE(with_gaps.mean_abs_error, 1.5 * without_faults.mean_abs_error);
-  EXPECT_GE(with_gaps.coverage, kCoverageAtHalfAMillimetre);
+  ASSERT_TRUE(reference.run.complete && gapped.run.complete) << gapped.run.stop_reason;
+  const PhaseErrors without = error_figures(reference.steps, reference.estimate, reference.std_dev, reference.truth).at(0);
+  const PhaseErrors with = error_figures(gapped.steps, gapped.estimate, gapped.std_dev, gapped.truth).at(0);
+  EXPECT_LE(with.mean_abs_error, 1.5 * without.mean_abs_error);
+  EXPECT_GE(with.coverage, kCoverageAtHalfAMillimetre);
   std::cout << "gaps of 50 steps on average (" << gaps.generated.dropouts << " point-steps missing): mean |error| "
-            << with_gaps.mean_abs_error << " N/m, coverage " << 100.0 * with_gaps.coverage << "%\n";
+            << with.mean_abs_error << " N/m against " << without.mean_abs_error << " N/m clean, coverage "
+            << 100.0 * with.coverage << "%\n";
 }
 
 }  // namespace
