@@ -474,6 +474,28 @@ InnovationSeries innovation_series(const EstimationRun& run) {
   return series;
 }
 
+InnovationSeries step_means(const InnovationSeries& series) {
+  InnovationSeries means = series;
+  const Eigen::Index N = series.innovation.rows();
+  means.innovation = Eigen::MatrixXd::Constant(N, 1, kNan);
+  means.innovation_std = Eigen::MatrixXd::Constant(N, 1, kNan);
+  for (Eigen::Index k = 0; k < N; ++k) {
+    double sum = 0.0, variance = 0.0;
+    int m = 0;
+    for (Eigen::Index i = 0; i < series.innovation.cols(); ++i) {
+      const double z = series.innovation(k, i), s = series.innovation_std(k, i);
+      if (!std::isfinite(z) || !std::isfinite(s)) continue;
+      sum += z;
+      variance += s * s;
+      ++m;
+    }
+    if (m == 0) continue;
+    means.innovation(k, 0) = sum / m;
+    means.innovation_std(k, 0) = std::sqrt(variance) / m;
+  }
+  return means;
+}
+
 ResidualDiagnostics diagnose_residuals(const InnovationSeries& series, const Eigen::MatrixX3d& positions,
                                        const ResidualDiagnosticsOptions& options) {
   const auto N_all = static_cast<Eigen::Index>(series.steps.size());
@@ -483,7 +505,7 @@ ResidualDiagnostics diagnose_residuals(const InnovationSeries& series, const Eig
       static_cast<Eigen::Index>(series.observed_rows.size()) != N_all ||
       (!series.catching_up.empty() && static_cast<Eigen::Index>(series.catching_up.size()) != N_all))
     throw std::invalid_argument("diagnose_residuals: the series' parts have different numbers of steps or rows");
-  if (3 * positions.rows() != n)
+  if (positions.rows() != 0 && 3 * positions.rows() != n)
     throw std::invalid_argument("diagnose_residuals: " + std::to_string(positions.rows()) +
                                 " observed points for " + std::to_string(n) + " innovation rows");
   if (!(options.false_alarm > 0.0 && options.false_alarm < 1.0) || options.max_lag < 1)
@@ -522,7 +544,7 @@ ResidualDiagnostics diagnose_residuals(const InnovationSeries& series, const Eig
   nis_tests(series, d.used, level, d);
   whiteness_tests(X, options.max_lag, level, d);
   bias_tests(Z, level, d);
-  spatial_pattern(Z, positions, level, d);
+  if (positions.rows() > 0) spatial_pattern(Z, positions, level, d);
   d.verdict.consistency = d.verdict.failed().empty() ? Consistency::consistent : Consistency::inconsistent;
   return d;
 }

@@ -58,6 +58,16 @@ struct InnovationSeries {
 // diagnostics skip them).
 InnovationSeries innovation_series(const EstimationRun& run);
 
+// For observations without identity (a surface point cloud: each step's rows are other
+// points), the tests that follow a row over the steps have no row to follow. This series has
+// one row per step instead: the step's mean innovation over its observed rows (the mean
+// signed distance of the cloud from the model's surface), with the std of that mean as if the
+// rows were independent; the NIS and its degrees of freedom stay the step's own. Its bias
+// test asks whether the cloud lies off the surface on average, its whiteness whether that
+// offset persists from step to step; there is no spatial pattern (diagnose_residuals with no
+// positions).
+InnovationSeries step_means(const InnovationSeries& series);
+
 struct ResidualDiagnosticsOptions {
   int burn_in_steps = -1;      // first steps left out while the filter settles; -1: 10% of the run
   int max_lag = 10;            // whiteness over lags 1..max_lag (at most a fifth of the steps)
@@ -166,7 +176,8 @@ struct ResidualDiagnostics {
 Eigen::MatrixX3d mean_observed_positions(const Eigen::MatrixXd& points);
 
 // `positions` (m x 3): where the observed points are (e.g. their mean observed position),
-// for the rigid part of the pattern. Throws std::invalid_argument when the sizes disagree.
+// for the rigid part of the pattern; none (0 rows): no spatial pattern and no rigid_bias test
+// (step_means' series). Throws std::invalid_argument when the sizes disagree.
 ResidualDiagnostics diagnose_residuals(const InnovationSeries& series, const Eigen::MatrixX3d& positions,
                                        const ResidualDiagnosticsOptions& options = {});
 

@@ -110,6 +110,7 @@ json run_estimation_job(const Scenario& scenario, const EstimationJob& job) {
   // the same points from one step to the next, and the report leaves them out).
   if (!cloud) report.observed_positions = mean_observed_positions(table.points);
   report.observations = observations;
+  report.surface_cloud = cloud.has_value();
   report.total_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   return write_estimation_report(report, run);
 }

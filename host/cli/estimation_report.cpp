@@ -231,10 +231,12 @@ nlohmann::ordered_json write_estimation_report(const EstimationReport& report, c
   }
 
   // Residual diagnostics (issue 6): does the model explain the data?
-  const InnovationSeries series = innovation_series(run);
+  const InnovationSeries series = report.surface_cloud ? step_means(innovation_series(run)) : innovation_series(run);
   std::optional<ResidualDiagnostics> residual;
-  if (!run.steps.empty() && 3 * report.observed_positions.rows() == series.innovation.cols()) {
-    residual = diagnose_residuals(series, report.observed_positions, report.residual);
+  if (!run.steps.empty() &&
+      (report.surface_cloud || 3 * report.observed_positions.rows() == series.innovation.cols())) {
+    residual = diagnose_residuals(series, report.surface_cloud ? Eigen::MatrixX3d() : report.observed_positions,
+                                  report.residual);
     json residual_file = residual_json(*residual, report.residual);
     residual_file["adaptive_noise"] = summary["adaptive_noise"];
     write_file_atomically(output.staged("residual.json"), residual_file.dump(2) + "\n");

@@ -32,6 +32,8 @@ struct EstimationReport {
   ResidualDiagnosticsOptions residual;        // burn-in, lags, false-alarm rate
   bool outlier_gate = false;                  // whether the run gated outliers
   nlohmann::ordered_json observations;        // summary.json's "observations": their kind and count
+  bool surface_cloud = false;                 // the rows are a cloud's points: the residual tests
+                                              // judge the step means (step_means)
   double total_seconds = 0.0;
 };
 

@@ -353,7 +353,11 @@ TEST_F(CliTest, SurfaceCloudsAreGeneratedAndEstimated) {
   EXPECT_EQ(summary["observations"]["kind"], "surface_cloud");
   EXPECT_EQ(summary["observations"]["frames"], 30);
   EXPECT_LT(summary["observations"]["points"].get<int>(), 30 * 200) << "dropouts thin the frames";
-  EXPECT_TRUE(summary["residual"].is_null()) << "the residual tests are for tracked points";
+  ASSERT_TRUE(summary["residual"].is_object()) << "a cloud's residual is judged by its step means";
+  std::ifstream residual_file(dir_ / "estimate" / "residual.json");
+  const json residual = json::parse(residual_file);
+  EXPECT_EQ(residual["bias"]["rows"].size(), 1u) << "one row: the step's mean signed distance";
+  EXPECT_TRUE(residual["spatial"]["points"].empty());
 
   fs::remove(dir_ / "data" / "pointcloud.csv");
   const CommandRun missing = run_sigmafem("estimate " + cloud_json + " --data " + (dir_ / "data").string() +

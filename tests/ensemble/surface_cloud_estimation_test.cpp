@@ -11,12 +11,14 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <iostream>
 #include <sstream>
 #include <string>
 
 #include "filter/error_figures.h"
 #include "filter/estimation.h"
+#include "filter/residual_diagnostics.h"
 #include "host/data/observation_table.h"
 #include "host/data/truth_table.h"
 #include "host/generator/generate.h"
@@ -114,6 +116,10 @@ TEST(LiverCloudEstimation, OutliersAndDropoutsCostLittleWithTheOutlierGate) {
   ASSERT_TRUE(clean.run.complete && faulty.run.complete) << clean.run.stop_reason << faulty.run.stop_reason;
   EXPECT_LE(faulty.phase.mean_abs_error, 1.5 * clean.phase.mean_abs_error);
   EXPECT_GE(faulty.phase.coverage, 0.9);
+  // The clean clouds' residual is consistent (the step means' tests, filter/residual_diagnostics.h).
+  const ResidualDiagnostics verdict = diagnose_residuals(step_means(innovation_series(clean.run)), {});
+  EXPECT_EQ(verdict.verdict.consistency, Consistency::consistent)
+      << "failed: " << ::testing::PrintToString(verdict.verdict.failed());
   std::cout << "liver clouds at 0.5 mm: mean |error| " << clean.phase.mean_abs_error << " N/m without faults (coverage "
             << 100.0 * clean.phase.coverage << "%), " << faulty.phase.mean_abs_error << " N/m with them (coverage "
             << 100.0 * faulty.phase.coverage << "%); outliers generated " << faulty.generated.outliers
@@ -132,6 +138,27 @@ TEST(LiverCloudEstimation, FramesAtTheirOwnTimesAreAsGoodAsFramesOnTheStepGrid) 
   EXPECT_LE(own_times.phase.mean_abs_error, 1.1 * on_grid.phase.mean_abs_error);
   std::cout << "liver clouds at 30 Hz, noise-free: mean |error| " << own_times.phase.mean_abs_error
             << " N/m with 3 ms jitter, " << on_grid.phase.mean_abs_error << " N/m on the step grid\n";
+}
+
+// Residual diagnostics on clouds (issue 15, item 4 in part): an undeclared camera offset of
+// 3 mm across the view moves the cloud off the model's surface; the step means' tests see it
+// (measured at stop 34: nis_mean, nis_above_band, whiteness, whiteness_rows and bias_rows
+// failed; the clean data's verdict above is consistent, as on seeds 2 and 3 by hand).
+// Not asked here, because it does not hold yet: that the filter completes. It diverges at
+// step 72 (the left ligament past 1e9 N/m; 1 mm: step 129): the adaptive noise, which keeps
+// the filter stable under model error on tracked points, takes its strength from the
+// correlation of each row's unexplained innovation from step to step, and a cloud's rows are
+// other points at every step (issue 15's note at stop 34 says what would give them identity).
+// The verdict is taken over the steps made.
+TEST(LiverCloudEstimation, AnUndeclaredCameraOffsetMakesTheResidualInconsistent) {
+  GenerateOptions offset;
+  offset.inject.push_back({"camera_offset", {0.003, 0.0, 0.0}});
+  const CloudRun run = run_liver_cloud(5e-4, 5e-4, offset, true);
+  const ResidualDiagnostics verdict = diagnose_residuals(step_means(innovation_series(run.run)), {});
+  EXPECT_EQ(verdict.verdict.consistency, Consistency::inconsistent);
+  const std::vector<std::string> failed = verdict.verdict.failed();
+  EXPECT_NE(std::find(failed.begin(), failed.end(), "bias_rows"), failed.end())
+      << "the cloud lies off the surface on average: " << ::testing::PrintToString(failed);
 }
 
 }  // namespace

@@ -118,6 +118,33 @@ TEST(ResidualDiagnostics, DISABLED_FalseAlarmRateOverManySeeds) {
   EXPECT_LE(inconsistent, runs / 100) << "above the 1% the options ask for";
 }
 
+// step_means: one row per step, the mean of its observed rows and that mean's std as if they
+// were independent; the NIS and its dof untouched; diagnose_residuals takes it with no
+// positions (no spatial pattern, no rigid_bias test).
+TEST(ResidualDiagnostics, StepMeansReduceACloudToOneRowPerStep) {
+  InnovationSeries series;
+  series.steps = {1, 2};
+  series.times = {0.01, 0.02};
+  series.innovation.resize(2, 3);
+  series.innovation << 1.0, 2.0, NAN, 4.0, NAN, NAN;
+  series.innovation_std.resize(2, 3);
+  series.innovation_std << 3.0, 4.0, NAN, 2.0, NAN, NAN;
+  series.normalised_innovation = Eigen::Vector2d(5.0, 6.0);
+  series.observed_rows = {2, 1};
+  const InnovationSeries means = step_means(series);
+  ASSERT_EQ(means.innovation.cols(), 1);
+  EXPECT_EQ(means.innovation(0, 0), 1.5);
+  EXPECT_EQ(means.innovation_std(0, 0), 2.5) << "sqrt(9 + 16) / 2";
+  EXPECT_EQ(means.innovation(1, 0), 4.0);
+  EXPECT_EQ(means.innovation_std(1, 0), 2.0);
+  EXPECT_EQ(means.normalised_innovation, series.normalised_innovation);
+  EXPECT_EQ(means.observed_rows, series.observed_rows);
+
+  const ResidualDiagnostics d = diagnose_residuals(step_means(synthetic_series(3)), Eigen::MatrixX3d());
+  EXPECT_EQ(d.verdict.consistency, Consistency::consistent) << describe(d);
+  for (const DiagnosticTest& test : d.verdict.tests) EXPECT_NE(test.name, "rigid_bias");
+}
+
 TEST(ResidualDiagnostics, ABiasOnOneRowIsFlagged) {
   Eigen::VectorXd offset = Eigen::VectorXd::Zero(kRows);
   const int row = 3 * 5 + 1;                       // point 5, axis y
