@@ -126,7 +126,9 @@ void plot_innovation(const EstimationReport& report, const EstimationRun& run, c
   for (const EstimationStep& step : run.steps)
     data.rows.push_back({step.time, 1e3 * step.innovation_rms, step.change_detected ? 1e3 * step.innovation_rms : NAN});
   std::ostringstream script;
-  script << "set output $output\nset title 'Innovation RMS (observed - predicted position), "
+  // A cloud's innovation is each point's signed distance from the model's surface.
+  const char* what = report.surface_cloud ? "signed distance of the cloud from the surface" : "observed - predicted position";
+  script << "set output $output\nset title 'Innovation RMS (" << what << "), "
          << report.scenario_name << "'\nset xlabel 'time (s)'\nset ylabel 'innovation RMS (mm)'\n"
          << "set logscale y\nset grid\nset datafile missing 'nan'\n"
          << "plot $data using 1:2 with lines lw 2 lc rgb '#1f77b4' title 'innovation RMS', "
