@@ -4,9 +4,9 @@
 // surface with it, once per filter step, for hundreds to thousands of points: the triangles
 // sit in a uniform grid of cells about a triangle in size, and a query visits shells of cells
 // around the point until no unvisited cell can hold a nearer triangle. Eigen's KdBVH
-// (unsupported/Eigen/BVH) was tried first: 1.0 us a query on the liver's 276 triangles, 70%
-// of it in its best-first traversal (a priority queue per query), against 0.2 us here
-// (bench/RESULTS.md, "Point clouds").
+// (unsupported/Eigen/BVH) was tried first: with it the observation of 1000 points on the
+// liver's 276 triangles took 1.33 ms, 70% of it in its best-first traversal (a priority queue
+// per query), against 0.45 ms with the grid (bench/RESULTS.md, "Point clouds").
 #pragma once
 
 #include <Eigen/Core>
