@@ -80,16 +80,21 @@ std::unique_ptr<Ensemble> make_bench_ensemble(const Backend& backend, const Scen
   return ensemble;
 }
 
+// Gives the ensemble's sigma points stiffnesses spread around the scenario's.
+void spread_parameters(Ensemble& ensemble, const Scenario& s, const Model& model) {
+  Eigen::MatrixXd theta(ensemble.parameter_count(), ensemble.sigma_count());
+  for (Eigen::Index j = 0; j < theta.rows(); ++j)
+    for (Eigen::Index k = 0; k < theta.cols(); ++k)
+      theta(j, k) = std::log(model.ligaments[s.filter->estimate[j]].stiffness) + 0.3 * std::sin(k + j);
+  ensemble.set_parameters(theta);
+}
+
 // An ensemble of S sigma points with stiffnesses spread around the scenario's, advanced a
 // few steps so that the organ is deformed and CG warm-starts as in a run.
 std::unique_ptr<Ensemble> warmed_up(const Backend& backend, const Scenario& s, const Model& model,
                                     int S, int& step) {
   auto ensemble = make_bench_ensemble(backend, s, model, S);
-  Eigen::MatrixXd theta(ensemble->parameter_count(), S);
-  for (int j = 0; j < theta.rows(); ++j)
-    for (int k = 0; k < S; ++k)
-      theta(j, k) = std::log(model.ligaments[s.filter->estimate[j]].stiffness) + 0.3 * std::sin(k + j);
-  ensemble->set_parameters(theta);
+  spread_parameters(*ensemble, s, model);
   for (step = 1; step <= 5; ++step) ensemble->advance(bench::so_position(s, step));
   return ensemble;
 }
@@ -214,15 +219,21 @@ struct CloudBench {
   }
 };
 
-void BM_cloud_filter_step(benchmark::State& state, const Backend& backend) {
-  const int points = static_cast<int>(state.range(0));
-  std::unique_ptr<CloudBench> b;
+// The CloudBench of state.range(0) points on `backend`, or none with the benchmark skipped
+// (the back end cannot run here).
+std::unique_ptr<CloudBench> make_cloud_bench(benchmark::State& state, const Backend& backend) {
   try {
-    b = std::make_unique<CloudBench>(backend, points);
+    return std::make_unique<CloudBench>(backend, static_cast<int>(state.range(0)));
   } catch (const std::exception& e) {
     state.SkipWithError(e.what());
-    return;
+    return nullptr;
   }
+}
+
+void BM_cloud_filter_step(benchmark::State& state, const Backend& backend) {
+  const int points = static_cast<int>(state.range(0));
+  const std::unique_ptr<CloudBench> b = make_cloud_bench(state, backend);
+  if (!b) return;
   RoukfOptions options = estimation_options(b->s).roukf;
   options.sigma_points = SigmaPointSet::simplex;
   Roukf filter(options, *b->ensemble);
@@ -241,18 +252,9 @@ void BM_cloud_filter_step(benchmark::State& state, const Backend& backend) {
 
 void BM_cloud_observation(benchmark::State& state, const Backend& backend) {
   const int points = static_cast<int>(state.range(0));
-  std::unique_ptr<CloudBench> b;
-  try {
-    b = std::make_unique<CloudBench>(backend, points);
-  } catch (const std::exception& e) {
-    state.SkipWithError(e.what());
-    return;
-  }
-  Eigen::MatrixXd theta(b->ensemble->parameter_count(), b->ensemble->sigma_count());
-  for (Eigen::Index j = 0; j < theta.rows(); ++j)
-    for (Eigen::Index k = 0; k < theta.cols(); ++k)
-      theta(j, k) = std::log(b->model.ligaments[b->s.filter->estimate[j]].stiffness) + 0.3 * std::sin(k + j);
-  b->ensemble->set_parameters(theta);
+  const std::unique_ptr<CloudBench> b = make_cloud_bench(state, backend);
+  if (!b) return;
+  spread_parameters(*b->ensemble, b->s, b->model);
   Eigen::MatrixXd h;
   for (int i = 0; i < 5; ++i) b->ensemble->advance(b->observe());
   for (auto _ : state) {

@@ -56,6 +56,10 @@ class Ensemble {
   virtual StepReport advance(const Eigen::Vector3d& so_position) = 0;
   // 3m x S: the observed nodes' positions of every sigma point.
   virtual void predicted_observations(Eigen::MatrixXd& y) const = 0;
+  // The consecutive rows of y that belong to one measured point: 3 for a tracked point
+  // (x, y, z), 1 for a point of a surface cloud (its distance; filter/point_cloud_observation.h).
+  // The outlier gate leaves points out, all their rows together.
+  virtual int rows_per_point() const { return 3; }
   virtual void recenter(const Recentering& recentering) = 0;
 };
 

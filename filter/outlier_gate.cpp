@@ -7,11 +7,12 @@
 namespace sigmafem {
 
 std::vector<int> gate_outliers(const OutlierGateOptions& options, const std::vector<int>& rows,
-                               const Eigen::VectorXd& innovation, const Eigen::VectorXd& variance) {
+                               const Eigen::VectorXd& innovation, const Eigen::VectorXd& variance,
+                               int rows_per_point) {
   std::vector<int> outliers;
   if (!options.enabled) return outliers;
   int points = 0;
-  const int per_point = options.rows_per_point;
+  const int per_point = rows_per_point;
   std::vector<double> threshold_of;   // by rows observed; -1: not computed yet
   // The rows of one point are consecutive in `rows` (increasing data rows).
   for (std::size_t begin = 0; begin < rows.size();) {

@@ -32,14 +32,13 @@ struct OutlierGateOptions {
   // them outliers, 3 or 4 at once happen on 1-2% of the steps (a quarter left 11% of the
   // outliers in, BoxEstimation.OutliersAndDropouts...), while a change moves them all.
   double max_share = 0.5;
-  // The data rows of one point: 3 for a tracked point (x, y, z), 1 for a point of a surface
-  // cloud (its distance to the surface, filter/point_cloud_observation.h).
-  int rows_per_point = 3;
 };
 
-// The points (data row / rows_per_point) of one step to leave out. `rows` are the observed data rows
+// The points (data row / rows_per_point, Ensemble::rows_per_point) of one step to leave out.
+// `rows` are the observed data rows
 // (increasing), `innovation` and `variance` the step's z_bar and diag(S) on them.
 std::vector<int> gate_outliers(const OutlierGateOptions& options, const std::vector<int>& rows,
-                               const Eigen::VectorXd& innovation, const Eigen::VectorXd& variance);
+                               const Eigen::VectorXd& innovation, const Eigen::VectorXd& variance,
+                               int rows_per_point = 3);
 
 }  // namespace sigmafem

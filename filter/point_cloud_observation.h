@@ -57,6 +57,7 @@ class PointCloudObservation : public Ensemble {
   // max_points x S: h_s(p) for the frame's points, 0 beyond them.
   void predicted_observations(Eigen::MatrixXd& y) const override;
   void recenter(const Recentering& recentering) override { surface_->recenter(recentering); }
+  int rows_per_point() const override { return 1; }   // one distance per measured point
 
  private:
   std::unique_ptr<Ensemble> surface_;

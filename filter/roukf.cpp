@@ -122,12 +122,13 @@ RoukfStep Roukf::step(const Eigen::Vector3d& so_position, const Eigen::VectorXd&
     const double variance = options_.observation_std * options_.observation_std;
     const Eigen::VectorXd S_diag =
         (alpha * Z * I.transpose()).rowwise().squaredNorm().array() + variance;
-    result.outliers = gate_outliers(options_.outlier_gate, rows, alpha * Z.rowwise().sum(), S_diag);
+    result.outliers = gate_outliers(options_.outlier_gate, rows, alpha * Z.rowwise().sum(), S_diag,
+                                    ensemble_.rows_per_point());
     if (!result.outliers.empty()) {
       std::vector<int> kept;
       std::vector<Eigen::Index> kept_rows_of_Z;
       for (std::size_t j = 0; j < rows.size(); ++j)
-        if (std::find(result.outliers.begin(), result.outliers.end(), rows[j] / options_.outlier_gate.rows_per_point) == result.outliers.end()) {
+        if (std::find(result.outliers.begin(), result.outliers.end(), rows[j] / ensemble_.rows_per_point()) == result.outliers.end()) {
           kept.push_back(rows[j]);
           kept_rows_of_Z.push_back(static_cast<Eigen::Index>(j));
         }

@@ -58,7 +58,7 @@ struct RoukfStep {
   Eigen::VectorXd innovation_variance;  // diag(S) on the observed rows, S = H P^- H^T + R
   std::vector<int> observed_indices;    // the rows of y that `innovation` holds, increasing
   int observed_rows = 0;                // rows of y that were not missing, nor an outlier's
-  std::vector<int> outliers;            // points (row / rows_per_point) the outlier gate left out
+  std::vector<int> outliers;            // points (row / Ensemble::rows_per_point) the gate left out
   double innovation_rms = 0.0;          // sqrt(mean z_bar^2) over the observed rows (NaN if none)
   double normalised_innovation = 0.0;   // z_bar^T S^-1 z_bar, S = H P^- H^T + R (chi^2, m dof)
   // log det S: with the NIS, the step's Gaussian log-likelihood of the innovation

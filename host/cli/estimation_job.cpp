@@ -2,7 +2,6 @@
 
 #include <chrono>
 #include <cmath>
-#include <algorithm>
 #include <cstdio>
 #include <filesystem>
 #include <iostream>
@@ -71,7 +70,6 @@ json run_estimation_job(const Scenario& scenario, const EstimationJob& job) {
     for (PointCloudFrame& frame : cloud_table.frames) frame.points.colwise() -= offset;
     cloud = make_surface_cloud_estimation(backend.backend, model, scenario.mesh, spec.estimate, sigma_count,
                                           job.device, cloud_table, scenario.time.dt, table.row_count(), cloud_path);
-    options.roukf.outlier_gate.rows_per_point = 1;   // one distance per point
     observations = {{"kind", "surface_cloud"},
                     {"frames", cloud_table.frames.size()},
                     {"points", cloud_table.point_count()},

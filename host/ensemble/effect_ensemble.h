@@ -51,6 +51,7 @@ class EffectEnsemble : public Ensemble {
   StepReport advance(const Eigen::Vector3d& so_position) override;
   void predicted_observations(Eigen::MatrixXd& y) const override;
   void recenter(const Recentering& recentering) override;
+  int rows_per_point() const override { return inner_->rows_per_point(); }
 
   const std::vector<const EffectDefinition*>& effects() const { return effects_; }
 

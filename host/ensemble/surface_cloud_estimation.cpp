@@ -3,9 +3,8 @@
 #include <algorithm>
 #include <cmath>
 
-#include <unistd.h>
-
 #include "host/common/input_error.h"
+#include "host/common/machine_memory.h"
 #include "host/data/csv_format.h"
 #include "host/ensemble/make_ensemble.h"
 
@@ -26,7 +25,7 @@ SurfaceCloudEstimation make_surface_cloud_estimation(const std::string& backend,
   // The data matrix and the run's innovations and their stds are rows x max_points each:
   // refuse what would not fit in half the memory before allocating it.
   const double needed = 3.0 * 8.0 * static_cast<double>(rows) * static_cast<double>(max_points);
-  const double available = static_cast<double>(::sysconf(_SC_PHYS_PAGES)) * static_cast<double>(::sysconf(_SC_PAGE_SIZE));
+  const double available = physical_memory_bytes();
   if (available > 0.0 && needed > 0.5 * available)
     throw InputError("point cloud " + path + ": " + std::to_string(rows) + " steps of up to " + std::to_string(max_points) +
                      " points need about " + format_number(std::ceil(needed / 1e9)) + " GB, more than half of this "

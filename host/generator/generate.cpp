@@ -10,9 +10,8 @@
 #include <random>
 #include <vector>
 
-#include <unistd.h>
-
 #include "host/common/atomic_file.h"
+#include "host/common/machine_memory.h"
 #include "host/common/input_error.h"
 #include "host/common/output_set.h"
 #include "host/common/progress.h"
@@ -58,7 +57,7 @@ void check_table_memory(const Scenario& scenario) {
                          static_cast<double>(scenario.ligaments.size());
   constexpr double kBytesPerValue = 8.0 + 24.0;   // the double and its text
   const double needed = (scenario.time.steps + 1.0) * columns * kBytesPerValue;
-  const double available = static_cast<double>(::sysconf(_SC_PHYS_PAGES)) * static_cast<double>(::sysconf(_SC_PAGE_SIZE));
+  const double available = physical_memory_bytes();
   if (available > 0.0 && needed > 0.5 * available)
     throw InputError("scenario " + scenario.path + ": time.steps: " + std::to_string(scenario.time.steps) +
                      " steps of " + std::to_string(scenario.observations.observed.size()) +

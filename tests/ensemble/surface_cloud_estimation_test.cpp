@@ -57,7 +57,6 @@ CloudRun run_liver_cloud(double noise, double observation_std, GenerateOptions g
 
   EstimationOptions options = test::filter_options(s, SigmaPointSet::simplex, observation_std);
   options.roukf.outlier_gate.enabled = gate;
-  options.roukf.outlier_gate.rows_per_point = 1;
   const int p = static_cast<int>(s.filter->estimate.size());
   SurfaceCloudEstimation estimation =
       make_surface_cloud_estimation("cpu", make_model(s), s.mesh, s.filter->estimate,

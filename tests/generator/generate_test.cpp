@@ -61,9 +61,13 @@ class GenerateTest : public ::testing::Test {
 
   GenerateResult run(const std::string& sub, std::uint64_t seed, int vtk_every = 0) {
     GenerateOptions options;
-    options.out_dir = (dir_ / sub).string();
     options.seed = seed;
     options.vtk_every = vtk_every;
+    return run_with(sub, options);
+  }
+  // generate with `options` (faults, gaps, ...) into `sub`.
+  GenerateResult run_with(const std::string& sub, GenerateOptions options) {
+    options.out_dir = (dir_ / sub).string();
     std::ostringstream log;
     return generate(scenario_, options, log);
   }
@@ -195,12 +199,10 @@ TEST_F(GenerateTest, SurfaceCloudsHaveAFramePerStepWithTheScenarioNoise) {
   EXPECT_NEAR(std_dev, 0.001, 0.00005) << "18000 samples: the sample std within 5%";
 
   GenerateOptions options;
-  options.out_dir = (dir_ / "faulty").string();
   options.vtk_every = 0;
   options.dropouts = 0.1;
   options.outliers = 0.05;
-  std::ostringstream log;
-  const GenerateResult faulty = generate(scenario_, options, log);
+  const GenerateResult faulty = run_with("faulty", options);
   const PointCloudTable thinned = read_point_cloud_csv((dir_ / "faulty/pointcloud.csv").string());
   EXPECT_EQ(thinned.point_count(), clean.point_count() - faulty.dropouts);
   EXPECT_NEAR(faulty.dropouts, 0.1 * clean.point_count(), 5.0 * std::sqrt(0.09 * clean.point_count()));
@@ -213,12 +215,10 @@ TEST_F(GenerateTest, GapsLastTheirMeanLengthAndKeepTheMissingShare) {
   scenario_ = load_scenario(std::string(SIGMAFEM_SOURCE_DIR) + "/scenarios/liver.json");
   scenario_.events.clear();
   GenerateOptions options;
-  options.out_dir = (dir_ / "gaps").string();
   options.vtk_every = 0;
   options.dropouts = 0.1;
   options.gap_steps = 20.0;
-  std::ostringstream log;
-  const GenerateResult result = generate(scenario_, options, log);
+  const GenerateResult result = run_with("gaps", options);
   const auto rows = read_rows(dir_ / "gaps" / "observations.csv");
   int gaps = 0, missing = 0, point_steps = 0;
   for (std::size_t p = 0; p < 12; ++p) {
@@ -235,8 +235,7 @@ TEST_F(GenerateTest, GapsLastTheirMeanLengthAndKeepTheMissingShare) {
   EXPECT_NEAR(static_cast<double>(missing) / point_steps, 0.1, 0.03);
   EXPECT_NEAR(static_cast<double>(missing) / gaps, 20.0, 5.0) << gaps << " gaps";
   scenario_ = load_scenario(std::string(SIGMAFEM_SOURCE_DIR) + "/scenarios/liver_cloud.json");
-  options.out_dir = (dir_ / "cloud").string();
-  EXPECT_THROW(generate(scenario_, options, log), InputError) << "a cloud's points have no identity to lose";
+  EXPECT_THROW(run_with("cloud", options), InputError) << "a cloud's points have no identity to lose";
 }
 
 }  // namespace
