@@ -124,7 +124,9 @@ class VtkReader {
     // Version 1.0 files have no number; anything before 5 uses the classic CELLS layout.
     if (title_line.size() >= 5) {
       const double version = parse_real(title_line.back(), in_, "the VTK file version");
-      major_version_ = static_cast<int>(std::min(version, 100.0));
+      // Clamped before the cast: a version outside int's range (fuzzing found -8.9e12) is
+      // undefined behaviour to convert, and any version below 5 reads the same.
+      major_version_ = static_cast<int>(std::clamp(version, 0.0, 100.0));
     }
     in_.require_line("the title line");
     const std::vector<std::string_view> encoding =
