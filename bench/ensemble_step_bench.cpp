@@ -202,7 +202,7 @@ struct CloudBench {
         make_bench_ensemble(backend, s, model,
                             sigma_point_count(SigmaPointSet::simplex, static_cast<int>(s.filter->estimate.size())),
                             &observed),
-        surface.triangles, points);
+        surface.triangles);
     cloud = wrapped.get();
     ensemble = std::move(wrapped);
   }
@@ -237,7 +237,7 @@ void BM_cloud_filter_step(benchmark::State& state, const Backend& backend) {
   RoukfOptions options = estimation_options(b->s).roukf;
   options.sigma_points = SigmaPointSet::simplex;
   Roukf filter(options, *b->ensemble);
-  const Eigen::VectorXd y = Eigen::VectorXd::Zero(points);
+  const Eigen::VectorXd y = Eigen::VectorXd::Zero(b->ensemble->observation_count());   // every triangle's datum is 0
   for (int i = 0; i < 5; ++i) filter.step(b->observe(), y);   // warm-up, untimed
   for (auto _ : state) {
     state.PauseTiming();

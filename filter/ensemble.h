@@ -60,6 +60,14 @@ class Ensemble {
   // (x, y, z), 1 for a point of a surface cloud (its distance; filter/point_cloud_observation.h).
   // The outlier gate leaves points out, all their rows together.
   virtual int rows_per_point() const { return 3; }
+  // Whether the last predicted_observations() predicts data row `row`: a row it does not is
+  // left out of that step as a missing datum is (a surface triangle that no point of a cloud's
+  // frame fell on, filter/point_cloud_observation.h).
+  virtual bool predicts_row(Eigen::Index /*row*/) const { return true; }
+  // The measured points the ensemble's own outlier gate left out of the last
+  // predicted_observations() (a cloud gates its points before binning them); counted with the
+  // filter's own (filter/outlier_gate.h).
+  virtual std::vector<int> rejected_points() const { return {}; }
   virtual void recenter(const Recentering& recentering) = 0;
 };
 

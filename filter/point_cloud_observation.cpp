@@ -1,6 +1,7 @@
 #include "filter/point_cloud_observation.h"
 
 #include <Eigen/Geometry>
+#include <algorithm>
 #include <cmath>
 #include <stdexcept>
 #include <string>
@@ -10,10 +11,11 @@
 namespace sigmafem {
 
 PointCloudObservation::PointCloudObservation(std::unique_ptr<Ensemble> surface,
-                                             std::vector<std::array<int, 3>> triangles, int max_points)
-    : surface_(std::move(surface)), triangles_(std::move(triangles)), max_points_(max_points) {
+                                             std::vector<std::array<int, 3>> triangles,
+                                             const PointCloudOptions& options)
+    : surface_(std::move(surface)), triangles_(std::move(triangles)), options_(options),
+      bin_size_(triangles_.size(), 0) {
   if (!surface_) throw std::invalid_argument("PointCloudObservation: no ensemble");
-  if (max_points_ < 1) throw std::invalid_argument("PointCloudObservation: max_points must be at least 1");
   if (triangles_.empty()) throw std::invalid_argument("PointCloudObservation: no surface triangles");
   const int nodes = surface_->observation_count() / 3;
   for (const std::array<int, 3>& tri : triangles_)
@@ -24,9 +26,6 @@ PointCloudObservation::PointCloudObservation(std::unique_ptr<Ensemble> surface,
 }
 
 void PointCloudObservation::set_frame(const Eigen::Matrix3Xd& points, const Eigen::VectorXd& share) {
-  if (points.cols() > max_points_)
-    throw std::invalid_argument("PointCloudObservation: a frame of " + std::to_string(points.cols()) +
-                                " points, more than the " + std::to_string(max_points_) + " it was made for");
   if (share.size() != 0 && share.size() != points.cols())
     throw std::invalid_argument("PointCloudObservation: " + std::to_string(share.size()) + " times for " +
                                 std::to_string(points.cols()) + " points");
@@ -35,6 +34,12 @@ void PointCloudObservation::set_frame(const Eigen::Matrix3Xd& points, const Eige
   frame_ = points;
   share_ = share.size() != 0 ? share : Eigen::VectorXd::Ones(points.cols());
   between_steps_ = (share_.array() < 1.0).any();
+}
+
+void PointCloudObservation::recenter(const Recentering& recentering) {
+  alpha_ = recentering.alpha;
+  directions_ = recentering.directions;
+  surface_->recenter(recentering);
 }
 
 StepReport PointCloudObservation::advance(const Eigen::Vector3d& so_position) {
@@ -46,13 +51,20 @@ StepReport PointCloudObservation::advance(const Eigen::Vector3d& so_position) {
 void PointCloudObservation::predicted_observations(Eigen::MatrixXd& y) const {
   surface_->predicted_observations(surface_positions_);   // 3n x S: the surface nodes
   const Eigen::Index S = surface_positions_.cols();
-  y = Eigen::MatrixXd::Zero(max_points_, S);
-  if (frame_.cols() == 0) return;
-  // The sigma points have equal weights (both sets, filter/sigma_points.h): the mean surface.
+  const Eigen::Index n = frame_.cols();
+  y = Eigen::MatrixXd::Zero(static_cast<Eigen::Index>(triangles_.size()), S);
+  std::fill(bin_size_.begin(), bin_size_.end(), 0);
+  rejected_.clear();
+  if (n == 0) return;
+  // Each point's h_s(p), and the triangle it matched on the sigma points' mean surface (they
+  // have equal weights, both sets, filter/sigma_points.h).
   const SurfaceSearch search(surface_positions_.rowwise().mean(), triangles_);
-  for (Eigen::Index i = 0; i < frame_.cols(); ++i) {
+  Eigen::MatrixXd h(n, S);
+  std::vector<int> triangle_of(static_cast<std::size_t>(n));
+  for (Eigen::Index i = 0; i < n; ++i) {
     const Eigen::Vector3d p = frame_.col(i);
     const SurfacePoint at = search.closest(p);
+    triangle_of[static_cast<std::size_t>(i)] = at.triangle;
     const std::array<int, 3>& tri = triangles_[static_cast<std::size_t>(at.triangle)];
     const double u = share_[i];
     for (Eigen::Index s = 0; s < S; ++s) {
@@ -67,9 +79,30 @@ void PointCloudObservation::predicted_observations(Eigen::MatrixXd& y) const {
       const Eigen::Vector3d a = corner(0), b = corner(1), c = corner(2);
       const Eigen::Vector3d x = at.weights[0] * a + at.weights[1] * b + at.weights[2] * c;
       const Eigen::Vector3d normal = (b - a).cross(c - a).normalized();
-      y(i, s) = normal.dot(x - p);
+      h(i, s) = normal.dot(x - p);
     }
   }
+  // The gate, per point, with the filter's nominal innovation variance (filter/roukf.cpp): the
+  // innovation is 0 - h, its predicted variance |alpha Z I^T|^2 + sigma^2.
+  if (options_.outlier_gate.enabled) {
+    const Eigen::MatrixXd Z = -h;
+    const double alpha = alpha_ > 0.0 ? alpha_ : 1.0 / static_cast<double>(S);
+    Eigen::VectorXd variance = Eigen::VectorXd::Constant(n, options_.observation_std * options_.observation_std);
+    if (directions_.cols() == S) variance += (alpha * Z * directions_.transpose()).rowwise().squaredNorm();
+    std::vector<int> rows(static_cast<std::size_t>(n));
+    for (Eigen::Index i = 0; i < n; ++i) rows[static_cast<std::size_t>(i)] = static_cast<int>(i);
+    rejected_ = gate_outliers(options_.outlier_gate, rows, alpha * Z.rowwise().sum(), variance, 1);
+  }
+  std::vector<char> rejected(static_cast<std::size_t>(n), 0);
+  for (int i : rejected_) rejected[static_cast<std::size_t>(i)] = 1;
+  for (Eigen::Index i = 0; i < n; ++i) {
+    if (rejected[static_cast<std::size_t>(i)]) continue;
+    const int t = triangle_of[static_cast<std::size_t>(i)];
+    y.row(t) += h.row(i);
+    ++bin_size_[static_cast<std::size_t>(t)];
+  }
+  for (std::size_t t = 0; t < triangles_.size(); ++t)
+    if (bin_size_[t] > 1) y.row(static_cast<Eigen::Index>(t)) /= std::sqrt(static_cast<double>(bin_size_[t]));
 }
 
 }  // namespace sigmafem

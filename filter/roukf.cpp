@@ -113,7 +113,8 @@ RoukfStep Roukf::step(const Eigen::Vector3d& so_position, const Eigen::VectorXd&
   // Innovations on the observed rows.
   std::vector<int> rows;
   for (int k = 0; k < y.size(); ++k)
-    if (!std::isnan(y[k])) rows.push_back(k);
+    if (!std::isnan(y[k]) && ensemble_.predicts_row(k)) rows.push_back(k);
+  result.outliers = ensemble_.rejected_points();
   Eigen::MatrixXd Z(static_cast<Eigen::Index>(rows.size()), r);
   for (std::size_t j = 0; j < rows.size(); ++j)
     Z.row(static_cast<Eigen::Index>(j)) = y[rows[j]] - predicted.row(rows[j]).array();
@@ -122,13 +123,14 @@ RoukfStep Roukf::step(const Eigen::Vector3d& so_position, const Eigen::VectorXd&
     const double variance = options_.observation_std * options_.observation_std;
     const Eigen::VectorXd S_diag =
         (alpha * Z * I.transpose()).rowwise().squaredNorm().array() + variance;
-    result.outliers = gate_outliers(options_.outlier_gate, rows, alpha * Z.rowwise().sum(), S_diag,
-                                    ensemble_.rows_per_point());
-    if (!result.outliers.empty()) {
+    const std::vector<int> outliers = gate_outliers(options_.outlier_gate, rows, alpha * Z.rowwise().sum(), S_diag,
+                                                    ensemble_.rows_per_point());
+    result.outliers.insert(result.outliers.end(), outliers.begin(), outliers.end());
+    if (!outliers.empty()) {
       std::vector<int> kept;
       std::vector<Eigen::Index> kept_rows_of_Z;
       for (std::size_t j = 0; j < rows.size(); ++j)
-        if (std::find(result.outliers.begin(), result.outliers.end(), rows[j] / ensemble_.rows_per_point()) == result.outliers.end()) {
+        if (std::find(outliers.begin(), outliers.end(), rows[j] / ensemble_.rows_per_point()) == outliers.end()) {
           kept.push_back(rows[j]);
           kept_rows_of_Z.push_back(static_cast<Eigen::Index>(j));
         }

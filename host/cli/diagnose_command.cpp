@@ -5,6 +5,7 @@
 #include <fstream>
 #include <iostream>
 #include <memory>
+#include <optional>
 #include <sstream>
 
 #include "host/cli/backend_options.h"
@@ -13,6 +14,7 @@
 #include "host/cli/diagnosis_report.h"
 #include "host/common/input_error.h"
 #include "host/common/input_file.h"
+#include "host/data/point_cloud_table.h"
 #include "filter/sigma_points.h"
 #include "host/diagnosis/diagnosis.h"
 #include "host/ensemble/choose_backend.h"
@@ -65,9 +67,6 @@ Action add_diagnose_command(CLI::App& app) {
     const Scenario scenario = load_scenario(options->scenario);
     if (!scenario.filter)
       throw InputError("scenario " + scenario.path + ": filter: missing; diagnose needs a filter block");
-    if (scenario.observations.surface_cloud)
-      throw InputError("scenario " + scenario.path + ": observations.surface_cloud: diagnose works on tracked "
-                       "points (observations.nodes, observations.points) so far; `estimate` takes surface clouds");
     const fs::path data(options->data_dir);
     const ObservationTable table = read_observations_csv(
         (data / "observations.csv").string(), static_cast<int>(scenario.observations.observed.size()), scenario.time.dt);
@@ -93,6 +92,13 @@ Action add_diagnose_command(CLI::App& app) {
       }
     }
     DiagnoseOptions diagnose_options;
+    // A surface cloud (observations.surface_cloud): its frames, observed as `estimate` does.
+    std::optional<PointCloudTable> cloud;
+    if (scenario.observations.surface_cloud) {
+      diagnose_options.surface_cloud_path = (data / "pointcloud.csv").string();
+      cloud = read_point_cloud_csv(diagnose_options.surface_cloud_path);
+      diagnose_options.surface_cloud = &*cloud;
+    }
     diagnose_options.device = options->backend.device_options();
     diagnose_options.max_rounds = options->max_rounds;
     diagnose_options.burn_in_fraction = options->burn_in;

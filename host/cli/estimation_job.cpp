@@ -1,5 +1,6 @@
 #include "host/cli/estimation_job.h"
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
@@ -50,6 +51,7 @@ json run_estimation_job(const Scenario& scenario, const EstimationJob& job) {
   truth = read_optional_truth_csv((data / "truth.csv").string(), scenario.ligament_names(), table.row_count(), std::cerr);
 
   EstimationOptions options = estimation_options(scenario);
+  const bool outlier_gate = options.roukf.outlier_gate.enabled;   // a cloud's observation takes it over
   if (!job.sigma_points.empty()) options.roukf.sigma_points = parse_sigma_point_set(job.sigma_points);
   const int sigma_count =
       sigma_point_count(options.roukf.sigma_points, static_cast<int>(spec.estimate.size()));
@@ -69,11 +71,14 @@ json run_estimation_job(const Scenario& scenario, const EstimationJob& job) {
     PointCloudTable cloud_table = read_point_cloud_csv(cloud_path);
     for (PointCloudFrame& frame : cloud_table.frames) frame.points.colwise() -= offset;
     cloud = make_surface_cloud_estimation(backend.backend, model, scenario.mesh, spec.estimate, sigma_count,
-                                          job.device, cloud_table, scenario.time.dt, table.row_count(), cloud_path);
+                                          job.device, cloud_table, scenario.time.dt, table.row_count(), cloud_path,
+                                          options.roukf);
+    Eigen::Index max_points = 0;
+    for (const StepFrames& step : cloud->frames) max_points = std::max(max_points, step.points.cols());
     observations = {{"kind", "surface_cloud"},
                     {"frames", cloud_table.frames.size()},
                     {"points", cloud_table.point_count()},
-                    {"max_points_per_step", cloud->measured.cols()},
+                    {"max_points_per_step", max_points},
                     {"surface_triangles", cloud->surface_triangles}};
   } else {
     tracked = make_ensemble(backend.backend, model, spec.estimate, scenario.observations.observed, sigma_count,
@@ -100,7 +105,7 @@ json run_estimation_job(const Scenario& scenario, const EstimationJob& job) {
   report.backend = backend.backend;
   report.backend_reason = backend.reason;
   report.sigma_points = to_string(options.roukf.sigma_points);
-  report.outlier_gate = options.roukf.outlier_gate.enabled;
+  report.outlier_gate = outlier_gate;
   report.sigma_count = sigma_count;
   for (int l : spec.estimate) report.names.push_back(scenario.ligaments[l].name);
   report.truth = truth;

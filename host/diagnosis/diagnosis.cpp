@@ -8,6 +8,7 @@
 #include "host/common/input_error.h"
 #include "host/common/interruption.h"
 #include "host/ensemble/effect_ensemble.h"
+#include "host/ensemble/surface_cloud_estimation.h"
 #include "host/model/effects.h"
 #include "host/model/model.h"
 #include "host/scenario/estimation_options.h"
@@ -126,21 +127,35 @@ ModelFit fit_model(const Scenario& scenario, const ObservationTable& data,
   fit.parameter_count = p;
 
   const int sigma_count = sigma_point_count(roukf.sigma_points, p);
-  const std::unique_ptr<EffectEnsemble> ensemble =
-      EffectEnsemble::make(options.backend, make_model(scenario), spec.estimate, scenario.observations.observed,
-                           sigma_count, options.device, effects);
+  Eigen::MatrixX3d positions;   // the tracked points' mean positions: the residual's lever arms
+  const Model model = make_model(scenario);
   // A camera offset the scenario declares: the positions are the data minus the offset.
-  Eigen::MatrixXd points = data.points;
   const Eigen::Vector3d offset = camera_offset(scenario.effects);
-  for (Eigen::Index c = 0; c + 2 < points.cols(); c += 3) points.middleCols(c, 3).rowwise() -= offset.transpose();
-
-  fit.run = run_estimation(*ensemble, estimation, data.times, data.so, points,
-                           [](const EstimationStep&) { throw_if_interrupted(); });
-  fit.series = innovation_series(fit.run);
+  const auto stop_if_interrupted = [](const EstimationStep&) { throw_if_interrupted(); };
+  if (options.surface_cloud) {
+    PointCloudTable cloud = *options.surface_cloud;
+    for (PointCloudFrame& frame : cloud.frames) frame.points.colwise() -= offset;
+    SurfaceCloudEstimation observed = make_surface_cloud_estimation(
+        options.backend, model, scenario.mesh, spec.estimate, sigma_count, options.device, cloud,
+        scenario.time.dt, data.row_count(), options.surface_cloud_path, roukf, effects);
+    fit.run = run_estimation(*observed.ensemble, estimation, data.times, data.so, observed.measured,
+                             stop_if_interrupted, [&](Eigen::Index row) { observed.before_step(row); });
+  } else {
+    const std::unique_ptr<EffectEnsemble> ensemble = EffectEnsemble::make(
+        options.backend, model, spec.estimate, scenario.observations.observed, sigma_count, options.device, effects);
+    Eigen::MatrixXd points = data.points;
+    for (Eigen::Index c = 0; c + 2 < points.cols(); c += 3) points.middleCols(c, 3).rowwise() -= offset.transpose();
+    fit.run = run_estimation(*ensemble, estimation, data.times, data.so, points, stop_if_interrupted);
+    positions = mean_observed_positions(points);
+  }
+  // A cloud's rows are surface triangles, not points with lever arms: its residual is judged
+  // by the step means, with no spatial or rigid pattern (as `estimate` does).
+  const InnovationSeries series = innovation_series(fit.run);
+  fit.series = options.surface_cloud ? step_means(series) : series;
   ResidualDiagnosticsOptions residual = options.residual;
   if (residual.burn_in_steps < 0)
     residual.burn_in_steps = static_cast<int>(options.burn_in_fraction * static_cast<double>(data.row_count() - 1));
-  fit.residual = diagnose_residuals(fit.series, mean_observed_positions(points), residual);
+  fit.residual = diagnose_residuals(fit.series, positions, residual);
   if (!fit.run.complete) {
     // A filter that diverged did not explain the data, however few steps it made.
     DiagnosticTest diverged;
@@ -165,8 +180,8 @@ ModelFit fit_model(const Scenario& scenario, const ObservationTable& data,
   double sum = 0.0;
   long long count = 0;
   for (int k : fit.residual.used)
-    for (Eigen::Index i = 0; i < fit.series.innovation.cols(); ++i) {
-      const double z = fit.series.innovation(k, i);
+    for (Eigen::Index i = 0; i < series.innovation.cols(); ++i) {
+      const double z = series.innovation(k, i);
       if (!std::isnan(z)) sum += z * z, ++count;
     }
   fit.innovation_rms = count > 0 ? std::sqrt(sum / static_cast<double>(count)) : NAN;

@@ -46,6 +46,7 @@
 #include "filter/residual_diagnostics.h"
 #include "host/common/device_options.h"
 #include "host/data/observation_table.h"
+#include "host/data/point_cloud_table.h"
 #include "host/data/truth_table.h"
 #include "host/diagnosis/model_form_claim.h"
 #include "host/scenario/effect_catalogue.h"
@@ -70,6 +71,13 @@ struct DiagnoseOptions {
   // simplex, 0.53 +- 0.47 with the star set). Empty: the scenario's filter.sigma_points.
   std::optional<SigmaPointSet> sigma_points = SigmaPointSet::star;
   ModelFormClaimOptions claims;             // when the residual stays inconsistent
+  // The data's surface cloud (pointcloud.csv) when the scenario observes one
+  // (observations.surface_cloud), and its path for messages; the observation table then
+  // holds the times and the SO only. Every fit observes the cloud as `estimate` does
+  // (host/ensemble/surface_cloud_estimation.h), and its residual is judged by its step
+  // means (filter/residual_diagnostics.h, step_means).
+  const PointCloudTable* surface_cloud = nullptr;
+  std::string surface_cloud_path;
   std::ostream* log = nullptr;              // a line per fit, when set
 };
 

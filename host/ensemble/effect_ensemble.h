@@ -52,6 +52,8 @@ class EffectEnsemble : public Ensemble {
   void predicted_observations(Eigen::MatrixXd& y) const override;
   void recenter(const Recentering& recentering) override;
   int rows_per_point() const override { return inner_->rows_per_point(); }
+  bool predicts_row(Eigen::Index row) const override { return inner_->predicts_row(row); }
+  std::vector<int> rejected_points() const override { return inner_->rejected_points(); }
 
   const std::vector<const EffectDefinition*>& effects() const { return effects_; }
 

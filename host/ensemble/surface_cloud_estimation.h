@@ -2,7 +2,8 @@
 // observations.surface_cloud, issue 15 item 2), built in one place for `estimate`, the tests
 // and the benchmarks: the ensemble of the organ observing its surface nodes, wrapped in the
 // point-cloud observation (filter/point_cloud_observation.h), the frames by data row, and the
-// data matrix (0 for each point of a row's frame, NaN beyond).
+// data matrix (one row per step, one column per surface triangle: 0 where the step has a frame,
+// NaN where it has none; the observation says which triangles its points fell on).
 #pragma once
 
 #include <Eigen/Core>
@@ -11,6 +12,7 @@
 #include <vector>
 
 #include "filter/point_cloud_observation.h"
+#include "filter/roukf.h"
 #include "host/common/device_options.h"
 #include "host/data/point_cloud_table.h"
 #include "host/mesh/mesh.h"
@@ -21,7 +23,7 @@ namespace sigmafem {
 struct SurfaceCloudEstimation {
   std::unique_ptr<PointCloudObservation> ensemble;
   std::vector<StepFrames> frames;         // by data row (frames_by_step); no point: no frame
-  Eigen::MatrixXd measured;               // rows x the most points of a row
+  Eigen::MatrixXd measured;               // rows x surface triangles
   int surface_triangles = 0;
 
   // For run_estimation's before_step: hands row `row`'s frame to the observation.
@@ -32,13 +34,17 @@ struct SurfaceCloudEstimation {
 };
 
 // The estimation of `model` (on `mesh`'s boundary surface) from `cloud` over `rows` data rows
-// of `dt`, on `backend` (make_ensemble). Throws InputError naming `path` when no frame lies
-// after the rest state, one lies after the last row, or the run's tables (rows x the most
-// points of a step, three of them) would take more than half the machine's memory.
+// of `dt`, on `backend` (make_ensemble), with the candidate `effects` estimated too
+// (EffectEnsemble, for diagnose; its camera offset moves the surface). The outlier gate moves from the filter into the
+// observation, which gates each point before binning it: `roukf`'s gate is handed over and
+// turned off there. Throws InputError naming `path` when no frame lies after the rest state,
+// one lies after the last row, or the run's tables (rows x triangles, three of them) would
+// take more than half the machine's memory.
 SurfaceCloudEstimation make_surface_cloud_estimation(const std::string& backend, const Model& model,
                                                      const Mesh& mesh, const std::vector<int>& estimated,
                                                      int sigma_count, const DeviceOptions& device,
                                                      const PointCloudTable& cloud, double dt, int rows,
-                                                     const std::string& path);
+                                                     const std::string& path, RoukfOptions& roukf,
+                                                     const std::vector<std::string>& effects = {});
 
 }  // namespace sigmafem

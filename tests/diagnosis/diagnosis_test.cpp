@@ -88,6 +88,7 @@ struct BoxData {
   Scenario scenario;
   ObservationTable data;
   std::optional<TruthTable> truth;
+  std::optional<PointCloudTable> cloud;   // when the scenario observes a surface cloud
 };
 
 // Data from `generate` on scenarios/SCENARIO.json; `steps` > 0 shortens the run, and
@@ -109,6 +110,7 @@ BoxData box_data(const std::vector<EffectValue>& inject, std::uint64_t seed = 1,
   box.data = read_observations_csv((dir / "observations.csv").string(),
                                    static_cast<int>(box.scenario.observations.nodes.size()), box.scenario.time.dt);
   box.truth = read_truth_csv((dir / "truth.csv").string());
+  if (box.scenario.observations.surface_cloud) box.cloud = read_point_cloud_csv((dir / "pointcloud.csv").string());
   fs::remove_all(dir);
   return box;
 }
@@ -184,12 +186,15 @@ std::string describe(const Diagnosis& d) {
 bool opencl_missing() { return list_opencl_devices().empty(); }
 
 // Injects `effect`, runs diagnose with every candidate, and checks the issue's three claims.
+// `steps` > 0 shortens the scenario's run.
 void expect_found(const EffectValue& effect, const std::vector<std::string>& candidates = {},
-                  const std::string& scenario = "box_diagnose", const std::string& backend = "cpu") {
-  const BoxData box = box_data({effect}, 1, scenario);
+                  const std::string& scenario = "box_diagnose", const std::string& backend = "cpu",
+                  std::uint64_t seed = 1, int steps = 0) {
+  const BoxData box = box_data({effect}, seed, scenario, steps);
   DiagnoseOptions options;
   options.candidates = candidates;
   options.backend = backend;
+  if (box.cloud) options.surface_cloud = &*box.cloud;
   const Diagnosis d = diagnose(box.scenario, box.data, box.truth, options);
   ASSERT_EQ(d.outcome, DiagnosisOutcome::explained) << describe(d);
   ASSERT_EQ(d.after().estimates.size(), 1u) << describe(d);
@@ -371,6 +376,31 @@ TEST(DiagnoseLiverOnOpenCl, CleanDataAddNothing) {
   const BoxData liver = box_data({}, 1, "liver_diagnose");
   DiagnoseOptions options;
   options.backend = "opencl";
+  const Diagnosis d = diagnose(liver.scenario, liver.data, liver.truth, options);
+  EXPECT_EQ(d.outcome, DiagnosisOutcome::consistent) << describe(d);
+  EXPECT_EQ(d.fits.size(), 1u);
+}
+
+// Surface point clouds (issue 15, item 4; scenarios/liver_cloud.json: 300 points per frame on
+// the front third, 0.5 mm noise), the first 400 steps, on the CPU back end: a camera offset of
+// 3 mm across the view moves the cloud off the surface, and diagnose finds it as on tracked
+// points; clean data add nothing. Seed 11, a seed no figure was tuned on. By hand (stop 35,
+// `sigmafem generate scenarios/liver_cloud.json --inject camera_offset=...` over 600 steps,
+// then `sigmafem diagnose` with the whole library, 53 s a run): 3 mm along x (seed 1), y
+// (seed 2) and the view (z, seed 3) explained, each component within 0.013 mm; clean seeds 1
+// and 2 consistent; (2, -2, 1) mm with 5% outliers and 10% dropouts (seed 4) partly explained
+// (the offset within 0.02 mm, the outliers that pass the gate leave the NIS high). The
+// candidates here are those that also move the observed surface as a whole or in time
+// (gravity, the modulus, the lag) and the offset: 6 filter runs instead of 15 keep CI short.
+TEST(DiagnoseLiverCloud, FindsAThreeMillimetreCameraOffset) {
+  expect_found({"camera_offset", {3e-3, 0.0, 0.0}}, {"gravity", "young_scale", "camera_offset", "time_lag"},
+               "liver_cloud", "cpu", 11, 400);
+}
+
+TEST(DiagnoseLiverCloud, CleanDataAddNothing) {
+  const BoxData liver = box_data({}, 11, "liver_cloud", 400);
+  DiagnoseOptions options;
+  options.surface_cloud = &*liver.cloud;
   const Diagnosis d = diagnose(liver.scenario, liver.data, liver.truth, options);
   EXPECT_EQ(d.outcome, DiagnosisOutcome::consistent) << describe(d);
   EXPECT_EQ(d.fits.size(), 1u);
