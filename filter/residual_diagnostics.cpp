@@ -525,7 +525,15 @@ ResidualDiagnostics diagnose_residuals(const InnovationSeries& series, const Eig
   d.steps_used = static_cast<int>(d.used.size());
   if (!d.used.empty()) d.first_step = series.steps[static_cast<std::size_t>(d.used.front())];
   if (d.steps_used < std::max(options.min_steps, 2)) {
-    d.verdict.consistency = Consistency::too_few_steps;
+    long long rows = 0;
+    for (int k : d.used) rows += series.observed_rows[static_cast<std::size_t>(k)];
+    if (d.steps_used == 0 || rows < options.min_rows_of_few_steps) {
+      d.verdict.consistency = Consistency::too_few_steps;
+      return d;
+    }
+    d.nis_only = true;
+    nis_tests(series, d.used, options.false_alarm / 2.0, d);   // its two tests share the rate
+    d.verdict.consistency = d.verdict.failed().empty() ? Consistency::consistent : Consistency::inconsistent;
     return d;
   }
 

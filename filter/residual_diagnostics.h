@@ -72,7 +72,11 @@ struct ResidualDiagnosticsOptions {
   int burn_in_steps = -1;      // first steps left out while the filter settles; -1: 10% of the run
   int max_lag = 10;            // whiteness over lags 1..max_lag (at most a fifth of the steps)
   double false_alarm = 0.01;   // bound on P(verdict inconsistent | consistent filter)
-  int min_steps = 20;          // fewer steps after the burn-in: too few to judge
+  int min_steps = 20;          // fewer steps after the burn-in: too few to judge...
+  // ...unless they hold at least this many observed rows together: a few scans of many points
+  // (the Truth Cube: three scans of 343 beads) are too few steps to follow a row over time,
+  // but their NIS still tests the model. Then only the NIS tests run (nis_only).
+  int min_rows_of_few_steps = 300;
 };
 
 // One test of the verdict: it passes when `statistic` lies in [accept_low, accept_high]
@@ -164,6 +168,8 @@ struct ResidualDiagnostics {
   int catch_up_steps = 0;     // steps after the burn-in left out as a catch-up after a change
   int first_step = 0;         // data row of the first step used
   std::vector<int> used;      // indices into the series of the steps used
+  // Fewer than min_steps steps but at least min_rows_of_few_steps rows: only the NIS tests ran.
+  bool nis_only = false;
   NisDiagnostics nis;
   WhitenessDiagnostics whiteness;
   BiasDiagnostics bias;

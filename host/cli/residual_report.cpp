@@ -52,6 +52,9 @@ json residual_json(const ResidualDiagnostics& d, const ResidualDiagnosticsOption
               {"steps_above_95_band", nis.steps_above},
               {"fraction_above_95_band", nis.fraction_above},
               {"max_above_accepted", nis.max_above}};
+  // A few scans of many points: only the NIS tests ran (ResidualDiagnostics::nis_only).
+  j["nis_only"] = d.nis_only;
+  if (d.nis_only) return j;
 
   const WhitenessDiagnostics& w = d.whiteness;
   json flagged_white = json::array();

@@ -89,6 +89,7 @@ void EffectEnsemble::set_parameters(const Eigen::MatrixXd& theta) {
       else if (name == "damping_scale") physics[s].damping_mass_scale = v[0], physics[s].damping_stiffness_scale = v[1];
       else if (name == "ligament_law") physics[s].ligament_d0 = v[0];
       else if (name == "time_lag") physics[s].time_lag = v[0];
+      else if (name == "control_scale") physics[s].control_scale = v[0];
       else if (name == "extra_ligament") inner_theta_(inner_row, s) = std::log(v[0]);
       else if (name == "camera_offset") camera_offsets_.col(s) = Eigen::Vector3d(v[0], v[1], v[2]);
     }

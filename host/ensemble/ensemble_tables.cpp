@@ -124,7 +124,8 @@ std::vector<double> StepConstants::next_step(const Model& m, const Eigen::Vector
     const PhysicsEffects& e = physics_[s];
     auto at = [&](int k) -> double& { return c[SF_STEP_CONSTANTS + k * S + s]; };
     const Eigen::Vector3d gravity = m.gravity + e.gravity;
-    const Eigen::Vector3d shift = so_history_.lagged(m.so_lag + e.time_lag) - m.control_start;
+    const Eigen::Vector3d shift =
+        m.control_scale * e.control_scale * (so_history_.lagged(m.so_lag + e.time_lag) - m.control_start);
     const double d0 = std::isfinite(e.ligament_d0) ? e.ligament_d0 : m.ligament_d0;
     const double a = e.damping_stiffness_scale * m.damping.rayleigh_stiffness;
     const double b = e.damping_mass_scale * m.damping.rayleigh_mass;

@@ -28,6 +28,8 @@ void apply_effects(const std::vector<EffectValue>& effects, Model& model) {
       model.ligament_d0 = effect.value[0];
     } else if (family == "time_lag") {
       model.so_lag += effect.value[0];
+    } else if (family == "control_scale") {
+      model.control_scale *= effect.value[0];
     } else if (family == "extra_ligament") {
       add_extra_ligament(model, effect.name, effect.value[0]);
     } else if (family == "inclusion") {

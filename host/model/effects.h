@@ -28,6 +28,7 @@ struct PhysicsEffects {
   // The ligament law's d0 (m) instead of the model's; infinite: the model's.
   double ligament_d0 = std::numeric_limits<double>::infinity();
   double time_lag = 0.0;                               // s, added to the model's so_lag
+  double control_scale = 1.0;                          // multiplies the model's control_scale
 };
 
 // Changes `model` by the physics effects among `effects`; observation effects are ignored.

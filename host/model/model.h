@@ -56,6 +56,9 @@ struct Model {
   // The organ is driven by the SO as it was so_lag seconds earlier (the time_lag effect: the
   // observations, stamped with the SO's time, show the organ late). 0: no lag.
   double so_lag = 0.0;
+  // The control nodes follow control_scale (so(t) - so(0)) (the control_scale effect: the SO's
+  // record off by a factor). 1: as recorded.
+  double control_scale = 1.0;
   // Surface regions where an unmodelled ligament may be (diagnose's extra_ligament:NAME).
   std::vector<SpringSet> candidate_regions;
   SpringSet control;                    // each node tied to so(t) + rest - so(0)

@@ -23,6 +23,7 @@ ReferenceSimulation::ReferenceSimulation(Model model)
   base_damping_ = model_.damping;
   base_d0_ = model_.ligament_d0;
   base_so_lag_ = model_.so_lag;
+  base_control_scale_ = model_.control_scale;
 }
 
 void ReferenceSimulation::set_physics_effects(const PhysicsEffects& effects) {
@@ -31,6 +32,7 @@ void ReferenceSimulation::set_physics_effects(const PhysicsEffects& effects) {
   model_.damping.rayleigh_stiffness = effects.damping_stiffness_scale * base_damping_.rayleigh_stiffness;
   model_.ligament_d0 = std::isfinite(effects.ligament_d0) ? effects.ligament_d0 : base_d0_;
   model_.so_lag = base_so_lag_ + effects.time_lag;
+  model_.control_scale = base_control_scale_ * effects.control_scale;
   if (effects.young_scale == young_scale_) return;
   if (base_lame_.empty())
     for (const ElementRest& element : model_.elements) base_lame_.emplace_back(element.vlambda, element.vmu);
@@ -87,7 +89,7 @@ Eigen::VectorXd ReferenceSimulation::forces(const Eigen::VectorXd& x,
     }
   }
   const SpringSet& control = model_.control;
-  const Eigen::Vector3d shift = so_position - model_.control_start;
+  const Eigen::Vector3d shift = model_.control_scale * (so_position - model_.control_start);
   for (std::size_t j = 0; j < control.nodes.size(); ++j) {
     const int node = control.nodes[j];
     f.segment<3>(3 * node) -=

@@ -84,7 +84,7 @@ class ReferenceSimulation {
   std::vector<Eigen::Vector2d> base_lame_;   // per element: vlambda, vmu of the model
   double young_scale_ = 1.0;
   Damping base_damping_;
-  double base_d0_ = 0.0, base_so_lag_ = 0.0;
+  double base_d0_ = 0.0, base_so_lag_ = 0.0, base_control_scale_ = 1.0;
   SoHistory so_history_;                     // for the lag (Model::so_lag)
 };
 

@@ -44,6 +44,11 @@ const std::vector<EffectDefinition>& effect_catalogue() {
       {"damping_scale", "a mismatch of the Rayleigh damping: factors on its mass and stiffness coefficients",
        EffectSide::physics, true, false, "am,ak (> 0, multiply damping.rayleigh_mass and damping.rayleigh_stiffness)", 2,
        {{"am", "", true, 0.0, 1.0, 1.0}, {"ak", "", true, 0.0, 1.0, 1.0}}},
+      // The SO's recorded displacement is off by a factor: a tracker's or a test rig's scale
+      // calibration (for the Truth Cube, the plates' travel against the nominal strain). 1 a
+      // priori, within 20% (1 std).
+      {"control_scale", "the SO's displacement from its start is off by a factor (a scale calibration of the SO's record)",
+       EffectSide::physics, true, false, "c (> 0, multiplies so(t) - so(0))", 1, {{"c", "", true, 0.0, 0.2, 1.0}}},
       {"inclusion", "a stiffer (or softer) sphere inside the organ: outside the candidate library",
        EffectSide::physics, false, false, "x,y,z,radius,factor (m, m, > 0: multiplies Young's modulus of the elements whose centroid is inside)",
        5, {}},
@@ -80,7 +85,8 @@ std::string effect_value_problem(const EffectDefinition& definition, const std::
   for (double x : value)
     if (!std::isfinite(x) || std::fabs(x) > kMaxScenarioMagnitude)
       return "every number must be finite and within +-1e12 (SI units)";
-  if ((definition.name == "young_scale" || definition.name == "ligament_law" || definition.name == "damping_scale") &&
+  if ((definition.name == "young_scale" || definition.name == "ligament_law" || definition.name == "damping_scale" ||
+       definition.name == "control_scale") &&
       !(*std::min_element(value.begin(), value.end()) > 0.0))
     return "must be > 0 (" + definition.value_syntax + ")";
   if ((definition.name == "time_lag" || definition.name == "extra_ligament") && !(value[0] >= 0.0))

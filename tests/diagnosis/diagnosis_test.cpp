@@ -65,7 +65,7 @@ TEST(CandidateLibrary, AnExtraLigamentIsACandidateAtEveryRegion) {
   const std::vector<std::string> all = candidate_library(scenario, {});
   EXPECT_EQ(all, (std::vector<std::string>{"gravity", "young_scale", "camera_offset", "ligament_law",
                                            "extra_ligament:bottom", "extra_ligament:side_y0",
-                                           "extra_ligament:side_y15", "time_lag", "damping_scale"}));
+                                           "extra_ligament:side_y15", "time_lag", "damping_scale", "control_scale"}));
   EXPECT_EQ(candidate_library(scenario, {"extra_ligament:side_y0", "time_lag"}),
             (std::vector<std::string>{"extra_ligament:side_y0", "time_lag"}));
   try {

@@ -242,8 +242,29 @@ TEST(ResidualDiagnostics, BurnInMissingRowsAndTooFewSteps) {
   // Without the burn-in the transient shows.
   options.burn_in_steps = 0;
   EXPECT_EQ(diagnose_residuals(series, synthetic_points(), options).verdict.consistency, Consistency::inconsistent);
-  options.burn_in_steps = kSteps - 10;
+  // 5 steps of 36 rows: too few steps, and too few rows for the NIS alone (below).
+  options.burn_in_steps = kSteps - 5;
   EXPECT_EQ(diagnose_residuals(series, synthetic_points(), options).verdict.consistency, Consistency::too_few_steps);
+}
+
+// A few scans of many points (the Truth Cube: 3 scans of 1029 rows): too few steps to follow
+// a row, but the NIS over their rows still judges the model; only the NIS tests run.
+TEST(ResidualDiagnostics, AFewStepsOfManyRowsAreJudgedByTheirNis) {
+  ResidualDiagnosticsOptions options;
+  options.burn_in_steps = kSteps - 10;   // 10 steps of 36 rows: 360 >= 300
+  const ResidualDiagnostics consistent = diagnose_residuals(synthetic_series(21), synthetic_points(), options);
+  EXPECT_TRUE(consistent.nis_only);
+  EXPECT_EQ(consistent.verdict.consistency, Consistency::consistent) << describe(consistent);
+  for (const DiagnosticTest& test : consistent.verdict.tests)
+    EXPECT_TRUE(test.name == "nis_mean" || test.name == "nis_above_band") << test.name << " ran";
+  // Innovations twice what S says fail, even over ten steps.
+  const ResidualDiagnostics understated = diagnose_residuals(synthetic_series(21, 2.0), synthetic_points(), options);
+  EXPECT_EQ(understated.verdict.consistency, Consistency::inconsistent) << describe(understated);
+  EXPECT_TRUE(failed(understated, "nis_mean"));
+  // Fewer rows than min_rows_of_few_steps: too few to judge.
+  options.min_rows_of_few_steps = 400;
+  EXPECT_EQ(diagnose_residuals(synthetic_series(21), synthetic_points(), options).verdict.consistency,
+            Consistency::too_few_steps);
 }
 
 TEST(ResidualDiagnostics, CatchUpStepsAreLeftOut) {

@@ -1,6 +1,7 @@
 // The physics of the candidate effects (host/model/effects.h) in the CPU reference, against
 // what each one means: the ligament law's force is k u (1 + |u|^2/d0^2); a time lag of whole
-// steps is the same motion that many steps later; a per-simulation effect
+// steps is the same motion that many steps later; a control scale is the SO's displacement
+// scaled; a per-simulation effect
 // (set_physics_effects) is the same simulation as a model built with that effect; an extra
 // ligament is one more ligament on its region's nodes.
 #include <gtest/gtest.h>
@@ -77,10 +78,26 @@ TEST_F(PhysicsEffectsTest, ATimeLagOfWholeStepsIsTheSameMotionThatManyStepsLater
   }
 }
 
+// A control scale c is the SO's record off by c: the model driven by so(0) + c (so(t) - so(0)).
+TEST_F(PhysicsEffectsTest, AControlScaleIsTheSosDisplacementScaled) {
+  constexpr double c = 1.25;
+  Model scaled_model = model_;
+  apply_effects({{"control_scale", {c}}}, scaled_model);
+  EXPECT_EQ(scaled_model.control_scale, c);
+  ReferenceSimulation scaled(scaled_model), driven(model_);
+  const Eigen::Vector3d start = model_.control_start;
+  for (int n = 1; n <= 40; ++n) {
+    scaled.step(so(n));
+    driven.step(start + c * (so(n) - start));
+  }
+  EXPECT_LT((scaled.positions() - driven.positions()).lpNorm<Eigen::Infinity>(), 1e-12);
+  EXPECT_GT((scaled.positions() - ReferenceSimulation(model_).positions()).norm(), 1e-4) << "the organ moved";
+}
+
 TEST_F(PhysicsEffectsTest, PerSimulationEffectsEqualAModelBuiltWithThem) {
   const std::vector<EffectValue> effects = {{"damping_scale", {0.5, 2.0}}, {"ligament_law", {0.006}},
                                             {"time_lag", {0.034}}, {"gravity", {0.0, 1.0, -0.5}},
-                                            {"young_scale", {1.3}}};
+                                            {"young_scale", {1.3}}, {"control_scale", {0.8}}};
   Model built = model_;
   apply_effects(effects, built);
   EXPECT_EQ(built.damping.rayleigh_mass, 0.5 * model_.damping.rayleigh_mass);
@@ -94,6 +111,7 @@ TEST_F(PhysicsEffectsTest, PerSimulationEffectsEqualAModelBuiltWithThem) {
   physics.time_lag = 0.034;
   physics.gravity = Eigen::Vector3d(0.0, 1.0, -0.5);
   physics.young_scale = 1.3;
+  physics.control_scale = 0.8;
   per_simulation.set_physics_effects(physics);
   for (int n = 1; n <= 30; ++n) {
     expected.step(so(n));
