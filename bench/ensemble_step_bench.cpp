@@ -198,11 +198,17 @@ struct CloudBench {
         sampler(s.mesh, with_points(*s.observations.surface_cloud, points), 1),
         truth(model) {
     const ObservedPoints observed(surface.nodes);
+    // The outlier gate in the observation, per point, as `estimate` has it
+    // (host/ensemble/surface_cloud_estimation.h).
+    const RoukfOptions roukf = estimation_options(s).roukf;
+    PointCloudOptions options;
+    options.observation_std = roukf.observation_std;
+    options.outlier_gate = roukf.outlier_gate;
     auto wrapped = std::make_unique<PointCloudObservation>(
         make_bench_ensemble(backend, s, model,
                             sigma_point_count(SigmaPointSet::simplex, static_cast<int>(s.filter->estimate.size())),
                             &observed),
-        surface.triangles);
+        surface.triangles, options);
     cloud = wrapped.get();
     ensemble = std::move(wrapped);
   }
@@ -236,6 +242,7 @@ void BM_cloud_filter_step(benchmark::State& state, const Backend& backend) {
   if (!b) return;
   RoukfOptions options = estimation_options(b->s).roukf;
   options.sigma_points = SigmaPointSet::simplex;
+  options.outlier_gate.enabled = false;   // the observation gates each point (CloudBench)
   Roukf filter(options, *b->ensemble);
   const Eigen::VectorXd y = Eigen::VectorXd::Zero(b->ensemble->observation_count());   // every triangle's datum is 0
   for (int i = 0; i < 5; ++i) filter.step(b->observe(), y);   // warm-up, untimed

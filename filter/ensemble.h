@@ -57,7 +57,8 @@ class Ensemble {
   // 3m x S: the observed nodes' positions of every sigma point.
   virtual void predicted_observations(Eigen::MatrixXd& y) const = 0;
   // The consecutive rows of y that belong to one measured point: 3 for a tracked point
-  // (x, y, z), 1 for a point of a surface cloud (its distance; filter/point_cloud_observation.h).
+  // (x, y, z), 1 for a surface cloud's rows (a triangle's binned distances; filter/
+  // point_cloud_observation.h, which gates its points itself).
   // The outlier gate leaves points out, all their rows together.
   virtual int rows_per_point() const { return 3; }
   // Whether the last predicted_observations() predicts data row `row`: a row it does not is
