@@ -11,6 +11,7 @@
 
 #include "filter/estimation.h"
 #include "filter/residual_diagnostics.h"
+#include "filter/timed_observation.h"
 #include "host/cli/estimation_report.h"
 #include "host/data/csv_format.h"
 #include "host/common/input_error.h"
@@ -65,6 +66,7 @@ json run_estimation_job(const Scenario& scenario, const EstimationJob& job) {
   // (host/ensemble/surface_cloud_estimation.h).
   std::optional<SurfaceCloudEstimation> cloud;
   std::unique_ptr<Ensemble> tracked;
+  TimedObservation* timed = nullptr;
   nlohmann::ordered_json observations = {{"kind", "tracked_points"}, {"points", table.point_count()}};
   if (scenario.observations.surface_cloud) {
     const std::string cloud_path = (data / "pointcloud.csv").string();
@@ -83,6 +85,14 @@ json run_estimation_job(const Scenario& scenario, const EstimationJob& job) {
   } else {
     tracked = make_ensemble(backend.backend, model, spec.estimate, scenario.observations.observed, sigma_count,
                             job.device);
+    // Frames at their own times (observations.csv's frame_time): observed then
+    // (filter/timed_observation.h).
+    if (!table.frame_times.empty()) {
+      auto wrapped = std::make_unique<TimedObservation>(std::move(tracked), table.frame_shares);
+      timed = wrapped.get();
+      tracked = std::move(wrapped);
+      observations["frame_time"] = true;
+    }
   }
   Progress progress("estimate " + scenario.name + ": step", table.row_count() - 1, job.progress);
   const EstimationRun run = run_estimation(
@@ -95,6 +105,7 @@ json run_estimation_job(const Scenario& scenario, const EstimationJob& job) {
       },
       [&](Eigen::Index row) {
         if (cloud) cloud->before_step(row);
+        if (timed) timed->set_row(row);
       });
   progress.finish();
 

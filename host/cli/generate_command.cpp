@@ -56,8 +56,10 @@ Action add_generate_command(CLI::App& app) {
       ->check(finite_between(1.0, 1e6))
       ->type_name("N");
   sub->add_option("--frame-rate", options->generate.frame_rate,
-                  "Surface clouds: frames at this rate (Hz) instead of one per step, each taken and "
-                  "stamped at its own time (the organ interpolated between steps). Recorded in truth.json")
+                  "Frames at this rate (Hz) instead of one per step, each taken and stamped at its own time (the "
+                  "organ interpolated between steps): a cloud's in pointcloud.csv, tracked points' in the row of "
+                  "the step they fall in, with observations.csv's frame_time column (at most one per step). "
+                  "Recorded in truth.json")
       ->check(finite_between(1e-3, 1e4))
       ->type_name("HZ");
   sub->add_option("--frame-jitter", options->generate.frame_jitter,
@@ -114,9 +116,6 @@ Action add_generate_command(CLI::App& app) {
     if (options->generate.frames_on_steps && options->generate.frame_jitter > 0.0)
       throw InputError("--frames-on-steps takes frames at the steps, without jitter: leave out --frame-jitter");
     Scenario scenario = load_scenario(options->scenario);
-    if (sub->count("--frame-rate") > 0 && !scenario.observations.surface_cloud)
-      throw InputError("--frame-rate: frames at their own times are for surface clouds (observations.surface_cloud); "
-                       "tracked points are written per step in observations.csv");
     for (const std::string& text : options->inject) {
       options->generate.inject.push_back(parse_effect_assignment(text, "--inject"));
       const std::string& name = options->generate.inject.back().name;

@@ -66,9 +66,9 @@ void check_table_memory(const Scenario& scenario) {
                      format_number(std::floor(available / 1e9)) + " GB; generate fewer steps per run");
 }
 
-// When each frame of a cloud at options.frame_rate is taken (GenerateOptions::frame_rate):
-// within (0, steps dt], increasing.
-std::vector<double> cloud_frame_times(const GenerateOptions& options, int steps, double dt, std::uint64_t seed) {
+// When each frame at options.frame_rate is taken (GenerateOptions::frame_rate): within
+// (0, steps dt], increasing.
+std::vector<double> frame_times_of(const GenerateOptions& options, int steps, double dt, std::uint64_t seed) {
   std::vector<double> times;
   GaussianNoise jitter(seed);
   const double end = steps * dt;
@@ -102,9 +102,10 @@ GenerateResult generate(const Scenario& scenario, const GenerateOptions& options
   if (options.gap_steps > 1.0 && scenario.observations.surface_cloud)
     throw InputError("scenario " + scenario.path + ": gaps of several steps are for tracked points; a cloud's points "
                      "have no identity to lose (use --dropouts alone)");
-  if (options.frame_rate > 0.0 && !scenario.observations.surface_cloud)
-    throw InputError("scenario " + scenario.path + ": a frame rate is for surface clouds (observations.surface_cloud); "
-                     "tracked points are written per step");
+  if (options.frame_rate * scenario.time.dt > 1.0 && !scenario.observations.surface_cloud)
+    throw InputError("generate: --frame-rate " + format_number(options.frame_rate) + " Hz is faster than the "
+                     "simulation's steps (" + format_number(1.0 / scenario.time.dt) + " Hz); tracked points take "
+                     "at most one frame per step");
   const TruthMesh truth_mesh = make_truth_mesh(scenario, options.truth_mesh);
   if (!truth_mesh.ligament_spread.empty() && options.backend != "cpu")
     throw InputError("--truth-refine with --backend " + options.backend +
@@ -153,8 +154,7 @@ GenerateResult generate(const Scenario& scenario, const GenerateOptions& options
   PointCloudTable cloud;
   std::vector<double> frame_times;   // with a frame rate: when each frame is taken
   std::size_t next_frame = 0;
-  if (scenario.observations.surface_cloud && options.frame_rate > 0.0)
-    frame_times = cloud_frame_times(options, steps, dt, options.seed ^ 0x3c6ef372fe94f82bULL);
+  if (options.frame_rate > 0.0) frame_times = frame_times_of(options, steps, dt, options.seed ^ 0x3c6ef372fe94f82bULL);
   if (scenario.observations.surface_cloud) {
     const SurfaceCloud& spec = *scenario.observations.surface_cloud;
     sampler.emplace(truth_mesh.scenario.mesh, spec, options.seed ^ 0xbb67ae8584caa73bULL);
@@ -224,10 +224,27 @@ GenerateResult generate(const Scenario& scenario, const GenerateOptions& options
     table.steps.push_back(k);
     table.times.push_back(t);
     table.so.row(k) = scenario.control.trajectory.position(t, scenario.control.start).transpose();
-    for (std::size_t p = 0; p < observed.size(); ++p) {
-      Eigen::Vector3d point = measured(truth_mesh.observed[p].of(positions));
-      if (k > 0 && !keep_with_faults(point, &lost_for[p])) point.setConstant(std::nan(""));
-      table.points.row(k).segment<3>(static_cast<Eigen::Index>(3 * p)) = point.transpose();
+    // The tracked points of one frame, of the organ at `at`, into row k.
+    auto track = [&](const Eigen::VectorXd& at) {
+      for (std::size_t p = 0; p < observed.size(); ++p) {
+        Eigen::Vector3d point = measured(truth_mesh.observed[p].of(at));
+        if (k > 0 && !keep_with_faults(point, &lost_for[p])) point.setConstant(std::nan(""));
+        table.points.row(k).segment<3>(static_cast<Eigen::Index>(3 * p)) = point.transpose();
+      }
+    };
+    if (sampler || frame_times.empty() || k == 0) {
+      track(positions);
+      if (!frame_times.empty() && !sampler) table.frame_times.push_back(0.0);   // the rest state
+    } else {
+      // Tracked frames at their own times: the one taken in ((k-1) dt, k dt] (of two, the
+      // later), of the organ interpolated between the two steps; none: the row is empty.
+      table.points.row(k).setConstant(std::nan(""));
+      table.frame_times.push_back(std::nan(""));
+      for (; next_frame < frame_times.size() && frame_times[next_frame] <= t + 1e-12 * dt; ++next_frame) {
+        const double share = (frame_times[next_frame] - (t - dt)) / dt;
+        track(previous_positions + share * (positions - previous_positions));
+        table.frame_times.back() = frame_times[next_frame];
+      }
     }
     if (sampler && k > 0 && options.frame_rate <= 0.0) take_frame(t, positions);   // a frame per step
     // Frames at their own times: those taken in ((k-1) dt, k dt], of the organ interpolated
@@ -321,6 +338,11 @@ GenerateResult generate(const Scenario& scenario, const GenerateOptions& options
                                    {"visible_area_m2", sampler->visible_area_at_rest()},
                                    {"frames", cloud.frames.size()},
                                    {"points", cloud.point_count()}};
+  if (!sampler && options.frame_rate > 0.0)
+    truth_json["tracked_frames"] = {{"frame_rate_hz", options.frame_rate},
+                                    {"frame_jitter_s", options.frame_jitter},
+                                    {"frames_on_steps", options.frames_on_steps},
+                                    {"frames", frame_times.size()}};
   write_file_atomically(output.staged("truth.json"), truth_json.dump(2) + "\n");
   if (vtk) {
     vtk->finish();

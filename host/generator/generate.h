@@ -62,13 +62,16 @@ struct GenerateOptions {
   // still `dropouts` (a tracked point is lost with probability
   // dropouts / (gap_steps (1 - dropouts) + dropouts) at each step). Tracked points only.
   double gap_steps = 1.0;
-  // A surface cloud's frames (observations.surface_cloud; --frame-rate, --frame-jitter,
-  // --frames-on-steps): 0, one frame at every step's time; else frames at `frame_rate` Hz
+  // The frames of a surface cloud (observations.surface_cloud) or of the tracked points
+  // (--frame-rate, --frame-jitter, --frames-on-steps): 0, one frame at every step's time; else
+  // frames at `frame_rate` Hz
   // from 1/frame_rate on, each taken at its nominal time plus Gaussian jitter of std
   // `frame_jitter` s (kept in order, within the run) and stamped with the time it was taken,
   // the organ there interpolated linearly between the two steps around it. With
   // `frames_on_steps` each frame is taken and stamped at the step nearest its nominal time
-  // instead (no jitter): the same frames on the simulation's grid, to compare with.
+  // instead (no jitter): the same frames on the simulation's grid, to compare with. Tracked
+  // points go to the row of the step each frame was taken in, stamped in observations.csv's
+  // frame_time column (at most one frame per step: frame_rate <= 1 / dt).
   double frame_rate = 0.0;
   double frame_jitter = 0.0;
   bool frames_on_steps = false;

@@ -372,7 +372,8 @@ TEST_F(CliTest, SurfaceCloudsAreGeneratedAndEstimated) {
 }
 
 // generate --frame-rate: a cloud's frames at their own times (jittered, off the step grid),
-// which estimate takes; the frame options only for clouds and only together as they make sense.
+// and tracked points' in observations.csv's frame_time column, which estimate takes; the frame
+// options only together as they make sense, tracked frames at most one per step.
 TEST_F(CliTest, CloudFramesAtTheirOwnTimesAreGeneratedAndEstimated) {
   json scenario = box_;
   scenario["time"]["steps"] = 30;
@@ -395,9 +396,22 @@ TEST_F(CliTest, CloudFramesAtTheirOwnTimesAreGeneratedAndEstimated) {
   const CommandRun estimated = run_sigmafem("estimate " + cloud_json + " --data " + (dir_ / "data").string() +
                                             " --out " + (dir_ / "estimate").string() + " --backend cpu --quiet");
   EXPECT_EQ(estimated.exit_code, 0) << estimated.output;
+  // Tracked points: one row per step, the frames' rows stamped, the others empty.
+  ASSERT_EQ(run_sigmafem("generate " + tracked_json + out + " --frame-rate 30 --frame-jitter 0.003").exit_code, 0);
+  const ObservationTable tracked =
+      read_observations_csv((dir_ / "data" / "observations.csv").string(), 12, 0.01);
+  ASSERT_EQ(tracked.frame_times.size(), 31u);
+  int frames = 0;
+  for (double t : tracked.frame_times) frames += !std::isnan(t) && t > 0.0;
+  EXPECT_GE(frames, 8);
+  EXPECT_LE(frames, 9);
+  const CommandRun tracked_estimate = run_sigmafem("estimate " + tracked_json + " --data " + (dir_ / "data").string() +
+                                                   " --out " + (dir_ / "tracked_estimate").string() +
+                                                   " --backend cpu --quiet");
+  EXPECT_EQ(tracked_estimate.exit_code, 0) << tracked_estimate.output;
 
   const std::vector<std::pair<std::string, std::string>> refused = {
-      {tracked_json + out + " --frame-rate 30", "for surface clouds"},
+      {tracked_json + out + " --frame-rate 150", "at most one frame per step"},
       {cloud_json + out + " --frames-on-steps", "only with --frame-rate"},
       {cloud_json + out + " --frame-rate 30 --frames-on-steps --frame-jitter 0.001", "leave out --frame-jitter"},
       {cloud_json + out + " --frame-rate 0", "--frame-rate"},

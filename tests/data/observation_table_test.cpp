@@ -65,6 +65,33 @@ TEST_F(ObservationTableTest, WrittenTableReadsBackWithMissingValues) {
   EXPECT_LT((read.points - expected).cwiseAbs().maxCoeff(), 1e-9);
 }
 
+// Frames at their own times (issue 15, item 3): the frame_time column reads back, with each
+// row's share of its step; a row without a frame is empty there (taken as at the step's end).
+TEST_F(ObservationTableTest, FrameTimesReadBackWithTheirShareOfTheStep) {
+  table_.frame_times = {0.0, 0.006, NAN};
+  write(good_text());
+  ASSERT_NE(good_text().find("step,time,frame_time,so_x"), std::string::npos);
+  const ObservationTable read = read_observations_csv(path_.string(), 2, 0.01);
+  ASSERT_EQ(read.frame_times.size(), 3u);
+  EXPECT_EQ(read.frame_times[1], 0.006);
+  EXPECT_TRUE(std::isnan(read.frame_times[2]));
+  ASSERT_EQ(read.frame_shares.size(), 3u);
+  EXPECT_NEAR(read.frame_shares[1], 0.6, 1e-12) << "0.006 s is 60% into the step (0, 0.01]";
+  EXPECT_EQ(read.frame_shares[2], 1.0);
+  EXPECT_LT((read.so - table_.so).cwiseAbs().maxCoeff(), 1e-9) << "the columns after frame_time shift right";
+  // Without the column: no frame times.
+  table_.frame_times.clear();
+  write(good_text());
+  EXPECT_TRUE(read_observations_csv(path_.string(), 2, 0.01).frame_times.empty());
+}
+
+TEST_F(ObservationTableTest, RejectsAFrameTimeOutsideItsStep) {
+  table_.frame_times = {0.0, 0.0, 0.02};   // row 1's step is (0, 0.01]
+  expect_rejected(good_text(), {"line 4", "frame_time 0", "outside the row's step", "(0, 0.01]"});
+  table_.frame_times = {0.003, 0.01, 0.02};
+  expect_rejected(good_text(), {"line 3", "rest state"});
+}
+
 TEST_F(ObservationTableTest, RejectsColumnsThatDoNotMatchTheScenario) {
   table_.points = Eigen::MatrixXd::Random(3, 9);   // three points, the scenario has two
   expect_rejected(good_text(), {"line 2", "header does not match", "2 observed points"});

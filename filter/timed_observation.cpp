@@ -1,0 +1,33 @@
+#include "filter/timed_observation.h"
+
+#include <stdexcept>
+#include <string>
+
+namespace sigmafem {
+
+TimedObservation::TimedObservation(std::unique_ptr<Ensemble> inner, std::vector<double> share_by_row)
+    : inner_(std::move(inner)), share_by_row_(std::move(share_by_row)) {
+  if (!inner_) throw std::invalid_argument("TimedObservation: no ensemble");
+  for (double share : share_by_row_)
+    if (!(share > 0.0 && share <= 1.0))
+      throw std::invalid_argument("TimedObservation: a row's share of its step must lie in (0, 1]");
+}
+
+void TimedObservation::set_row(Eigen::Index row) {
+  if (row < 0 || row >= static_cast<Eigen::Index>(share_by_row_.size()))
+    throw std::invalid_argument("TimedObservation: no row " + std::to_string(row));
+  share_ = share_by_row_[static_cast<std::size_t>(row)];
+}
+
+StepReport TimedObservation::advance(const Eigen::Vector3d& so_position) {
+  // The re-sampled state the sigma points start the step from, for a frame taken inside it.
+  if (share_ < 1.0) inner_->predicted_observations(start_);
+  return inner_->advance(so_position);
+}
+
+void TimedObservation::predicted_observations(Eigen::MatrixXd& y) const {
+  inner_->predicted_observations(y);
+  if (share_ < 1.0) y = start_ + share_ * (y - start_);
+}
+
+}  // namespace sigmafem
