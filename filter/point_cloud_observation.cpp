@@ -34,6 +34,7 @@ void PointCloudObservation::set_frame(const Eigen::Matrix3Xd& points, const Eige
   frame_ = points;
   share_ = share.size() != 0 ? share : Eigen::VectorXd::Ones(points.cols());
   between_steps_ = (share_.array() < 1.0).any();
+  start_read_ = false;
 }
 
 void PointCloudObservation::recenter(const Recentering& recentering) {
@@ -44,7 +45,8 @@ void PointCloudObservation::recenter(const Recentering& recentering) {
 
 StepReport PointCloudObservation::advance(const Eigen::Vector3d& so_position) {
   // The re-sampled state the sigma points start the step from, for points taken inside it.
-  if (between_steps_) surface_->predicted_observations(start_positions_);
+  start_read_ = between_steps_;
+  if (start_read_) surface_->predicted_observations(start_positions_);
   return surface_->advance(so_position);
 }
 
@@ -72,7 +74,7 @@ void PointCloudObservation::predicted_observations(Eigen::MatrixXd& y) const {
       const auto corner = [&](int c) -> Eigen::Vector3d {
         const Eigen::Index row = 3 * static_cast<Eigen::Index>(tri[static_cast<std::size_t>(c)]);
         const Eigen::Vector3d end = surface_positions_.col(s).segment<3>(row);
-        if (u == 1.0) return end;
+        if (u == 1.0 || !start_read_) return end;   // on the grid, or no step made since set_frame
         const Eigen::Vector3d start = start_positions_.col(s).segment<3>(row);
         return start + u * (end - start);
       };

@@ -95,6 +95,7 @@ class PointCloudObservation : public Ensemble {
   Eigen::VectorXd share_;                       // per point of the frame, (0, 1]
   bool between_steps_ = false;                  // a point of the frame was taken before the step's end
   Eigen::MatrixXd start_positions_;             // 3n x S, the surface at the step's start
+  bool start_read_ = false;                     // start_positions_ holds the coming step's start
   mutable Eigen::MatrixXd surface_positions_;   // 3n x S, the surface's nodes (reused)
   mutable std::vector<int> bin_size_;           // per triangle, the last prediction's points
   mutable std::vector<int> rejected_;           // the frame's points the gate left out

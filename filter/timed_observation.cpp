@@ -17,17 +17,19 @@ void TimedObservation::set_row(Eigen::Index row) {
   if (row < 0 || row >= static_cast<Eigen::Index>(share_by_row_.size()))
     throw std::invalid_argument("TimedObservation: no row " + std::to_string(row));
   share_ = share_by_row_[static_cast<std::size_t>(row)];
+  start_read_ = false;
 }
 
 StepReport TimedObservation::advance(const Eigen::Vector3d& so_position) {
   // The re-sampled state the sigma points start the step from, for a frame taken inside it.
-  if (share_ < 1.0) inner_->predicted_observations(start_);
+  start_read_ = share_ < 1.0;
+  if (start_read_) inner_->predicted_observations(start_);
   return inner_->advance(so_position);
 }
 
 void TimedObservation::predicted_observations(Eigen::MatrixXd& y) const {
   inner_->predicted_observations(y);
-  if (share_ < 1.0) y = start_ + share_ * (y - start_);
+  if (start_read_) y = start_ + share_ * (y - start_);   // else: no step made since set_row
 }
 
 }  // namespace sigmafem

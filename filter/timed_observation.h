@@ -46,6 +46,7 @@ class TimedObservation : public Ensemble {
   std::vector<double> share_by_row_;
   double share_ = 1.0;                 // of the coming step
   Eigen::MatrixXd start_;              // the observations at the step's start (share < 1)
+  bool start_read_ = false;            // start_ holds the coming step's start
 };
 
 }  // namespace sigmafem

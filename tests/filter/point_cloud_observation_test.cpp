@@ -170,6 +170,14 @@ TEST(PointCloudObservationTest, APointTakenInsideAStepIsObservedOnTheSurfaceOfIt
   // Taken as at the step's end, the first point would lie 0.6 mm outside (below) the face,
   // now at z = 1 mm: h = n . (x - p) = -0.6 mm with n = -z.
   EXPECT_NEAR(observe(Eigen::Vector3d(0.25, 0.25, 0.4e-3), 1.0), -0.6e-3, 1e-15);
+  // Asked before the step is made: the surface as it is (nothing to interpolate from).
+  PointCloudObservation before(std::make_unique<MovingSurface>(tetrahedron_positions(surface, 2),
+                                                               Eigen::Vector3d(0.0, 0.0, 1e-3)),
+                               surface.triangles);
+  before.set_frame(Eigen::Vector3d(0.25, 0.25, 0.4e-3), Eigen::VectorXd::Constant(1, 0.4));
+  Eigen::MatrixXd h;
+  before.predicted_observations(h);
+  EXPECT_EQ(predicted_rows(before).size(), 1u);
 }
 
 TEST(PointCloudObservationTest, AnEmptyFrameObservesNothingAndBadInputIsRefused) {

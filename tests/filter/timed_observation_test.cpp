@@ -58,6 +58,11 @@ TEST(TimedObservationTest, AFrameInsideAStepIsObservedWhereThePointsWereThen) {
   timed.advance(Eigen::Vector3d::Zero());
   timed.predicted_observations(y);
   EXPECT_LT((y.col(0) - 2.0 * velocity).norm(), 1e-15);
+  // Asked before any step of a timed row: the ensemble's own observations (no start to
+  // interpolate from), not a read of a stale or empty start.
+  timed.set_row(1);
+  timed.predicted_observations(y);
+  EXPECT_LT((y.col(0) - 2.0 * velocity).norm(), 1e-15);
   EXPECT_THROW(timed.set_row(3), std::invalid_argument);
   EXPECT_THROW(TimedObservation(std::make_unique<MovingPoint>(velocity), {0.0}), std::invalid_argument);
 }
