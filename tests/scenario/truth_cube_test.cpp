@@ -122,7 +122,9 @@ TEST(TruthCube, TheEffectsDiagnoseTriedBringTheBeadsNearer) {
     std::cout << "truth cube, " << kStrain[i] << ": bead error mean " << 1e3 * with_effects[i].mean_error
               << " mm, largest " << 1e3 * with_effects[i].max_error << " mm with the effects tried\n";
     EXPECT_LT(with_effects[i].mean_error, 0.75 * declared[i].mean_error) << kStrain[i];
-    EXPECT_GT(with_effects[i].mean_error, 0.3e-3) << kStrain[i] << ": still beyond the beads' noise";
+    // Still beyond what the beads' localisation noise alone leaves: 0.3 mm per axis (the
+    // scenario's) has a mean length of 1.6 x 0.3 = 0.48 mm.
+    EXPECT_GT(with_effects[i].mean_error, 0.48e-3) << kStrain[i] << ": within the beads' noise";
   }
 }
 
