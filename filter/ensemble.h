@@ -6,7 +6,7 @@
 //   2. set_parameters(): hands over the S parameter vectors,
 //   3. advance(): all S simulations advance one time step with the SO at its measured position,
 //   4. predicted_observations(): reads back only the observed positions (3m x S numbers).
-// filter/ never includes mesh or device headers; host/ includes nothing of filter/ but this.
+// filter/ includes nothing of host/ (no mesh, device or scenario headers); host/ builds on filter/.
 #pragma once
 
 #include <Eigen/Core>
