@@ -15,6 +15,7 @@
 #include "filter/roukf.h"
 #include "host/ensemble/cpu_ensemble.h"
 #include "host/ensemble/make_ensemble.h"
+#include "host/ensemble/surface_cloud_estimation.h"
 #include "host/generator/surface_cloud_sampler.h"
 #include "host/model/model.h"
 #include "host/reference/reference_simulation.h"
@@ -200,10 +201,8 @@ struct CloudBench {
     const ObservedPoints observed(surface.nodes);
     // The outlier gate in the observation, per point, as `estimate` has it
     // (host/ensemble/surface_cloud_estimation.h).
-    const RoukfOptions roukf = estimation_options(s).roukf;
-    PointCloudOptions options;
-    options.observation_std = roukf.observation_std;
-    options.outlier_gate = roukf.outlier_gate;
+    RoukfOptions roukf = estimation_options(s).roukf;
+    const PointCloudOptions options = take_outlier_gate(roukf);
     auto wrapped = std::make_unique<PointCloudObservation>(
         make_bench_ensemble(backend, s, model,
                             sigma_point_count(SigmaPointSet::simplex, static_cast<int>(s.filter->estimate.size())),

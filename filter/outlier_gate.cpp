@@ -37,4 +37,14 @@ std::vector<int> gate_outliers(const OutlierGateOptions& options, const std::vec
   return outliers;
 }
 
+std::vector<int> gate_sigma_point_innovations(const OutlierGateOptions& options, const std::vector<int>& rows,
+                                              const Eigen::MatrixXd& Z, double alpha,
+                                              const Eigen::MatrixXd& directions, double observation_variance,
+                                              int rows_per_point) {
+  if (!options.enabled) return {};
+  Eigen::VectorXd variance = Eigen::VectorXd::Constant(Z.rows(), observation_variance);
+  if (directions.cols() == Z.cols()) variance += (alpha * Z * directions.transpose()).rowwise().squaredNorm();
+  return gate_outliers(options, rows, alpha * Z.rowwise().sum(), variance, rows_per_point);
+}
+
 }  // namespace sigmafem

@@ -41,4 +41,14 @@ std::vector<int> gate_outliers(const OutlierGateOptions& options, const std::vec
                                const Eigen::VectorXd& innovation, const Eigen::VectorXd& variance,
                                int rows_per_point = 3);
 
+// The gate on a step's sigma-point innovations Z (one row per entry of `rows`, one column per
+// sigma point) with the filter's nominal variance S_ii = |alpha Z_i I^T|^2 + sigma^2 and mean
+// innovation alpha sum Z_i (docs/ROUKF.md): the ROUKF gates its data rows with it, the point-
+// cloud observation its points before binning them. `directions` (p x S, I) empty: S_ii =
+// sigma^2 (no spread known yet).
+std::vector<int> gate_sigma_point_innovations(const OutlierGateOptions& options, const std::vector<int>& rows,
+                                              const Eigen::MatrixXd& Z, double alpha,
+                                              const Eigen::MatrixXd& directions, double observation_variance,
+                                              int rows_per_point);
+
 }  // namespace sigmafem

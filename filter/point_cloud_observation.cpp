@@ -84,16 +84,13 @@ void PointCloudObservation::predicted_observations(Eigen::MatrixXd& y) const {
       h(i, s) = normal.dot(x - p);
     }
   }
-  // The gate, per point, with the filter's nominal innovation variance (filter/roukf.cpp): the
-  // innovation is 0 - h, its predicted variance |alpha Z I^T|^2 + sigma^2.
+  // The gate, per point, with the filter's test (filter/outlier_gate.h): the innovation is 0 - h.
   if (options_.outlier_gate.enabled) {
-    const Eigen::MatrixXd Z = -h;
-    const double alpha = alpha_ > 0.0 ? alpha_ : 1.0 / static_cast<double>(S);
-    Eigen::VectorXd variance = Eigen::VectorXd::Constant(n, options_.observation_std * options_.observation_std);
-    if (directions_.cols() == S) variance += (alpha * Z * directions_.transpose()).rowwise().squaredNorm();
-    std::vector<int> rows(static_cast<std::size_t>(n));
-    for (Eigen::Index i = 0; i < n; ++i) rows[static_cast<std::size_t>(i)] = static_cast<int>(i);
-    rejected_ = gate_outliers(options_.outlier_gate, rows, alpha * Z.rowwise().sum(), variance, 1);
+    std::vector<int> points(static_cast<std::size_t>(n));
+    for (Eigen::Index i = 0; i < n; ++i) points[static_cast<std::size_t>(i)] = static_cast<int>(i);
+    rejected_ = gate_sigma_point_innovations(options_.outlier_gate, points, -h,
+                                             alpha_ > 0.0 ? alpha_ : 1.0 / static_cast<double>(S), directions_,
+                                             options_.observation_std * options_.observation_std, 1);
   }
   std::vector<char> rejected(static_cast<std::size_t>(n), 0);
   for (int i : rejected_) rejected[static_cast<std::size_t>(i)] = 1;

@@ -120,11 +120,9 @@ RoukfStep Roukf::step(const Eigen::Vector3d& so_position, const Eigen::VectorXd&
     Z.row(static_cast<Eigen::Index>(j)) = y[rows[j]] - predicted.row(rows[j]).array();
   // Outliers (filter/outlier_gate.h), judged with the nominal S, leave with their rows.
   if (options_.outlier_gate.enabled && !rows.empty()) {
-    const double variance = options_.observation_std * options_.observation_std;
-    const Eigen::VectorXd S_diag =
-        (alpha * Z * I.transpose()).rowwise().squaredNorm().array() + variance;
-    const std::vector<int> outliers = gate_outliers(options_.outlier_gate, rows, alpha * Z.rowwise().sum(), S_diag,
-                                                    ensemble_.rows_per_point());
+    const std::vector<int> outliers =
+        gate_sigma_point_innovations(options_.outlier_gate, rows, Z, alpha, I,
+                                     options_.observation_std * options_.observation_std, ensemble_.rows_per_point());
     result.outliers.insert(result.outliers.end(), outliers.begin(), outliers.end());
     if (!outliers.empty()) {
       std::vector<int> kept;

@@ -14,10 +14,11 @@ TimedObservation::TimedObservation(std::unique_ptr<Ensemble> inner, std::vector<
 }
 
 void TimedObservation::set_row(Eigen::Index row) {
+  start_read_ = false;
+  if (share_by_row_.empty()) return;   // no frame times: on the grid
   if (row < 0 || row >= static_cast<Eigen::Index>(share_by_row_.size()))
     throw std::invalid_argument("TimedObservation: no row " + std::to_string(row));
   share_ = share_by_row_[static_cast<std::size_t>(row)];
-  start_read_ = false;
 }
 
 StepReport TimedObservation::advance(const Eigen::Vector3d& so_position) {

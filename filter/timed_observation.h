@@ -24,7 +24,8 @@ namespace sigmafem {
 class TimedObservation : public Ensemble {
  public:
   // `share_by_row`: for each data row, when in its step the row's points were taken, in
-  // (0, 1] (1: at the step's end, on the grid).
+  // (0, 1] (1: at the step's end, on the grid); empty: every row on the grid (the data have no
+  // frame times, and the decorator changes nothing).
   TimedObservation(std::unique_ptr<Ensemble> inner, std::vector<double> share_by_row);
 
   // The data row of the coming step (run_estimation's before_step).

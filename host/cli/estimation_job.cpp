@@ -65,8 +65,7 @@ json run_estimation_job(const Scenario& scenario, const EstimationJob& job) {
   // and each frame's points are observed by their distance to it
   // (host/ensemble/surface_cloud_estimation.h).
   std::optional<SurfaceCloudEstimation> cloud;
-  std::unique_ptr<Ensemble> tracked;
-  TimedObservation* timed = nullptr;
+  std::unique_ptr<TimedObservation> tracked;
   nlohmann::ordered_json observations = {{"kind", "tracked_points"}, {"points", table.point_count()}};
   if (scenario.observations.surface_cloud) {
     const std::string cloud_path = (data / "pointcloud.csv").string();
@@ -83,16 +82,12 @@ json run_estimation_job(const Scenario& scenario, const EstimationJob& job) {
                     {"max_points_per_step", max_points},
                     {"surface_triangles", cloud->surface_triangles}};
   } else {
-    tracked = make_ensemble(backend.backend, model, spec.estimate, scenario.observations.observed, sigma_count,
-                            job.device);
-    // Frames at their own times (observations.csv's frame_time): observed then
-    // (filter/timed_observation.h).
-    if (!table.frame_times.empty()) {
-      auto wrapped = std::make_unique<TimedObservation>(std::move(tracked), table.frame_shares);
-      timed = wrapped.get();
-      tracked = std::move(wrapped);
-      observations["frame_time"] = true;
-    }
+    // Frames at their own times (observations.csv's frame_time) are observed then
+    // (filter/timed_observation.h); without the column the decorator changes nothing.
+    tracked = std::make_unique<TimedObservation>(
+        make_ensemble(backend.backend, model, spec.estimate, scenario.observations.observed, sigma_count, job.device),
+        table.frame_shares);
+    if (!table.frame_times.empty()) observations["frame_time"] = true;
   }
   Progress progress("estimate " + scenario.name + ": step", table.row_count() - 1, job.progress);
   const EstimationRun run = run_estimation(
@@ -105,7 +100,7 @@ json run_estimation_job(const Scenario& scenario, const EstimationJob& job) {
       },
       [&](Eigen::Index row) {
         if (cloud) cloud->before_step(row);
-        if (timed) timed->set_row(row);
+        if (tracked) tracked->set_row(row);
       });
   progress.finish();
 

@@ -142,21 +142,15 @@ ModelFit fit_model(const Scenario& scenario, const ObservationTable& data,
     fit.run = run_estimation(*observed.ensemble, estimation, data.times, data.so, observed.measured,
                              stop_if_interrupted, [&](Eigen::Index row) { observed.before_step(row); });
   } else {
-    std::unique_ptr<Ensemble> ensemble = EffectEnsemble::make(
-        options.backend, model, spec.estimate, scenario.observations.observed, sigma_count, options.device, effects);
     // Frames at their own times (observations.csv's frame_time), as `estimate` observes them.
-    TimedObservation* timed = nullptr;
-    if (!data.frame_times.empty()) {
-      auto wrapped = std::make_unique<TimedObservation>(std::move(ensemble), data.frame_shares);
-      timed = wrapped.get();
-      ensemble = std::move(wrapped);
-    }
+    TimedObservation ensemble(EffectEnsemble::make(options.backend, model, spec.estimate,
+                                                   scenario.observations.observed, sigma_count, options.device,
+                                                   effects),
+                              data.frame_shares);
     Eigen::MatrixXd points = data.points;
     for (Eigen::Index c = 0; c + 2 < points.cols(); c += 3) points.middleCols(c, 3).rowwise() -= offset.transpose();
-    fit.run = run_estimation(*ensemble, estimation, data.times, data.so, points, stop_if_interrupted,
-                             [&](Eigen::Index row) {
-                               if (timed) timed->set_row(row);
-                             });
+    fit.run = run_estimation(ensemble, estimation, data.times, data.so, points, stop_if_interrupted,
+                             [&](Eigen::Index row) { ensemble.set_row(row); });
     positions = mean_observed_positions(points);
   }
   // A cloud's rows are surface triangles, not points with lever arms: its residual is judged

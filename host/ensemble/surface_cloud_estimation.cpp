@@ -11,6 +11,14 @@
 
 namespace sigmafem {
 
+PointCloudOptions take_outlier_gate(RoukfOptions& roukf) {
+  PointCloudOptions options;
+  options.observation_std = roukf.observation_std;
+  options.outlier_gate = roukf.outlier_gate;
+  roukf.outlier_gate.enabled = false;
+  return options;
+}
+
 SurfaceCloudEstimation make_surface_cloud_estimation(const std::string& backend, const Model& model,
                                                      const Mesh& mesh, const std::vector<int>& estimated,
                                                      int sigma_count, const DeviceOptions& device,
@@ -38,10 +46,7 @@ SurfaceCloudEstimation make_surface_cloud_estimation(const std::string& backend,
   estimation.measured = Eigen::MatrixXd::Constant(rows, triangles, std::nan(""));
   for (std::size_t k = 0; k < estimation.frames.size(); ++k)
     if (estimation.frames[k].points.cols() > 0) estimation.measured.row(static_cast<Eigen::Index>(k)).setZero();
-  PointCloudOptions options;
-  options.observation_std = roukf.observation_std;
-  options.outlier_gate = roukf.outlier_gate;
-  roukf.outlier_gate.enabled = false;
+  const PointCloudOptions options = take_outlier_gate(roukf);
   const ObservedPoints observed(surface.nodes);
   std::unique_ptr<Ensemble> organ =
       effects.empty() ? make_ensemble(backend, model, estimated, observed, sigma_count, device)

@@ -33,6 +33,11 @@ struct SurfaceCloudEstimation {
   }
 };
 
+// The point-cloud observation's options from the filter's: the outlier gate moves from the
+// filter into the observation, which gates each point before binning it (`roukf`'s gate is
+// handed over and turned off there), with the filter's observation std.
+PointCloudOptions take_outlier_gate(RoukfOptions& roukf);
+
 // The estimation of `model` (on `mesh`'s boundary surface) from `cloud` over `rows` data rows
 // of `dt`, on `backend` (make_ensemble), with the candidate `effects` estimated too
 // (EffectEnsemble, for diagnose; its camera offset moves the surface). The outlier gate moves from the filter into the

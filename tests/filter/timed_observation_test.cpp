@@ -64,6 +64,12 @@ TEST(TimedObservationTest, AFrameInsideAStepIsObservedWhereThePointsWereThen) {
   timed.predicted_observations(y);
   EXPECT_LT((y.col(0) - 2.0 * velocity).norm(), 1e-15);
   EXPECT_THROW(timed.set_row(3), std::invalid_argument);
+  // Data without frame times: every row on the grid, the ensemble's own observations.
+  TimedObservation on_grid(std::make_unique<MovingPoint>(velocity), {});
+  on_grid.set_row(7);
+  on_grid.advance(Eigen::Vector3d::Zero());
+  on_grid.predicted_observations(y);
+  EXPECT_LT((y.col(0) - velocity).norm(), 1e-15);
   EXPECT_THROW(TimedObservation(std::make_unique<MovingPoint>(velocity), {0.0}), std::invalid_argument);
 }
 
