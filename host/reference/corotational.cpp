@@ -28,10 +28,11 @@ Eigen::Matrix3d frame_matrix(const double frame[9]) {
 
 void element_frames(const Model& model, const Eigen::VectorXd& x, std::vector<Frame>& frames) {
   frames.resize(model.elements.size());
+  const double polar = model.material.rotation == ElementRotation::polar ? 1.0 : 0.0;
   double p[12];
   for (std::size_t e = 0; e < model.elements.size(); ++e) {
     gather_corners(model.elements[e], x, p);
-    shared::sf_element_frame(p, frames[e].data());
+    shared::sf_element_rotation(model.elements[e].grad.data(), p, polar, frames[e].data());
   }
 }
 

@@ -24,10 +24,18 @@ struct MeshSpec {
   int refine = 0;                   // uniform refinement levels (0..3), each x8 tetrahedra
 };
 
+// How each tetrahedron's rotation is taken from its corners (kernels/shared/element.h).
+enum class ElementRotation {
+  qr,      // SOFA's "large" method: a frame built on edge 0-1 and face 0-1-2 (the default)
+  polar,   // SOFA's "polar" method: the rotation of the polar decomposition of the element's
+           // deformation gradient; stable at large strain near nu = 0.5 (README, "The Truth Cube")
+};
+
 struct Material {
   double young_modulus = 0.0;       // Pa
   double poisson_ratio = 0.0;       // in (-1, 0.5)
   double density = 0.0;             // kg/m^3
+  ElementRotation rotation = ElementRotation::qr;
 };
 
 struct Damping {

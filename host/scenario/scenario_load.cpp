@@ -507,7 +507,7 @@ void read_mesh_section(const Checker& c, const json& root, const std::string& sc
 
 void read_physics(const Checker& c, const json& root, Scenario& s) {
   const json& material = root.at("material");
-  c.check_object(material, "material", {"young_modulus", "poisson_ratio", "density"},
+  c.check_object(material, "material", {"young_modulus", "poisson_ratio", "density", "rotation"},
                  {"young_modulus", "poisson_ratio", "density"});
   s.material.young_modulus = c.number(material.at("young_modulus"), "material.young_modulus");
   c.positive(s.material.young_modulus, "material.young_modulus");
@@ -518,6 +518,13 @@ void read_physics(const Checker& c, const json& root, Scenario& s) {
             "must be in (-1, 0.5), found " + message_number(s.material.poisson_ratio));
   s.material.density = c.number(material.at("density"), "material.density");
   c.positive(s.material.density, "material.density");
+  if (material.contains("rotation")) {
+    const std::string rotation = c.string(material.at("rotation"), "material.rotation");
+    c.require(rotation == "qr" || rotation == "polar", "material.rotation",
+              "unknown element rotation " + in_quotes(rotation) + suggestion(rotation, {"qr", "polar"}) +
+                  " (expected \"qr\", SOFA's large method, or \"polar\")");
+    s.material.rotation = rotation == "polar" ? ElementRotation::polar : ElementRotation::qr;
+  }
 
   if (root.contains("damping")) {
     const json& damping = root.at("damping");

@@ -1,7 +1,8 @@
 /* element_rhs: the rotation step and each element's part of the implicit Euler right-hand
  * side and of the Jacobi diagonal, per sigma point, in one pass over the elements (host:
  * element_frames, ImplicitEulerSystem::right_hand_side and ::diagonal):
- *   frame  = the element's QR frame at x   (stored: every CG product of the step uses it)
+ *   frame  = the element's frame at x      (QR or polar, element.h; stored: every CG
+ *                                           product of the step uses it)
  *   rhs_e  = f_e(x) - (h + a) K_e v_e      (elastic force and the stiffness-damping product;
  *                                           h + a per sigma point, step_constants.h)
  *   diag_e = diag(R K_e R^T)
@@ -31,7 +32,7 @@ __kernel void element_rhs(uint S, uint element_count, __global const int* restri
     real force[12];
     real product[12];
     sf_gather_corners(x, corner_nodes, s, S, corner);
-    sf_element_frame(corner, frame);
+    sf_element_rotation(grad, corner, c[SF_POLAR_ROTATION], frame);
     SF_UNROLL
     for (int i = 0; i < 9; ++i) frames[((size_t)9 * e + i) * S + s] = frame[i];
     sf_element_force(frame, grad, vlambda, vmu, corner, force);

@@ -1,6 +1,7 @@
 /* element_rhs: the rotation step and each element's part of the implicit Euler right-hand
  * side and of the Jacobi diagonal, per sigma point (as kernels/opencl/element_rhs.cl):
- *   frame  = the element's QR frame at x   (stored: every CG product of the step uses it)
+ *   frame  = the element's frame at x      (QR or polar, element.h; stored: every CG
+ *                                           product of the step uses it)
  *   rhs_e  = f_e(x) - (h + a) K_e v_e
  *   diag_e = diag(R K_e R^T)
  * One invocation per (element, sigma). */
@@ -34,7 +35,7 @@ void main() {
   real force[12];
   real product[12];
   SF_GATHER_CORNERS(x, corner_nodes, s, S, corner)
-  sf_element_frame(corner, frame);
+  sf_element_rotation(grad, corner, c[SF_POLAR_ROTATION], frame);
   for (uint i = 0u; i < 9u; ++i) frames[(9u * e + i) * S + s] = frame[i];
   sf_element_force(frame, grad, vlambda, vmu, corner, force);
   SF_GATHER_CORNERS(v, corner_nodes, s, S, corner)

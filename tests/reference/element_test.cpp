@@ -239,5 +239,95 @@ TEST_F(ElementTest, DiagonalEqualsDiagonalOfExplicitMatrix) {
   }
 }
 
+// The polar frame (material.rotation "polar"): at rest and under rigid motion it is the QR
+// frame (both are then the element's rotation); under any deformation it makes the stretch
+// H = frame G symmetric, which is what gives forces without a net torque.
+Eigen::Matrix3d polar_frame_of(const ElementRest& rest, const std::array<double, 12>& x) {
+  double frame[9];
+  shared::sf_element_polar_frame(rest.grad.data(), x.data(), frame);
+  Eigen::Matrix3d F;
+  for (int r = 0; r < 3; ++r)
+    for (int k = 0; k < 3; ++k) F(r, k) = frame[3 * r + k];
+  return F;
+}
+
+// x deformed by up to `strain` of the 0.1 m element per coordinate, then moved rigidly.
+std::array<double, 12> deformed_and_moved(const std::array<double, 12>& X, double strain, std::mt19937& random) {
+  std::uniform_real_distribution<double> offset(-strain * 0.1, strain * 0.1);
+  std::array<double, 12> deformed = X;
+  for (double& v : deformed) v += offset(random);
+  return moved(deformed, test::random_rotation(random), test::random_vector(random, 3));
+}
+
+// The net torque sum_c x_c x f_c of the corner forces f at positions x.
+Eigen::Vector3d net_torque(const std::array<double, 12>& x, const double f[12]) {
+  Eigen::Vector3d torque = Eigen::Vector3d::Zero();
+  for (int c = 0; c < 4; ++c)
+    torque += Eigen::Vector3d(x[3 * c], x[3 * c + 1], x[3 * c + 2]).cross(Eigen::Vector3d(f[3 * c], f[3 * c + 1], f[3 * c + 2]));
+  return torque;
+}
+
+TEST_F(ElementTest, PolarFrameIsTheQrFrameOfTheRigidlyMovedRestShape) {
+  for (int e = 0; e < kElements; ++e) {
+    const std::array<double, 12> X = random_element(random_);
+    const ElementRest rest = element_rest_state(X, kMaterial);
+    const Eigen::Matrix3d Q = test::random_rotation(random_);
+    const std::array<double, 12> x = moved(X, Q, Eigen::Vector3d(1.0, -2.0, 0.5));
+    EXPECT_LE((polar_frame_of(rest, x) - frame_of(x)).norm(), kRotationTolerance)
+        << "polar vs QR frame of the rigidly moved rest shape, element " << e;
+  }
+}
+
+TEST_F(ElementTest, PolarFrameMakesTheStretchSymmetricAtLargeStrain) {
+  for (int e = 0; e < kElements; ++e) {
+    const std::array<double, 12> X = random_element(random_);
+    const ElementRest rest = element_rest_state(X, kMaterial);
+    const std::array<double, 12> x = deformed_and_moved(X, 0.3, random_);   // strains up to ~50%
+    const Eigen::Matrix3d F = polar_frame_of(rest, x);
+    EXPECT_LE((F * F.transpose() - Eigen::Matrix3d::Identity()).norm(), kRotationTolerance) << "element " << e;
+    EXPECT_NEAR(F.determinant(), 1.0, kRotationTolerance) << "element " << e;
+    double G[9];
+    shared::sf_element_gradient(rest.grad.data(), x.data(), 1.0, G);
+    const Eigen::Matrix3d H = F * Eigen::Map<const Eigen::Matrix<double, 3, 3, Eigen::RowMajor>>(G);
+    EXPECT_LE((H - H.transpose()).norm(), 1e-12 * H.norm()) << "stretch of element " << e;
+    EXPECT_GT(H.eigenvalues().real().minCoeff(), 0.0) << "the stretch is positive definite, element " << e;
+  }
+}
+
+// Angular momentum: the elastic forces of the polar frame have no net torque, at any strain
+// (the stress H - I is symmetric in the frame); those of the QR frame do once the element is
+// strained (its frame follows one edge, not the element), which is what drove the Truth
+// Cube's drift at nu = 0.49 (README, "The Truth Cube"). Torques relative to |f| |x|.
+TEST_F(ElementTest, PolarForcesHaveNoNetTorqueWhereQrForcesDo) {
+  const Material incompressible{15300.0, 0.49, 1000.0};
+  double largest_qr = 0.0;
+  for (int e = 0; e < kElements; ++e) {
+    const std::array<double, 12> X = random_element(random_);
+    const ElementRest rest = element_rest_state(X, incompressible);
+    const std::array<double, 12> x = deformed_and_moved(X, 0.2, random_);
+    double frame[9], f[12];
+    const auto relative_torque = [&]() {
+      double size = 0.0;
+      for (int i = 0; i < 12; ++i) size = std::max(size, std::abs(x[i]));
+      return net_torque(x, f).norm() / (Eigen::Map<const Vector12>(f).norm() * size);
+    };
+    shared::sf_element_polar_frame(rest.grad.data(), x.data(), frame);
+    shared::sf_element_force(frame, rest.grad.data(), rest.vlambda, rest.vmu, x.data(), f);
+    EXPECT_LE(relative_torque(), 1e-12) << "net torque of the polar frame's forces, element " << e;
+    shared::sf_element_frame(x.data(), frame);
+    shared::sf_element_force(frame, rest.grad.data(), rest.vlambda, rest.vmu, x.data(), f);
+    largest_qr = std::max(largest_qr, relative_torque());
+  }
+  EXPECT_GT(largest_qr, 1e-3) << "the QR frame's forces would have no net torque either: the test proves nothing";
+}
+
+TEST_F(ElementTest, AnInvertedElementKeepsTheQrFrame) {
+  const std::array<double, 12> X = random_element(random_);
+  const ElementRest rest = element_rest_state(X, kMaterial);
+  std::array<double, 12> inverted = X;
+  for (int k = 0; k < 3; ++k) inverted[9 + k] = X[k] - (X[9 + k] - X[k]);   // corner 3 through face 0-1-2's side
+  EXPECT_EQ(polar_frame_of(rest, inverted), frame_of(inverted));
+}
+
 }  // namespace
 }  // namespace sigmafem

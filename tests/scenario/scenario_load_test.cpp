@@ -19,6 +19,7 @@
 #include "requirement.h"
 #include "temp_path.h"
 #include "host/common/input_error.h"
+#include "host/model/model.h"
 #include "host/scenario/scenario.h"
 #include "host/scenario/estimation_options.h"
 
@@ -124,6 +125,7 @@ TEST_F(ScenarioLoadTest, OptionalFieldsTakeTheirDefaults) {
   EXPECT_EQ(s.damping.rayleigh_stiffness, 0.0);
   EXPECT_EQ(s.damping.rayleigh_mass, 0.0);
   EXPECT_EQ(s.gravity, Eigen::Vector3d::Zero());
+  EXPECT_EQ(s.material.rotation, ElementRotation::qr) << "SOFA's large method, as the SOFA reference";
   EXPECT_EQ(s.solver.cg_max_iterations, 1000);
   EXPECT_EQ(s.solver.cg_tolerance, 1e-10);
   EXPECT_TRUE(s.ligaments.empty());
@@ -139,6 +141,7 @@ TEST_F(ScenarioLoadTest, GivenOptionalFieldsAreRead) {
   j["name"] = "named";
   j["description"] = "free text";
   j["damping"] = {{"rayleigh_stiffness", 0.1}, {"rayleigh_mass", 0.2}};
+  j["material"]["rotation"] = "polar";
   j["gravity"] = {0, -9.81, 0};
   j["solver"] = {{"cg_max_iterations", 300}, {"cg_tolerance", 1e-8}};
   j["output"] = {{"vtk_every", 0}};
@@ -151,6 +154,8 @@ TEST_F(ScenarioLoadTest, GivenOptionalFieldsAreRead) {
   EXPECT_EQ(s.description, "free text");
   EXPECT_EQ(s.damping.rayleigh_stiffness, 0.1);
   EXPECT_EQ(s.damping.rayleigh_mass, 0.2);
+  EXPECT_EQ(s.material.rotation, ElementRotation::polar);
+  EXPECT_EQ(make_model(s).material.rotation, ElementRotation::polar) << "the model's elements use it";
   EXPECT_EQ(s.gravity, Eigen::Vector3d(0, -9.81, 0));
   EXPECT_EQ(s.solver.cg_max_iterations, 300);
   EXPECT_EQ(s.solver.cg_tolerance, 1e-8);
@@ -715,6 +720,12 @@ TEST_F(ScenarioLoadTest, BadFieldsAreNamed) {
       {"density zero",
        [](json& j) { j["material"]["density"] = 0; },
        {"material.density:", "must be > 0"}},
+      {"rotation unknown",
+       [](json& j) { j["material"]["rotation"] = "polr"; },
+       {"material.rotation:", "unknown element rotation \"polr\"", "did you mean \"polar\"?"}},
+      {"rotation not a string",
+       [](json& j) { j["material"]["rotation"] = 1; },
+       {"material.rotation:"}},
       // negative stiffness, damping, noise
       {"ligament stiffness negative",
        [](json& j) { j["ligaments"][1]["stiffness"] = -300; },
