@@ -86,6 +86,7 @@ void EffectEnsemble::set_parameters(const Eigen::MatrixXd& theta) {
       const std::string& name = definition->name;
       if (name == "gravity") physics[s].gravity = Eigen::Vector3d(v[0], v[1], v[2]);
       else if (name == "young_scale") physics[s].young_scale = v[0];
+      else if (name == "lambda_scale") physics[s].lambda_scale = v[0];
       else if (name == "damping_scale") physics[s].damping_mass_scale = v[0], physics[s].damping_stiffness_scale = v[1];
       else if (name == "ligament_law") physics[s].ligament_d0 = v[0];
       else if (name == "time_lag") physics[s].time_lag = v[0];

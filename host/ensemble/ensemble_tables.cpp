@@ -136,6 +136,7 @@ std::vector<double> StepConstants::next_step(const Model& m, const Eigen::Vector
     }
     at(SF_INVERSE_D0_SQUARED) = 1.0 / (d0 * d0);   // 0 for the linear law (infinite d0)
     at(SF_YOUNG_SCALE) = e.young_scale;
+    at(SF_LAMBDA_SCALE) = e.lambda_scale;
     at(SF_MASS_FACTOR) = 1.0 + h * b;
     at(SF_STIFFNESS_FACTOR) = h * (h + a);
     at(SF_RAYLEIGH_MASS) = b;

@@ -14,6 +14,14 @@ void apply_effects(const std::vector<EffectValue>& effects, Model& model) {
     const std::string& family = definition->name;
     if (family == "gravity") {
       model.gravity += Eigen::Vector3d(effect.value[0], effect.value[1], effect.value[2]);
+    } else if (family == "lambda_scale") {
+      // Lame lambda scaled, mu kept: nu (and with it E) moves; the material record follows,
+      // lambda / mu = 2 nu / (1 - 2 nu).
+      const Eigen::Vector2d lame = lame_coefficients(model.material);
+      const double lambda = effect.value[0] * lame[0], mu = lame[1];
+      model.material.poisson_ratio = lambda / (2.0 * (lambda + mu));
+      model.material.young_modulus = mu * (3.0 * lambda + 2.0 * mu) / (lambda + mu);
+      for (ElementRest& element : model.elements) element.vlambda *= effect.value[0];
     } else if (family == "young_scale") {
       // Linear elasticity: the Lame terms, hence K_e, are proportional to E.
       model.material.young_modulus *= effect.value[0];

@@ -23,6 +23,7 @@ namespace sigmafem {
 struct PhysicsEffects {
   Eigen::Vector3d gravity = Eigen::Vector3d::Zero();   // m/s^2, added to the model's gravity
   double young_scale = 1.0;                            // multiplies every element's Lame terms
+  double lambda_scale = 1.0;                           // multiplies every element's Lame lambda
   double damping_mass_scale = 1.0;                     // multiplies damping.rayleigh_mass
   double damping_stiffness_scale = 1.0;                // multiplies damping.rayleigh_stiffness
   // The ligament law's d0 (m) instead of the model's; infinite: the model's.

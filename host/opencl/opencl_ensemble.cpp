@@ -162,6 +162,7 @@ OpenClEnsemble::OpenClEnsemble(const Model& model, std::vector<int> estimated,
     set_args(k_element_product_, S, E, element_nodes_, element_rest_, frames_);
     k_element_product_.setArg(7, element_out_);
     k_element_product_.setArg(8, N);
+    k_element_product_.setArg(9, constants_);
     set_args(k_node_product_, S, N, constants_, incidence_offsets_, incidence_, ligament_offsets_,
              ligament_of_node_, ligament_k_buffer_, control_k_, mass_);
     k_node_product_.setArg(11, element_out_);

@@ -33,15 +33,16 @@ void ReferenceSimulation::set_physics_effects(const PhysicsEffects& effects) {
   model_.ligament_d0 = std::isfinite(effects.ligament_d0) ? effects.ligament_d0 : base_d0_;
   model_.so_lag = base_so_lag_ + effects.time_lag;
   model_.control_scale = base_control_scale_ * effects.control_scale;
-  if (effects.young_scale == young_scale_) return;
+  if (effects.young_scale == young_scale_ && effects.lambda_scale == lambda_scale_) return;
   if (base_lame_.empty())
     for (const ElementRest& element : model_.elements) base_lame_.emplace_back(element.vlambda, element.vmu);
   // Scaled from the model's values each time, so that no rounding accumulates over steps.
   for (std::size_t e = 0; e < model_.elements.size(); ++e) {
-    model_.elements[e].vlambda = effects.young_scale * base_lame_[e][0];
+    model_.elements[e].vlambda = effects.young_scale * effects.lambda_scale * base_lame_[e][0];
     model_.elements[e].vmu = effects.young_scale * base_lame_[e][1];
   }
   young_scale_ = effects.young_scale;
+  lambda_scale_ = effects.lambda_scale;
 }
 
 void ReferenceSimulation::set_ligament_stiffness(const std::vector<double>& stiffness) {

@@ -82,7 +82,7 @@ class ReferenceSimulation {
   std::vector<Frame> frames_;
   Eigen::Vector3d base_gravity_;
   std::vector<Eigen::Vector2d> base_lame_;   // per element: vlambda, vmu of the model
-  double young_scale_ = 1.0;
+  double young_scale_ = 1.0, lambda_scale_ = 1.0;
   Damping base_damping_;
   double base_d0_ = 0.0, base_so_lag_ = 0.0, base_control_scale_ = 1.0;
   SoHistory so_history_;                     // for the lag (Model::so_lag)

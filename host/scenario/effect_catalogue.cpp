@@ -22,6 +22,12 @@ const std::vector<EffectDefinition>& effect_catalogue() {
        {{"gx", "m/s^2", false, 0.0, 5.0}, {"gy", "m/s^2", false, 0.0, 5.0}, {"gz", "m/s^2", false, 0.0, 5.0}}},
       {"young_scale", "a global scale of Young's modulus", EffectSide::physics, true, false,
        "s (> 0, multiplies material.young_modulus)", 1, {{"scale", "", true, 0.0, 0.5, 1.0}}},
+      // The material's resistance to volume change: Lame lambda scaled, the shear modulus kept
+      // (nu off: lambda / mu = 2 nu / (1 - 2 nu), 9 at nu = 0.45, 49 at 0.49); 1 a priori,
+      // within a factor of e^1.5 (1 std): from nu = 0.45 that is 0.36 to 0.49.
+      {"lambda_scale", "a scale of Lame's lambda, the shear modulus kept (Poisson's ratio off: nearer 0.5 or farther)",
+       EffectSide::physics, true, false, "s (> 0, multiplies Lame lambda; no effect where nu = 0)", 1,
+       {{"scale", "", true, 0.0, 1.5, 1.0}}},
       {"camera_offset", "a rigid translation of the observation frame (camera registration error)",
        EffectSide::observation, true, false, "tx,ty,tz (m, added to every observed position)", 3,
        {{"tx", "m", false, 0.0, 5e-3}, {"ty", "m", false, 0.0, 5e-3}, {"tz", "m", false, 0.0, 5e-3}}},
@@ -85,7 +91,8 @@ std::string effect_value_problem(const EffectDefinition& definition, const std::
   for (double x : value)
     if (!std::isfinite(x) || std::fabs(x) > kMaxScenarioMagnitude)
       return "every number must be finite and within +-1e12 (SI units)";
-  if ((definition.name == "young_scale" || definition.name == "ligament_law" || definition.name == "damping_scale" ||
+  if ((definition.name == "young_scale" || definition.name == "lambda_scale" || definition.name == "ligament_law" ||
+       definition.name == "damping_scale" ||
        definition.name == "control_scale") &&
       !(*std::min_element(value.begin(), value.end()) > 0.0))
     return "must be > 0 (" + definition.value_syntax + ")";

@@ -104,7 +104,7 @@ VulkanEnsemble::VulkanEnsemble(const Model& model, std::vector<int> estimated,
   // Bindings in the order of each shader's (and the OpenCL kernel's) buffer arguments.
   k_element_rhs_ = device_.kernel("element_rhs", 8);
   k_node_rhs_ = device_.kernel("node_rhs", 15);
-  k_element_product_ = device_.kernel("element_product", 6);
+  k_element_product_ = device_.kernel("element_product", 7);
   k_node_product_ = device_.kernel("node_product", 11);
   // The CG shaders: the start's three share 25 bindings, the iteration's four 17.
   const std::uint32_t partitions = static_cast<std::uint32_t>(cg_partitions_);
@@ -134,11 +134,11 @@ VulkanEnsemble::VulkanEnsemble(const Model& model, std::vector<int> estimated,
   s_node_rhs_ = device_.bind(k_node_rhs_, with_shared({rest_positions_, x_, v_, element_out_,
                                                        element_diagonal_, rhs_, inverse_diagonal_}));
   s_product_warm_start_ = device_.bind(
-      k_element_product_, {element_nodes_, element_rest_, frames_, dv_, all_active_, element_out_});
+      k_element_product_, {element_nodes_, element_rest_, frames_, dv_, all_active_, element_out_, constants_});
   s_product_cg_ = device_.bind(k_element_product_,
-                               {element_nodes_, element_rest_, frames_, d_, active_, element_out_});
+                               {element_nodes_, element_rest_, frames_, d_, active_, element_out_, constants_});
   s_product_all_ = device_.bind(
-      k_element_product_, {element_nodes_, element_rest_, frames_, d_, all_active_, element_out_});
+      k_element_product_, {element_nodes_, element_rest_, frames_, d_, all_active_, element_out_, constants_});
   s_node_product_ = device_.bind(k_node_product_, with_shared({d_, element_out_, q_}));
   const std::vector<VulkanBuffer> start_buffers = with_shared(
       {element_out_, rhs_, inverse_diagonal_, dv_, r_, z_, d_, bb_, rr_, rz_, active_, converged_,

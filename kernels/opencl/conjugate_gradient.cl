@@ -559,13 +559,13 @@ __kernel void cg_solve(uint S, uint element_count, uint node_count, int max_iter
                        __global uint* restrict converged, __global int* restrict iterations) {
   if (get_global_id(0) != 0) return;
   const uint rows = 3 * node_count;
-  sf_element_chunk_products(0, element_count, S, node_count, nodes, rest, frames, x, element_out);
+  sf_element_chunk_products(0, element_count, S, node_count, nodes, rest, frames, c, x, element_out);
   sf_block_node_product(0, SF_SIGMA_BLOCK, 1, S, node_count, c, ligament_offsets, ligament_of_node,
                         ligament_k, control_k, mass, x, element_out, q);
   int any = sf_block_cg_start(0, SF_SIGMA_BLOCK, S, rows, c, q, b, inverse_diagonal, r, z, d, bb,
                               rr, rz, active, converged, iterations);
   while (any) {
-    sf_element_chunk_products(0, element_count, S, node_count, nodes, rest, frames, d, element_out);
+    sf_element_chunk_products(0, element_count, S, node_count, nodes, rest, frames, c, d, element_out);
     sf_block_node_product(0, SF_SIGMA_BLOCK, 1, S, node_count, c, ligament_offsets,
                           ligament_of_node, ligament_k, control_k, mass, d, element_out, q);
     any = sf_block_cg_iteration(0, SF_SIGMA_BLOCK, S, rows, max_iterations, c, inverse_diagonal,

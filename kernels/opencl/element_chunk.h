@@ -11,7 +11,7 @@
 static inline __attribute__((always_inline)) void sf_element_chunk_products(
     uint begin, uint end, uint S, uint node_count, __global const int* restrict nodes,
     __global const real* restrict rest, __global const real* restrict frames,
-    __global const real* restrict d, __global real* restrict copy) {
+    __global const real* restrict c, __global const real* restrict d, __global real* restrict copy) {
   const size_t copy_size = (size_t)3 * node_count * S;
   for (size_t i = 0; i < copy_size; ++i) copy[i] = (real)0;
   for (uint e = begin; e < end; ++e) {
@@ -31,7 +31,8 @@ static inline __attribute__((always_inline)) void sf_element_chunk_products(
       real product[12];
       sf_load_frame(frames, e, s, S, frame);
       sf_gather_corners(d, corner_nodes, s, S, corner);
-      sf_element_product(frame, grad, vlambda, vmu, corner, product);
+      sf_element_product(frame, grad, vlambda * SF_SIGMA_CONSTANT(c, SF_LAMBDA_SCALE, s, S), vmu, corner,
+                         product);
       SF_UNROLL
       for (int i = 0; i < 12; ++i) products[i][s] = product[i];
     }

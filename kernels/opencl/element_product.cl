@@ -16,13 +16,14 @@
 __kernel void element_product(uint S, uint element_count, __global const int* restrict nodes,
                               __global const real* restrict rest, __global const real* restrict frames,
                               __global const real* restrict d, __global const uint* restrict active,
-                              __global real* restrict out, uint node_count) {
+                              __global real* restrict out, uint node_count,
+                              __global const real* restrict c) {
 #if SF_ELEMENT_CHUNKS > 0
   uint chunk = (uint)get_global_id(0);
   if (chunk >= SF_ELEMENT_CHUNKS) return;
   sf_element_chunk_products((uint)((ulong)element_count * chunk / SF_ELEMENT_CHUNKS),
                             (uint)((ulong)element_count * (chunk + 1) / SF_ELEMENT_CHUNKS), S,
-                            node_count, nodes, rest, frames, d,
+                            node_count, nodes, rest, frames, c, d,
                             out + chunk * ((size_t)3 * node_count * S));
 #else
   uint e;
@@ -34,11 +35,13 @@ __kernel void element_product(uint S, uint element_count, __global const int* re
   sf_load_rest(rest, e, grad, &vlambda, &vmu);
   int corner_nodes[4];
   sf_load_nodes(nodes, e, corner_nodes);
+  const real vlambda_model = vlambda;
   for (uint b = 0; b < SF_SIGMA_BLOCK; ++b) {
     uint s = first + b;
 #  if SF_SIGMA_BLOCK == 1
     if (!active[s]) return; /* this sigma point's CG is done */
 #  endif
+    vlambda = vlambda_model * SF_SIGMA_CONSTANT(c, SF_LAMBDA_SCALE, s, S);
     real frame[9];
     real corner[12];
     real product[12];

@@ -25,8 +25,10 @@ __kernel void element_rhs(uint S, uint element_count, __global const int* restri
   sf_load_rest(rest, e, grad, &vlambda, &vmu);
   int corner_nodes[4];
   sf_load_nodes(nodes, e, corner_nodes);
+  const real vlambda_model = vlambda;
   for (uint b = 0; b < SF_SIGMA_BLOCK; ++b) {
     uint s = first + b;
+    vlambda = vlambda_model * SF_SIGMA_CONSTANT(c, SF_LAMBDA_SCALE, s, S);
     real frame[9];
     real corner[12];
     real force[12];

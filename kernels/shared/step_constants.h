@@ -22,7 +22,8 @@
 #define SF_STIFFNESS_FACTOR 9    /* h (h + a) */
 #define SF_RAYLEIGH_MASS 10      /* b */
 #define SF_VELOCITY_FACTOR 11    /* h + a */
-#define SF_SIGMA_CONSTANT_COUNT 12
+#define SF_LAMBDA_SCALE 12       /* multiplies the elements' Lame lambda (lambda_scale; mu kept) */
+#define SF_SIGMA_CONSTANT_COUNT 13
 
 /* Constant k of sigma point s, with S sigma points, in the buffer c. */
 #define SF_SIGMA_CONSTANT(c, k, s, S) ((c)[SF_STEP_CONSTANTS + (k) * (S) + (s)])

@@ -13,6 +13,7 @@ layout(std430, binding = 2) restrict readonly buffer Frames { real frames[]; };
 layout(std430, binding = 3) restrict readonly buffer D { real d[]; };
 layout(std430, binding = 4) restrict readonly buffer Active { uint active_flags[]; };
 layout(std430, binding = 5) restrict writeonly buffer Out { real out_values[]; };
+layout(std430, binding = 6) restrict readonly buffer C { real c[]; };
 
 void main() {
   uint S = sf_push.S;
@@ -26,6 +27,7 @@ void main() {
   real vmu;
   uint corner_nodes[4];
   SF_LOAD_ELEMENT(rest, nodes, e, grad, vlambda, vmu, corner_nodes)
+  vlambda *= SF_SIGMA_CONSTANT(c, SF_LAMBDA_SCALE, s, S);
   real frame[9];
   real corner[12];
   real product[12];

@@ -30,6 +30,7 @@ void main() {
   real vmu;
   uint corner_nodes[4];
   SF_LOAD_ELEMENT(rest, nodes, e, grad, vlambda, vmu, corner_nodes)
+  vlambda *= SF_SIGMA_CONSTANT(c, SF_LAMBDA_SCALE, s, S);
   real frame[9];
   real corner[12];
   real force[12];

@@ -63,7 +63,7 @@ TEST(EffectCatalogue, ParsesAndRejectsInjections) {
 TEST(CandidateLibrary, AnExtraLigamentIsACandidateAtEveryRegion) {
   const Scenario scenario = load_scenario(std::string(SIGMAFEM_SOURCE_DIR) + "/scenarios/box_diagnose.json");
   const std::vector<std::string> all = candidate_library(scenario, {});
-  EXPECT_EQ(all, (std::vector<std::string>{"gravity", "young_scale", "camera_offset", "ligament_law",
+  EXPECT_EQ(all, (std::vector<std::string>{"gravity", "young_scale", "lambda_scale", "camera_offset", "ligament_law",
                                            "extra_ligament:bottom", "extra_ligament:side_y0",
                                            "extra_ligament:side_y15", "time_lag", "damping_scale", "control_scale"}));
   EXPECT_EQ(candidate_library(scenario, {"extra_ligament:side_y0", "time_lag"}),

@@ -131,10 +131,11 @@ TEST_P(EffectEnsembleOnDevice, EveryPhysicsEffectPerSigmaPointRunsAsOnTheCpu) {
   // declares a lag, a law and a control scale of its own (the per-sigma values are relative to them), each
   // sigma point with its own values.
   Model model = model_;
-  apply_effects({{"time_lag", {0.02}}, {"ligament_law", {0.02}}, {"control_scale", {1.1}}}, model);
+  apply_effects({{"time_lag", {0.02}}, {"ligament_law", {0.02}}, {"control_scale", {1.1}}, {"lambda_scale", {2.0}}},
+                model);
   const std::vector<std::string> effects = {"gravity", "young_scale", "time_lag", "ligament_law", "damping_scale",
-                                            "control_scale"};
-  constexpr int kEffectParameters = 3 + 1 + 1 + 1 + 2 + 1;
+                                            "control_scale", "lambda_scale"};
+  constexpr int kEffectParameters = 3 + 1 + 1 + 1 + 2 + 1 + 1;
   Eigen::MatrixXd theta(3 + kEffectParameters, kSigma);
   for (int s = 0; s < kSigma; ++s) {
     for (int j = 0; j < 3; ++j) theta(j, s) = std::log(model.ligaments[static_cast<std::size_t>(j)].stiffness);

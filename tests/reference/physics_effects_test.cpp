@@ -78,6 +78,26 @@ TEST_F(PhysicsEffectsTest, ATimeLagOfWholeStepsIsTheSameMotionThatManyStepsLater
   }
 }
 
+// A lambda scale s is the material with lambda s times as large and the same shear modulus:
+// the model made from the scenario with that Poisson's ratio and Young's modulus (nu = 0.45,
+// s = 49 / 9 gives nu = 0.49).
+TEST_F(PhysicsEffectsTest, ALambdaScaleIsTheMaterialWithPoissonsRatioNearerAHalf) {
+  ASSERT_EQ(scenario_.material.poisson_ratio, 0.45);
+  Model scaled = model_;
+  apply_effects({{"lambda_scale", {49.0 / 9.0}}}, scaled);
+  EXPECT_NEAR(scaled.material.poisson_ratio, 0.49, 1e-15);
+  Scenario nearly_incompressible = scenario_;
+  nearly_incompressible.material.poisson_ratio = 0.49;
+  nearly_incompressible.material.young_modulus = scaled.material.young_modulus;
+  const Model expected = make_model(nearly_incompressible);
+  ASSERT_EQ(expected.elements.size(), scaled.elements.size());
+  for (std::size_t e = 0; e < expected.elements.size(); ++e) {
+    EXPECT_NEAR(scaled.elements[e].vlambda, expected.elements[e].vlambda, 1e-12 * expected.elements[e].vlambda);
+    EXPECT_NEAR(scaled.elements[e].vmu, model_.elements[e].vmu, 0.0) << "the shear modulus is kept";
+    EXPECT_NEAR(expected.elements[e].vmu, model_.elements[e].vmu, 1e-12 * model_.elements[e].vmu);
+  }
+}
+
 // A control scale c is the SO's record off by c: the model driven by so(0) + c (so(t) - so(0)).
 TEST_F(PhysicsEffectsTest, AControlScaleIsTheSosDisplacementScaled) {
   constexpr double c = 1.25;
@@ -97,7 +117,8 @@ TEST_F(PhysicsEffectsTest, AControlScaleIsTheSosDisplacementScaled) {
 TEST_F(PhysicsEffectsTest, PerSimulationEffectsEqualAModelBuiltWithThem) {
   const std::vector<EffectValue> effects = {{"damping_scale", {0.5, 2.0}}, {"ligament_law", {0.006}},
                                             {"time_lag", {0.034}}, {"gravity", {0.0, 1.0, -0.5}},
-                                            {"young_scale", {1.3}}, {"control_scale", {0.8}}};
+                                            {"young_scale", {1.3}}, {"control_scale", {0.8}},
+                                            {"lambda_scale", {3.0}}};
   Model built = model_;
   apply_effects(effects, built);
   EXPECT_EQ(built.damping.rayleigh_mass, 0.5 * model_.damping.rayleigh_mass);
@@ -112,6 +133,7 @@ TEST_F(PhysicsEffectsTest, PerSimulationEffectsEqualAModelBuiltWithThem) {
   physics.gravity = Eigen::Vector3d(0.0, 1.0, -0.5);
   physics.young_scale = 1.3;
   physics.control_scale = 0.8;
+  physics.lambda_scale = 3.0;
   per_simulation.set_physics_effects(physics);
   for (int n = 1; n <= 30; ++n) {
     expected.step(so(n));
