@@ -154,9 +154,10 @@ def write_scenario(centre, rest_beads, steps):
             "plate (the SO) grips the face z = min and moves it down in three 1 s ramps, each held 1 s; the scans "
             "are the holds' ends (t = 2, 4, 6 s). Written by scenarios/make_truth_cube.py; the measured data are "
             "truth_cube_data/observations.csv. Material: E = 15.3 kPa (OpenSurgSim's value for this cube), "
-            "nu = 0.45 (with 0.49 the model is unstable at 18% strain: README, \"The Truth Cube\")."),
+            "nu = 0.45 (the seed paper's soft tissue; diagnose estimates it from the beads: README, \"The Truth "
+            "Cube\"), polar element rotations (at 18% strain the QR frame is not at rest near nu = 0.5)."),
         "mesh": {"file": "truth_cube.msh", "scale": 1.0, "translate": [0.0, 0.0, 0.0]},
-        "material": {"young_modulus": 15300.0, "poisson_ratio": 0.45, "density": 1000.0},
+        "material": {"young_modulus": 15300.0, "poisson_ratio": 0.45, "density": 1000.0, "rotation": "polar"},
         "damping": {"rayleigh_stiffness": 0.05, "rayleigh_mass": 1.0},
         "gravity": [0.0, 0.0, 0.0],
         "time": {"dt": DT, "steps": steps},
