@@ -101,10 +101,11 @@ std::unique_ptr<Ensemble> warmed_up(const Backend& backend, const Scenario& s, c
 }
 
 void BM_ensemble_step(benchmark::State& state, const Backend& backend, const std::string& name,
-                      int refinements) {
+                      int refinements, ElementRotation rotation = ElementRotation::qr) {
   const int S = static_cast<int>(state.range(0));
   const Scenario& s = bench::scenario(name, refinements);
-  const Model model = make_model(s);
+  Model model = make_model(s);
+  model.material.rotation = rotation;
   int step = 0;
   std::unique_ptr<Ensemble> ensemble;
   try {
@@ -122,6 +123,7 @@ void BM_ensemble_step(benchmark::State& state, const Backend& backend, const std
   element_iterations = cg_iterations * model.element_count();
   state.counters["tetrahedra"] = model.element_count();
   state.counters["S"] = S;
+  state.counters["polar"] = rotation == ElementRotation::polar ? 1.0 : 0.0;
   state.counters["cg_iterations_per_step"] =
       cg_iterations / (static_cast<double>(state.iterations()) * S);
   state.counters["element_iterations_per_s"] =
@@ -293,6 +295,14 @@ BENCHMARK_CAPTURE(BM_ensemble_step, cpu_liver_4768, kCpu, std::string("liver"), 
 BENCHMARK_CAPTURE(BM_ensemble_step, cpu_shared_liver_4768, kCpuShared, std::string("liver"), 1)
     ->Arg(16)->Unit(benchmark::kMillisecond)->UseRealTime();
 BENCHMARK_CAPTURE(BM_ensemble_step, cpu_jacobi_liver_4768, kCpuJacobi, std::string("liver"), 1)
+    ->Arg(16)->Unit(benchmark::kMillisecond)->UseRealTime();
+// The polar element frames (material.rotation "polar") beside the QR frames of the cases
+// above, S = 4 and 16: what the rotation pass's polar iteration costs a step.
+BENCHMARK_CAPTURE(BM_ensemble_step, opencl_polar_liver_4768, kOpenCl, std::string("liver"), 1, ElementRotation::polar)
+    ->Arg(4)->Arg(16)->Unit(benchmark::kMillisecond)->UseRealTime();
+BENCHMARK_CAPTURE(BM_ensemble_step, vulkan_polar_liver_4768, kVulkan, std::string("liver"), 1, ElementRotation::polar)
+    ->Arg(4)->Arg(16)->Unit(benchmark::kMillisecond)->UseRealTime();
+BENCHMARK_CAPTURE(BM_ensemble_step, cpu_polar_liver_4768, kCpu, std::string("liver"), 1, ElementRotation::polar)
     ->Arg(16)->Unit(benchmark::kMillisecond)->UseRealTime();
 // Against mesh size, S = 16; on the device back ends also S = 64, the size of issue 4's GPU
 // goal (2e10 element-iterations per second at 100k+ tetrahedra and S >= 64).

@@ -1,5 +1,6 @@
 /* element_product: y_e = R K_e R^T d_e for every element and sigma point, the cost of every
- * CG iteration (host: element_product in host/reference/corotational.h). No atomics, and the
+ * CG iteration (host: element_product in host/reference/corotational.h), K_e with the sigma
+ * point's scale of Lame's lambda (SF_LAMBDA_SCALE, step_constants.h). No atomics, and the
  * sums come out in the same order every run, in one of two ways (the host chooses):
  *
  * Element outputs (a GPU): a work-item takes one element and one sigma point and writes the

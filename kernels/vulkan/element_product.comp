@@ -1,6 +1,7 @@
 /* element_product: y_e = R K_e R^T d_e for every element and sigma point, the cost of every
- * CG iteration (as kernels/opencl/element_product.cl). Each element writes its own 12
- * outputs; the node kernels sum them in a fixed order: no atomics, the same bits every run.
+ * CG iteration (as kernels/opencl/element_product.cl, with the sigma point's lambda scale).
+ * Each element writes its own 12 outputs; the node kernels sum them in a fixed order: no
+ * atomics, the same bits every run.
  * One invocation per (element, sigma); a sigma point whose CG is done is skipped. */
 #version 450
 #extension GL_GOOGLE_include_directive : require
