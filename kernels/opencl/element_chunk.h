@@ -14,6 +14,8 @@ static inline __attribute__((always_inline)) void sf_element_chunk_products(
     __global const real* restrict c, __global const real* restrict d, __global real* restrict copy) {
   const size_t copy_size = (size_t)3 * node_count * S;
   for (size_t i = 0; i < copy_size; ++i) copy[i] = (real)0;
+  real lambda_scale[SF_SIGMA_BLOCK]; /* read once, not once per element */
+  for (uint s = 0; s < SF_SIGMA_BLOCK; ++s) lambda_scale[s] = SF_SIGMA_CONSTANT(c, SF_LAMBDA_SCALE, s, S);
   for (uint e = begin; e < end; ++e) {
     real grad[12];
     real vlambda;
@@ -31,8 +33,7 @@ static inline __attribute__((always_inline)) void sf_element_chunk_products(
       real product[12];
       sf_load_frame(frames, e, s, S, frame);
       sf_gather_corners(d, corner_nodes, s, S, corner);
-      sf_element_product(frame, grad, vlambda * SF_SIGMA_CONSTANT(c, SF_LAMBDA_SCALE, s, S), vmu, corner,
-                         product);
+      sf_element_product(frame, grad, vlambda * lambda_scale[s], vmu, corner, product);
       SF_UNROLL
       for (int i = 0; i < 12; ++i) products[i][s] = product[i];
     }
