@@ -32,6 +32,9 @@ Action add_info_command(CLI::App& app) {
               << boundary_faces(s.mesh).size() << " boundary faces, volume "
               << s.mesh_report.total_volume << " m^3, " << s.mesh_report.inverted_reordered
               << " inverted tetrahedra reordered\n"
+              << "  material E " << s.material.young_modulus << " Pa, nu " << s.material.poisson_ratio << ", density "
+              << s.material.density << " kg/m^3, "
+              << (s.material.rotation == ElementRotation::polar ? "polar" : "qr") << " element rotations\n"
               << "  time " << s.time.steps << " steps of " << s.time.dt << " s\n";
     for (const Ligament& ligament : s.ligaments) {
       std::cout << "  ligament " << ligament.name << " " << ligament.stiffness << " N/m: ";

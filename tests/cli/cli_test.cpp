@@ -483,7 +483,13 @@ TEST_F(CliTest, InfoDescribesTheShippedScenarios) {
         run_sigmafem("info " + (fs::path(SIGMAFEM_SOURCE_DIR) / "scenarios" / name).string() + ".json");
     EXPECT_EQ(run.exit_code, 0) << run.output;
     EXPECT_NE(run.output.find("tetrahedra"), std::string::npos) << run.output;
+    EXPECT_NE(run.output.find("material E 5000 Pa, nu 0.45, density 1000 kg/m^3, qr element rotations"),
+              std::string::npos)
+        << run.output;
   }
+  const CommandRun cube =
+      run_sigmafem("info " + (fs::path(SIGMAFEM_SOURCE_DIR) / "scenarios" / "truth_cube.json").string());
+  EXPECT_NE(cube.output.find("polar element rotations"), std::string::npos) << cube.output;
 }
 
 }  // namespace
