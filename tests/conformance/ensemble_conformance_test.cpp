@@ -83,6 +83,16 @@ std::vector<BackendCase> backend_cases() {
 // gtest prints a failing case with this, instead of its bytes.
 void PrintTo(const BackendCase& c, std::ostream* out) { *out << c.name; }
 
+// The device options a case runs with.
+DeviceOptions device_options(const BackendCase& c) {
+  DeviceOptions options;
+  options.precision = c.precision;
+  options.solve_launch = c.solve_launch;
+  options.kernel_form = c.kernel_form;
+  options.cg_partitions = c.cg_partitions;
+  return options;
+}
+
 // Why a back end cannot run here ("" when it can).
 std::string unavailable(const BackendCase& c) {
   if (c.backend == "opencl") {
@@ -267,13 +277,9 @@ class EnsembleConformance : public ::testing::TestWithParam<Case> {
   }
 
   std::unique_ptr<DeviceEnsemble> device_ensemble(const Model& model) const {
-    DeviceOptions options;
-    options.precision = GetParam().backend.precision;
-    options.solve_launch = GetParam().backend.solve_launch;
-    options.kernel_form = GetParam().backend.kernel_form;
-    options.cg_partitions = GetParam().backend.cg_partitions;
-    std::unique_ptr<Ensemble> ensemble = make_ensemble(
-        GetParam().backend.backend, model, estimated_, scenario_.observations.nodes, S_, options);
+    std::unique_ptr<Ensemble> ensemble = make_ensemble(GetParam().backend.backend, model, estimated_,
+                                                       scenario_.observations.nodes, S_,
+                                                       device_options(GetParam().backend));
     return std::unique_ptr<DeviceEnsemble>(dynamic_cast<DeviceEnsemble*>(ensemble.release()));
   }
 
@@ -568,11 +574,7 @@ TEST_P(ObservedPointsConformance, PointsAnywhereFollowTheReference) {
                         0.4 * mesh.nodes[t[3]])})
     points.push_back(ObservedPoint::at(mesh, locate_point(mesh, p)));
   ASSERT_EQ(points[1].weights[0], 1.0) << "the node given as a point is the node";
-  DeviceOptions options;
-  options.precision = backend.precision;
-  options.solve_launch = backend.solve_launch;
-  options.kernel_form = backend.kernel_form;
-  options.cg_partitions = backend.cg_partitions;
+  const DeviceOptions options = device_options(backend);
   auto device = make_ensemble(backend.backend, model, estimated, points, S, options);
   CpuEnsemble reference(model, estimated, points, S, 0, Preconditioner::jacobi);
   const Eigen::MatrixXd theta = sigma_theta(model, estimated, S);
@@ -638,11 +640,7 @@ TEST_P(PolarRotationConformance, TheFastCompressedCubeFollowsTheReference) {
   const std::vector<int>& estimated = polar.filter->estimate;
   const int S = 2;
   const Eigen::MatrixXd theta = sigma_theta(model, estimated, S);
-  DeviceOptions options;
-  options.precision = backend.precision;
-  options.solve_launch = backend.solve_launch;
-  options.kernel_form = backend.kernel_form;
-  options.cg_partitions = backend.cg_partitions;
+  const DeviceOptions options = device_options(backend);
   auto device = make_ensemble(backend.backend, model, estimated, polar.observations.observed, S, options);
   CpuEnsemble reference(model, estimated, polar.observations.observed, S, 0, Preconditioner::jacobi);
   const Eigen::MatrixXd y_device = fast_cube_beads(*device, polar, theta);

@@ -46,13 +46,15 @@ std::array<double, 12> random_element(std::mt19937& random) {
   return corners;
 }
 
+// A row-major frame[9] (element.h) as a matrix.
+Eigen::Matrix3d frame_matrix(const double frame[9]) {
+  return Eigen::Map<const Eigen::Matrix<double, 3, 3, Eigen::RowMajor>>(frame);
+}
+
 Eigen::Matrix3d frame_of(const std::array<double, 12>& corners) {
   double frame[9];
   shared::sf_element_frame(corners.data(), frame);
-  Eigen::Matrix3d F;
-  for (int r = 0; r < 3; ++r)
-    for (int k = 0; k < 3; ++k) F(r, k) = frame[3 * r + k];
-  return F;
+  return frame_matrix(frame);
 }
 
 double explicit_volume(const std::array<double, 12>& X) {
@@ -245,10 +247,7 @@ TEST_F(ElementTest, DiagonalEqualsDiagonalOfExplicitMatrix) {
 Eigen::Matrix3d polar_frame_of(const ElementRest& rest, const std::array<double, 12>& x) {
   double frame[9];
   shared::sf_element_polar_frame(rest.grad.data(), x.data(), frame);
-  Eigen::Matrix3d F;
-  for (int r = 0; r < 3; ++r)
-    for (int k = 0; k < 3; ++k) F(r, k) = frame[3 * r + k];
-  return F;
+  return frame_matrix(frame);
 }
 
 // x deformed by up to `strain` of the 0.1 m element per coordinate, then moved rigidly.
@@ -288,7 +287,7 @@ TEST_F(ElementTest, PolarFrameMakesTheStretchSymmetricAtLargeStrain) {
     EXPECT_NEAR(F.determinant(), 1.0, kRotationTolerance) << "element " << e;
     double G[9];
     shared::sf_element_gradient(rest.grad.data(), x.data(), 1.0, G);
-    const Eigen::Matrix3d H = F * Eigen::Map<const Eigen::Matrix<double, 3, 3, Eigen::RowMajor>>(G);
+    const Eigen::Matrix3d H = F * frame_matrix(G);   // G is row-major 3x3 too
     EXPECT_LE((H - H.transpose()).norm(), 1e-12 * H.norm()) << "stretch of element " << e;
     EXPECT_GT(H.eigenvalues().real().minCoeff(), 0.0) << "the stretch is positive definite, element " << e;
   }
