@@ -16,6 +16,11 @@ EstimationRun run_estimation(Ensemble& ensemble, const EstimationOptions& option
                              const std::function<void(Eigen::Index row)>& before_step) {
   Roukf filter(options.roukf, ensemble);
   ChangeDetector detector(options.detector);
+  ParameterChangeTest change_test(options.change_test);
+  // A jump is never opened wider than the prior (the parameter's initial std, log units).
+  const Eigen::VectorXd prior_std = options.roukf.initial_std.size() == options.roukf.initial_theta.size()
+                                        ? options.roukf.initial_std
+                                        : Eigen::VectorXd::Constant(options.roukf.initial_theta.size(), options.roukf.initial_log_std);
   RecoveryCheck recovery(options.recovery);
   // The first parameters that are log-stiffnesses (the rest are effect parameters).
   const Eigen::Index parameters = options.roukf.initial_theta.size();
@@ -23,6 +28,13 @@ EstimationRun run_estimation(Ensemble& ensemble, const EstimationOptions& option
       options.stiffness_count >= 0 ? std::min<Eigen::Index>(options.stiffness_count, parameters) : parameters;
   LigamentCutRule cut_rule(options.cut, static_cast<int>(stiffnesses));
   EstimationRun run;
+  // The step (data row) at which a parameter was last found changed: it drifts faster from then.
+  std::vector<double> changed_at(static_cast<std::size_t>(parameters), -1e300);
+  // The estimates of the last steps the parameter-change test looks back on (keep_all_steps
+  // may keep fewer): a cut is measured against the estimate before the window that fired.
+  std::deque<std::pair<Eigen::VectorXd, Eigen::VectorXd>> recent;   // theta, log_std
+  std::size_t look_back = 1;
+  for (int w : options.change_test.windows) look_back = std::max(look_back, static_cast<std::size_t>(w) + 1);
   std::deque<bool> scaled;   // the last 2W steps: did the correction use lambda > 1?
   int catch_up_start = -1;   // step index (made steps, from 0) of the firing that began the catch-up; -1: none
   int dropped = 0;           // steps made and no longer kept (keep_all_steps false)
@@ -98,6 +110,30 @@ EstimationRun run_estimation(Ensemble& ensemble, const EstimationOptions& option
           }
       }
     }
+    recent.emplace_back(step.theta, step.log_std);
+    if (recent.size() > look_back) recent.pop_front();
+    const ParameterChange change = change_test.update(result.score, result.score_covariance, filter.changeable());
+    if (change.fired && armed) {
+      Eigen::VectorXd jump = change.jump;
+      for (Eigen::Index j = 0; j < jump.size(); ++j) {
+        jump[j] = std::clamp(jump[j], -prior_std[j], prior_std[j]);
+        if (jump[j] != 0.0) changed_at[static_cast<std::size_t>(j)] = static_cast<double>(k);
+      }
+      filter.open(jump * jump.transpose());
+      step.parameters_changed = true;
+      run.parameter_changes.push_back({step.step, change.window, change.statistic, change.threshold, jump});
+      if (!cut_rule.armed()) {
+        const auto& before = recent[recent.size() - std::min(recent.size(), static_cast<std::size_t>(change.window) + 1)];
+        cut_rule.arm(before.first, before.second);
+      }
+    }
+    {
+      Eigen::VectorXd drift = Eigen::VectorXd::Zero(parameters);
+      const double q = options.change_test.drift_log_std, tau = options.change_test.drift_decay_steps;
+      for (Eigen::Index j = 0; j < parameters; ++j)
+        drift[j] = q * q * std::exp(-2.0 * (static_cast<double>(k) - changed_at[static_cast<std::size_t>(j)]) / tau);
+      if (drift.maxCoeff() > 0.0) filter.open(drift.asDiagonal());
+    }
     if (catch_up_start >= 0) {
       const int since = dropped + static_cast<int>(run.steps.size()) - catch_up_start;   // 0: the firing step
       // Over when the NIS is back (settled) and the innovations' mean too (RecoveryCheck).
@@ -112,7 +148,13 @@ EstimationRun run_estimation(Ensemble& ensemble, const EstimationOptions& option
     for (int j : cut_rule.update(step.theta, step.log_std)) {
       const double before = cut_rule.stiffness_before(j);
       filter.fix(j, std::log(options.cut.remaining * before));
-      run.cuts.push_back({j, step.step, step.time, before});
+      run.cuts.push_back({j, step.step, step.time, before, cut_rule.upper_bound(j)});
+    }
+    // A cut ligament is reported at its remaining stiffness, with the data's upper bound
+    // as its uncertainty: +-2 std spans zero to that bound (log k has no zero to be near).
+    for (const LigamentCut& cut : run.cuts) {
+      step.stiffness[cut.parameter] = std::exp(filter.theta()[cut.parameter]);
+      step.stiffness_std[cut.parameter] = 0.5 * cut.upper_bound;
     }
     // While the state catches up, its innovations are not evidence about the constants.
     filter.hold_constants(catch_up_start >= 0);

@@ -13,6 +13,7 @@
 #include "filter/change_detector.h"
 #include "filter/ensemble.h"
 #include "filter/ligament_cut.h"
+#include "filter/parameter_change_test.h"
 #include "filter/recovery_check.h"
 #include "filter/roukf.h"
 
@@ -23,6 +24,8 @@ struct EstimationOptions {
   ChangeDetectorOptions detector;
   RecoveryCheckOptions recovery;   // with the detector, ends a catch-up
   LigamentCutOptions cut;          // after a change: which ligament the data show cut
+  // Opens P along a jump of the parameters the innovations show (filter/parameter_change_test.h).
+  ParameterChangeTestOptions change_test;
   // N/m: below or above this range the filter has diverged. No floor by default: a cut
   // ligament (truth 0.01 N/m) is zero to the data below about 1 N/m and its log-estimate may
   // go on down (a spring of 1e-30 N/m, or exp underflowing to 0, is harmless); measured, the
@@ -64,6 +67,8 @@ struct EstimationStep {
   int observed_rows = 0;
   int outliers = 0;                // points the outlier gate left out (filter/outlier_gate.h)
   bool change_detected = false;
+  // The parameter-change test fired at this step and P was opened along the jump it estimated.
+  bool parameters_changed = false;
   // The step lies in the catch-up after a detected change: from the first step of the
   // detector's window that fired until the innovations are back within the detector's
   // threshold after its hold-off and their mean is back at zero (RecoveryCheck; at most
@@ -86,6 +91,9 @@ struct LigamentCut {
   int step = 0;                   // the data row at which it was found cut
   double time = 0.0;              // s
   double stiffness_before = 0.0;  // N/m, the estimate before the change began
+  // N/m: the upper bound the data showed when the rule fired (LigamentCutRule::upper_bound);
+  // from then on the ligament's reported std is half of it.
+  double upper_bound = 0.0;
 };
 
 struct EstimationRun {
@@ -96,6 +104,14 @@ struct EstimationRun {
   int changes_detected = 0;
   int catch_up_steps = 0;              // steps with catching_up
   std::vector<LigamentCut> cuts;
+  // The parameter-change test's firings (filter/parameter_change_test.h) and what was opened.
+  struct ParameterChangeRecord {
+    int step = 0;                  // data row
+    int window = 0;                // steps of the window that fired
+    double statistic = 0.0, threshold = 0.0;
+    Eigen::VectorXd jump;          // nu_hat (log units), as opened
+  };
+  std::vector<ParameterChangeRecord> parameter_changes;
   // The adaptive observation noise (filter/adaptive_noise.h): the steps whose correction used
   // lambda > 1, the first of them (data row; 0: none) and the largest lambda.
   int noise_scaled_steps = 0;

@@ -8,7 +8,9 @@
 namespace sigmafem {
 
 LigamentCutRule::LigamentCutRule(const LigamentCutOptions& options, int ligaments)
-    : options_(options), cut_(static_cast<std::size_t>(std::max(ligaments, 0)), false) {
+    : options_(options),
+      cut_(static_cast<std::size_t>(std::max(ligaments, 0)), false),
+      upper_bound_(cut_.size(), NAN) {
   if (!(options.fraction > 0.0 && options.fraction < 1.0))
     throw std::invalid_argument("LigamentCutRule: fraction must lie in (0, 1), got " +
                                 std::to_string(options.fraction));
@@ -35,6 +37,7 @@ std::vector<int> LigamentCutRule::update(const Eigen::VectorXd& theta, const Eig
     const double upper_log = theta[jj] + options_.z * log_std[jj];
     if (upper_log < reference_lower_log_[jj] + log_fraction) {
       cut_[j] = true;
+      upper_bound_[j] = std::exp(upper_log);
       cut_now.push_back(static_cast<int>(j));
     }
   }

@@ -53,6 +53,7 @@ Roukf::Roukf(const RoukfOptions& options, Ensemble& ensemble)
   L_theta_ = Eigen::MatrixXd::Identity(p, p);
   U_inv_ = Eigen::MatrixXd(prior_std.array().square().matrix().asDiagonal());
   correction_ = Eigen::VectorXd::Zero(p);
+  pending_covariance_ = Eigen::MatrixXd::Zero(p, p);
 }
 
 Eigen::MatrixXd Roukf::theta_covariance() const {
@@ -60,6 +61,19 @@ Eigen::MatrixXd Roukf::theta_covariance() const {
 }
 
 void Roukf::inflate(double log_std) { pending_variance_ += log_std * log_std; }
+
+void Roukf::open(const Eigen::MatrixXd& covariance) {
+  if (covariance.rows() != theta_.size() || covariance.cols() != theta_.size() || !covariance.allFinite())
+    throw std::invalid_argument("Roukf::open: expected a finite " + std::to_string(theta_.size()) + " x " +
+                                std::to_string(theta_.size()) + " covariance");
+  pending_covariance_ += covariance;
+}
+
+std::vector<bool> Roukf::changeable() const {
+  std::vector<bool> flags(static_cast<std::size_t>(theta_.size()));
+  for (Eigen::Index j = 0; j < theta_.size(); ++j) flags[static_cast<std::size_t>(j)] = opens_on_change_[j] > 0.0;
+  return flags;
+}
 
 void Roukf::fix(int j, double value) {
   if (j < 0 || j >= theta_.size())
@@ -69,10 +83,10 @@ void Roukf::fix(int j, double value) {
   opens_on_change_[j] = 0.0;
 }
 
-void Roukf::add_theta_variance(const Eigen::VectorXd& variance) {
+void Roukf::add_theta_covariance(const Eigen::MatrixXd& covariance) {
   // P_theta + D = L_theta (U^-1 + L_theta^-1 D L_theta^-T) L_theta^T: only U^-1 changes.
   const Eigen::MatrixXd L_inv = L_theta_.inverse();
-  U_inv_ += L_inv * variance.asDiagonal() * L_inv.transpose();
+  U_inv_ += L_inv * covariance * L_inv.transpose();
   U_inv_ = 0.5 * (U_inv_ + U_inv_.transpose());   // keep it exactly symmetric for chol
 }
 
@@ -85,9 +99,13 @@ RoukfStep Roukf::step(const Eigen::Vector3d& so_position, const Eigen::VectorXd&
                                 std::to_string(ensemble_.observation_count()) +
                                 " observation values, got " + std::to_string(y.size()));
 
-  if (drift_variance_.maxCoeff() > 0.0 || pending_variance_ > 0.0)
-    add_theta_variance(drift_variance_ + pending_variance_ * opens_on_change_);
+  if (drift_variance_.maxCoeff() > 0.0 || pending_variance_ > 0.0 || pending_covariance_.any()) {
+    // A fixed parameter is not opened: its rows and columns of the opened covariance go.
+    const Eigen::MatrixXd opened = opens_on_change_.asDiagonal() * pending_covariance_ * opens_on_change_.asDiagonal();
+    add_theta_covariance(Eigen::MatrixXd((drift_variance_ + pending_variance_ * opens_on_change_).asDiagonal()) + opened);
+  }
   pending_variance_ = 0.0;
+  pending_covariance_.setZero();
 
   // Sampling.
   const Eigen::LLT<Eigen::MatrixXd> llt(U_inv_);
@@ -145,6 +163,8 @@ RoukfStep Roukf::step(const Eigen::Vector3d& so_position, const Eigen::VectorXd&
   theta_ = alpha * theta_i.rowwise().sum();
   L_theta_ = alpha * theta_i * I.transpose();
 
+  result.score = Eigen::VectorXd::Zero(p);
+  result.score_covariance = Eigen::MatrixXd::Zero(p, p);
   if (m == 0) {
     // Nothing observed: the prior is the posterior (U = I, the old U^-1 is already in L).
     U_inv_ = Eigen::MatrixXd::Identity(p, p);
@@ -164,6 +184,13 @@ RoukfStep Roukf::step(const Eigen::Vector3d& so_position, const Eigen::VectorXd&
     // diag(S) = row norms of HL plus R's diagonal: what standardises each row's innovation
     // for the residual diagnostics (nominal R: the diagnostics judge the model as declared).
     result.innovation_variance = HL.rowwise().squaredNorm().array() + variance;
+    // The score in theta: H = -HL L_theta^-1 (HL is built from y - predicted: ROUKF.md), s = H^T z_bar / r, and with A = HL^T HL,
+    // H^T R^-1 S R^-1 H = L_theta^-T (A / r + A^2 / r^2) L_theta^-1 (S = HL HL^T + r I).
+    const Eigen::PartialPivLU<Eigen::MatrixXd> L_lu(L_theta_.transpose());
+    const Eigen::MatrixXd HLt_HL = HL.transpose() * HL;
+    result.score = -L_lu.solve(HL.transpose() * z_bar / variance);
+    const Eigen::MatrixXd half = L_lu.solve(HLt_HL / variance + HLt_HL * HLt_HL / (variance * variance));   // L^-T (..)
+    result.score_covariance = L_lu.solve(half.transpose());   // L^-T (..)^T L^-1, (..) symmetric
     if (hold_constants_ && constant_rows_.rows() > 0) {
       // The smallest change of the correction k (in sigma coordinates) that leaves the
       // constants' theta as they are: remove its component along the rows A = E_c L_theta,

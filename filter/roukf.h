@@ -68,6 +68,12 @@ struct RoukfStep {
   // The adaptive noise scale lambda this step's correction used (1: nominal R; the fields
   // above stay nominal).
   double noise_scale = 1.0;
+  // The score of theta, s = H^T R^-1 z_bar (p; H = -HL L_theta^-1, the sensitivities of the
+  // predicted observations to theta), and its covariance for a consistent filter,
+  // H^T R^-1 S R^-1 H (p x p), nominal R: what the parameter-change test sums
+  // (filter/parameter_change_test.h). Zero when nothing was observed.
+  Eigen::VectorXd score;
+  Eigen::MatrixXd score_covariance;
   StepReport ensemble;
 };
 
@@ -83,6 +89,11 @@ class Roukf {
   // quadrature, like drift) before the next sampling: the change detector's response to a
   // sudden change.
   void inflate(double log_std);
+  // Adds `covariance` (p x p, symmetric positive semi-definite) to P_theta before the next
+  // sampling: the parameter-change test's response, the estimated jump's nu nu^T.
+  void open(const Eigen::MatrixXd& covariance);
+  // The parameters a change may concern (not the constants, not a fixed one).
+  std::vector<bool> changeable() const;
   // While `hold` is set, each correction is projected so that the constants' estimates do not
   // move: the stiffnesses and the state take the innovation. After a change the innovations
   // measure how the state recovers, which no constant explains; let through, they pull a
@@ -105,8 +116,8 @@ class Roukf {
   const Eigen::VectorXd& last_correction() const { return correction_; }
 
  private:
-  // P_theta += diag(variance) (p).
-  void add_theta_variance(const Eigen::VectorXd& variance);
+  // P_theta += covariance (p x p).
+  void add_theta_covariance(const Eigen::MatrixXd& covariance);
   // Kalman correction from the innovations Z (m x r) of the observed rows with R = I / r_inv:
   // sets U_inv_ and correction_.
   void correct(const Eigen::MatrixXd& Z, double r_inv);
@@ -122,6 +133,7 @@ class Roukf {
   Eigen::MatrixXd U_inv_;               // p x p
   Eigen::VectorXd correction_;          // k of the last correction, applied at re-sampling
   double pending_variance_ = 0.0;       // inflation to add before the next sampling
+  Eigen::MatrixXd pending_covariance_;  // p x p: opened by a parameter change, added then too
   Eigen::VectorXd opens_on_change_;     // p: 1 where inflate() widens the parameter, else 0
   Eigen::MatrixXd constant_rows_;       // the rows of the identity that pick the constants
   bool hold_constants_ = false;

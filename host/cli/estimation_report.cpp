@@ -157,8 +157,24 @@ nlohmann::ordered_json cuts_json(const EstimationRun& run, const std::vector<std
     cuts.push_back({{"ligament", names[static_cast<std::size_t>(cut.parameter)]},
                     {"step", cut.step},
                     {"time_s", cut.time},
-                    {"stiffness_before_n_per_m", cut.stiffness_before}});
+                    {"stiffness_before_n_per_m", cut.stiffness_before},
+                    {"upper_bound_n_per_m", cut.upper_bound}});
   return cuts;
+}
+
+nlohmann::ordered_json parameter_changes_json(const EstimationRun& run, const std::vector<std::string>& names) {
+  json changes = json::array();
+  for (const auto& change : run.parameter_changes) {
+    json jump = json::object();
+    for (std::size_t j = 0; j < names.size() && static_cast<Eigen::Index>(j) < change.jump.size(); ++j)
+      if (change.jump[static_cast<Eigen::Index>(j)] != 0.0) jump[names[j]] = change.jump[static_cast<Eigen::Index>(j)];
+    changes.push_back({{"step", change.step},
+                       {"window_steps", change.window},
+                       {"statistic", change.statistic},
+                       {"threshold", change.threshold},
+                       {"opened_log_jump", jump}});
+  }
+  return changes;
 }
 
 nlohmann::ordered_json write_estimation_report(const EstimationReport& report, const EstimationRun& run) {
@@ -212,6 +228,7 @@ nlohmann::ordered_json write_estimation_report(const EstimationReport& report, c
   summary["cg"] = {{"max_iterations", max_cg}, {"unconverged_sigma_steps", unconverged}};
   summary["changes_detected_at_steps"] = changes;
   summary["catch_up_steps"] = run.catch_up_steps;
+  summary["parameter_changes"] = parameter_changes_json(run, report.names);
   summary["cuts"] = cuts_json(run, report.names);
   summary["adaptive_noise"] = adaptive_noise_json(run);
   // null when the gate is off (scenario filter.outlier_gate), else the point-steps it left out.

@@ -49,6 +49,9 @@ nlohmann::ordered_json adaptive_noise_json(const EstimationRun& run);
 // The ligaments the run found cut (EstimationRun::cuts), named by `names` (the estimated
 // ligaments in parameter order): summary.json's and report.json's `cuts`.
 nlohmann::ordered_json cuts_json(const EstimationRun& run, const std::vector<std::string>& names);
+// The parameter-change test's firings (filter/parameter_change_test.h): step, window, statistic
+// and the jump of each parameter P was opened by (log units).
+nlohmann::ordered_json parameter_changes_json(const EstimationRun& run, const std::vector<std::string>& names);
 
 // Writes every output into report.out_dir (atomically, file by file) and returns the
 // summary. Plots are skipped with a note in the summary when gnuplot is missing.

@@ -134,7 +134,11 @@ TEST(LiverCloudEstimation, FramesAtTheirOwnTimesAreAsGoodAsFramesOnTheStepGrid) 
   const CloudRun own_times = run_liver_cloud(0.0, 1e-4, at_30_hz(true), false);
   const CloudRun on_grid = run_liver_cloud(0.0, 1e-4, at_30_hz(false), false);
   ASSERT_TRUE(own_times.run.complete && on_grid.run.complete) << own_times.run.stop_reason << on_grid.run.stop_reason;
-  EXPECT_LE(own_times.phase.mean_abs_error, 1.1 * on_grid.phase.mean_abs_error);
+  // Since issue 16's small drift both are 10-20 times smaller (stop 37: 0.031 N/m with the
+  // jitter, 0.011 on the grid, 0.01% and 0.004% of the truth): a floor of 0.05 N/m, 50 times
+  // below the nearest-step timing error this test is there to catch, keeps it from comparing
+  // interpolation round-off.
+  EXPECT_LE(own_times.phase.mean_abs_error, std::max(1.1 * on_grid.phase.mean_abs_error, 0.05));
   std::cout << "liver clouds at 30 Hz, noise-free: mean |error| " << own_times.phase.mean_abs_error
             << " N/m with 3 ms jitter, " << on_grid.phase.mean_abs_error << " N/m on the step grid\n";
 }
@@ -142,7 +146,9 @@ TEST(LiverCloudEstimation, FramesAtTheirOwnTimesAreAsGoodAsFramesOnTheStepGrid) 
 // Residual diagnostics on clouds (issue 15, item 4): an undeclared camera offset of 3 mm
 // across the view moves the cloud off the model's surface; the step means' tests see it
 // (measured at stop 34: nis_mean, nis_above_band, whiteness, whiteness_rows and bias_rows
-// failed; the clean data's verdict above is consistent, as on seeds 2 and 3 by hand).
+// failed; the clean data's verdict above is consistent, as on seeds 2 and 3 by hand). Since
+// issue 16's small drift the stiffnesses no longer wander, and bias_rows passes: nis_mean,
+// nis_above_band, whiteness and whiteness_rows fail (stop 37): the NIS's mean is the test asked.
 // And the filter completes: with one row per point it diverged at step 72 (the left ligament
 // past 1e9 N/m; 1 mm: step 129), because the adaptive noise, which holds the filter under
 // model error, takes its strength from the correlation of each row's unexplained innovation
@@ -159,8 +165,8 @@ TEST(LiverCloudEstimation, AnUndeclaredCameraOffsetMakesTheResidualInconsistentA
   const ResidualDiagnostics verdict = diagnose_residuals(step_means(innovation_series(run.run)), {});
   EXPECT_EQ(verdict.verdict.consistency, Consistency::inconsistent);
   const std::vector<std::string> failed = verdict.verdict.failed();
-  EXPECT_NE(std::find(failed.begin(), failed.end(), "bias_rows"), failed.end())
-      << "the cloud lies off the surface on average: " << ::testing::PrintToString(failed);
+  EXPECT_NE(std::find(failed.begin(), failed.end(), "nis_mean"), failed.end())
+      << "the cloud lies off the surface: " << ::testing::PrintToString(failed);
 }
 
 }  // namespace

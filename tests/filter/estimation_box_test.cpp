@@ -131,8 +131,6 @@ TEST_P(BoxEstimationTest, ConvergesFromTwiceTheTruthAndFollowsTheCut) {
   EXPECT_LT(phases[1].mean_abs_error, kAfterCutError) << to_string(GetParam()) << ": after the cut";
   EXPECT_GE(phases[1].steps_to_follow, 0) << "the estimates must settle after the cut";
   EXPECT_LE(phases[1].steps_to_follow, kStepsToFollow) << to_string(GetParam());
-  // With the scenario's drift (0.035) the filter follows the cut without the change detector
-  // (ChangeDetectorFiresOnTheCutWithASmallDrift shows the detector's part).
   // Through the cut, no uncut ligament's estimate leaves 0.1x..10x of its truth.
   const int middle = data.scenario.ligament_index("middle");
   for (Eigen::Index k = phases[1].first_step - 1; k < box.estimate.rows(); ++k) {
@@ -168,6 +166,9 @@ TEST(BoxEstimation, ChangeDetectorFiresOnTheCutWithASmallDrift) {
   const Scenario& s = data.scenario;
   EstimationOptions options = filter_options(s, SigmaPointSet::simplex, kNoiseFreeObservationStd);
   options.roukf.parameter_drift_log_std = 0.02;
+  // The NIS detector's own part: with the parameter-change test on, it opens P first and the
+  // NIS never jumps (EstimationHistory runs both).
+  options.change_test.enabled = false;
   const int p = static_cast<int>(s.filter->estimate.size());
   CpuEnsemble ensemble(make_model(s), s.filter->estimate, s.observations.nodes, p + 1);
   const EstimationRun run = run_estimation(ensemble, options, data.observations.times,
@@ -258,16 +259,25 @@ TEST(LiverEstimation, ConvergesFromTwiceTheTruthAndFollowsTheCut) {
             << " steps\n";
 }
 
-// At the scenarios' 0.5 mm noise (seed 1), the truth lies inside estimate +- 2 std for at
-// least 90% of each phase's last 20% of steps (issue 3's coverage goal). Measured at stop 32:
-// box 99.3% / 98.9%, liver 98.5% / 98.5% (the README's table, with Jacobi CG: 99 / 98 and
-// 95 / 100).
+// At the scenarios' 0.5 mm noise (seed 1), issue 16's goals: the truth inside estimate +- 2
+// std for at least 90% of each phase's last 20% of steps; before the cut the mean relative
+// error over that tail under 2% (box) and 4% (liver); the cut followed within 300 and 400
+// steps; no uncut estimate outside 0.1x-10x of its truth at any step. Measured at stop 37
+// (the CLI on the same data, CPU back end): box 1.05%, coverage 100% / 98.5%, followed in 185
+// steps; liver 3.72%, 98.0% / 100%, 139 steps (seeds 2-5 in the README's table).
 constexpr double kCoverageAtHalfAMillimetre = 0.9;
 
-class NoisyEstimationTest : public ::testing::TestWithParam<const char*> {};
+struct NoisyGoal {
+  const char* scenario;
+  double before_cut_relative_error;
+  int steps_to_follow;
+};
 
-TEST_P(NoisyEstimationTest, TheTruthLiesInsideTwoStd) {
-  const ExperimentData& data = experiment_data(GetParam(), false, true);
+class NoisyEstimationTest : public ::testing::TestWithParam<NoisyGoal> {};
+
+TEST_P(NoisyEstimationTest, PreciseBeforeTheCutFastAfterItAndHonestThroughout) {
+  const NoisyGoal goal = GetParam();
+  const ExperimentData& data = experiment_data(goal.scenario, false, true);
   const ExperimentRun run = run_experiment(data, SigmaPointSet::simplex,
                                            data.scenario.filter->observation_std,
                                            data.observations.points);
@@ -275,15 +285,34 @@ TEST_P(NoisyEstimationTest, TheTruthLiesInsideTwoStd) {
   const std::vector<PhaseErrors> phases = error_figures(run.steps, run.estimate, run.std_dev, run.truth);
   ASSERT_EQ(phases.size(), 2u) << "one cut: two phases";
   for (const PhaseErrors& phase : phases) {
-    EXPECT_GE(phase.coverage, kCoverageAtHalfAMillimetre) << GetParam() << ", " << phase.name;
-    std::cout << GetParam() << ", " << phase.name << ": mean |error| " << phase.mean_abs_error
+    EXPECT_GE(phase.coverage, kCoverageAtHalfAMillimetre) << goal.scenario << ", " << phase.name;
+    std::cout << goal.scenario << ", " << phase.name << ": mean |error| " << phase.mean_abs_error
               << " N/m, coverage " << 100.0 * phase.coverage << "%\n";
   }
+  // The relative error before the cut, over the same tail error_figures scores.
+  const Eigen::Index cut_row = phases[1].first_step - run.steps.front();
+  const Eigen::Index tail = static_cast<Eigen::Index>(std::ceil(0.2 * static_cast<double>(cut_row)));
+  const double relative =
+      ((run.estimate.middleRows(cut_row - tail, tail) - run.truth.middleRows(cut_row - tail, tail)).cwiseAbs().array() /
+       run.truth.middleRows(cut_row - tail, tail).array()).mean();
+  EXPECT_LT(relative, goal.before_cut_relative_error) << goal.scenario;
+  EXPECT_GE(phases[1].steps_to_follow, 0) << goal.scenario << ": the cut was not followed";
+  EXPECT_LE(phases[1].steps_to_follow, goal.steps_to_follow) << goal.scenario;
+  std::cout << goal.scenario << ": " << 100.0 * relative << "% before the cut, followed in "
+            << phases[1].steps_to_follow << " steps\n";
+  for (Eigen::Index k = 0; k < run.estimate.rows(); ++k)
+    for (Eigen::Index j = 0; j < run.estimate.cols(); ++j) {
+      if (run.truth(k, j) < 1.0) continue;   // the cut one
+      const double ratio = run.estimate(k, j) / run.truth(k, j);
+      ASSERT_TRUE(ratio > 0.1 && ratio < 10.0) << goal.scenario << ": ligament " << j << " at step "
+                                               << run.steps[static_cast<std::size_t>(k)] << ", ratio " << ratio;
+    }
 }
 
-INSTANTIATE_TEST_SUITE_P(HalfAMillimetre, NoisyEstimationTest, ::testing::Values("box", "liver"),
-                         [](const ::testing::TestParamInfo<const char*>& param_info) {
-                           return std::string(param_info.param);
+INSTANTIATE_TEST_SUITE_P(HalfAMillimetre, NoisyEstimationTest,
+                         ::testing::Values(NoisyGoal{"box", 0.02, 300}, NoisyGoal{"liver", 0.04, 400}),
+                         [](const ::testing::TestParamInfo<NoisyGoal>& param_info) {
+                           return std::string(param_info.param.scenario);
                          });
 
 // Measured data's faults (issue 15): the box at 0.5 mm noise, its first 600 steps (before the

@@ -29,8 +29,14 @@ TEST(EstimationHistory, KeepingOnlyTheWindowChangesNothingButMemory) {
   s.observations.noise_std = 0.0;
   const ObservationTable data = test::generated_observations(s);
 
+  // Twice: with the change detector alone (the parameter-change test off, so that the NIS
+  // fires and its look-back is exercised), then with both (the parameter-change test fires
+  // first and arms the cut rule from its own look-back).
+  for (const bool change_test : {false, true}) {
+  SCOPED_TRACE(change_test ? "with the parameter-change test" : "the change detector alone");
   auto run = [&](bool keep_all_steps, std::vector<EstimationStep>& seen) {
     EstimationOptions options = estimation_options(s);
+    options.change_test.enabled = change_test;
     options.keep_all_steps = keep_all_steps;
     options.roukf.observation_std = 1e-4;
     options.roukf.parameter_drift_log_std = 0.02;
@@ -44,7 +50,14 @@ TEST(EstimationHistory, KeepingOnlyTheWindowChangesNothingButMemory) {
   const EstimationRun window = run(false, seen_window);
   ASSERT_TRUE(all.complete) << all.stop_reason;
   ASSERT_TRUE(window.complete) << window.stop_reason;
-  ASSERT_GT(all.changes_detected, 0) << "the cut must fire the detector, or the look-back is not exercised";
+  if (change_test) {
+    ASSERT_FALSE(all.parameter_changes.empty()) << "the cut must fire the test, or its look-back is not exercised";
+    ASSERT_EQ(window.parameter_changes.size(), all.parameter_changes.size());
+    for (std::size_t i = 0; i < all.parameter_changes.size(); ++i)
+      EXPECT_EQ(window.parameter_changes[i].step, all.parameter_changes[i].step);
+  } else {
+    ASSERT_GT(all.changes_detected, 0) << "the cut must fire the detector, or the look-back is not exercised";
+  }
   ASSERT_EQ(all.cuts.size(), 1u);
 
   const std::size_t W = static_cast<std::size_t>(estimation_options(s).detector.window);
@@ -69,6 +82,7 @@ TEST(EstimationHistory, KeepingOnlyTheWindowChangesNothingButMemory) {
   EXPECT_EQ(window.cuts[0].step, all.cuts[0].step);
   EXPECT_EQ(window.cuts[0].stiffness_before, all.cuts[0].stiffness_before) << "measured against the look-back";
   EXPECT_EQ(window.final_theta_covariance, all.final_theta_covariance);
+  }
 }
 
 }  // namespace

@@ -25,16 +25,18 @@ TEST(LigamentCutRule, CutsOnlyALigamentThatLostNearlyAllItsStiffness) {
 
   rule.arm(log_of({150, 300, 200}), std_before);
   EXPECT_NEAR(rule.stiffness_before(1), 300.0, 1e-9);
-  // 300 -> 10 N/m with a log std of 0.1: upper bound 10 e^0.3 = 13.5 N/m; the reference's lower
-  // bound is 300 e^-0.12 = 266 N/m, 5% of it 13.3: not yet.
-  EXPECT_TRUE(rule.update(log_of({150, 10, 200}), Eigen::Vector3d(0.04, 0.1, 0.04)).empty());
-  // A wide estimate low in the middle could still lie above the bound: not cut.
-  EXPECT_TRUE(rule.update(log_of({150, 2, 200}), Eigen::Vector3d(0.04, 0.8, 0.04)).empty());
-  // The left ligament weakened to a third: not cut. The middle at 5 N/m, log std 0.2: upper
-  // bound 9.1 N/m < 13.3: cut.
-  const std::vector<int> cut = rule.update(log_of({50, 5, 200}), Eigen::Vector3d(0.04, 0.2, 0.04));
+  // 300 -> 25 N/m with a log std of 0.1: upper bound 25 e^0.2 = 30.5 N/m; the reference's lower
+  // bound is 300 e^-0.08 = 277 N/m, 10% of it 27.7: not yet.
+  EXPECT_TRUE(rule.update(log_of({150, 25, 200}), Eigen::Vector3d(0.04, 0.1, 0.04)).empty());
+  // A wide estimate low in the middle could still lie above the bound (2 e^3 = 40 N/m): not cut.
+  EXPECT_TRUE(rule.update(log_of({150, 2, 200}), Eigen::Vector3d(0.04, 1.5, 0.04)).empty());
+  // The left ligament weakened to a third: not cut. The middle at 15 N/m, log std 0.2: upper
+  // bound 22.4 N/m < 27.7: cut, with that bound.
+  const std::vector<int> cut = rule.update(log_of({50, 15, 200}), Eigen::Vector3d(0.04, 0.2, 0.04));
   ASSERT_EQ(cut.size(), 1u);
   EXPECT_EQ(cut[0], 1);
+  EXPECT_NEAR(rule.upper_bound(1), 15.0 * std::exp(0.4), 1e-9);
+  EXPECT_TRUE(std::isnan(rule.upper_bound(0)));
   EXPECT_TRUE(rule.is_cut(1));
   EXPECT_FALSE(rule.is_cut(0));
   // Reported once.

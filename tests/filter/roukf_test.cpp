@@ -141,6 +141,50 @@ TEST_P(RoukfExactTest, DriftAddsItsVarianceToTheParameters) {
       << to_string(GetParam()) << ": P_theta after a drift step without data";
 }
 
+TEST_P(RoukfExactTest, TheScoreIsTheSensitivitiesTimesTheInnovation) {
+  // First step from the known x0: y = H (A x0 + B theta + c u), so the sensitivity of the
+  // predicted observation to theta is H B exactly, and with P = s^2 I and R = r I the score
+  // is (HB)^T z / r with covariance (HB)^T (HB P (HB)^T + R) HB / r^2
+  // (filter/parameter_change_test.h).
+  const int n = 5, p = 3, m = 4;
+  const LinearModel model = make_linear_model(n, p, m, 11);
+  const SigmaPoints points = make_sigma_points(GetParam(), p);
+  testing::LinearGaussianEnsemble ensemble(model.A, model.B, model.c, model.H, model.x0, points.count());
+  const double s = 0.5, sigma = 0.1;
+  Roukf filter(options(p, s, sigma), ensemble);
+  const Eigen::Vector3d so(0.3, 0.0, 0.0);
+  const Eigen::VectorXd x1 = model.A * model.x0 + model.B * model.theta_true + model.c * so.x();
+  const Eigen::VectorXd y = model.H * x1;
+  const RoukfStep result = filter.step(so, y);
+  const Eigen::MatrixXd HB = model.H * model.B;
+  const Eigen::VectorXd z = y - model.H * (model.A * model.x0 + model.c * so.x());   // theta_hat = 0
+  const double r = sigma * sigma;
+  const Eigen::VectorXd score = HB.transpose() * z / r;
+  const Eigen::MatrixXd S = s * s * HB * HB.transpose() + r * Eigen::MatrixXd::Identity(m, m);
+  const Eigen::MatrixXd covariance = HB.transpose() * S * HB / (r * r);
+  EXPECT_LT((result.score - score).norm(), kExact * score.norm()) << to_string(GetParam());
+  EXPECT_LT((result.score_covariance - covariance).norm(), kExact * covariance.norm()) << to_string(GetParam());
+}
+
+TEST_P(RoukfExactTest, OpeningAddsTheCovarianceButNotToAFixedParameter) {
+  const int n = 4, p = 3, m = 3;
+  const LinearModel model = make_linear_model(n, p, m, 12);
+  const SigmaPoints points = make_sigma_points(GetParam(), p);
+  testing::LinearGaussianEnsemble ensemble(model.A, model.B, model.c, model.H, model.x0, points.count());
+  Roukf filter(options(p, 0.5, 0.1), ensemble);
+  filter.fix(2, 0.0);
+  EXPECT_EQ(filter.changeable(), (std::vector<bool>{true, true, false}));
+  const Eigen::MatrixXd before = filter.theta_covariance();
+  Eigen::MatrixXd opened(p, p);
+  opened << 0.09, 0.03, 0.02, 0.03, 0.04, 0.01, 0.02, 0.01, 0.05;
+  filter.open(opened);
+  const RoukfStep result = filter.step(Eigen::Vector3d::Zero(), Eigen::VectorXd::Constant(m, NAN));
+  Eigen::MatrixXd expected = before;
+  expected.topLeftCorner(2, 2) += opened.topLeftCorner(2, 2);   // the fixed row and column stay
+  EXPECT_LT((result.theta_covariance - expected).norm(), kExact) << to_string(GetParam());
+  EXPECT_THROW(filter.open(Eigen::MatrixXd::Identity(2, 2)), std::invalid_argument);
+}
+
 TEST_P(RoukfExactTest, InflationLeavesTheConstantsAlone) {
   const int n = 4, p = 3, m = 3;
   const LinearModel model = make_linear_model(n, p, m, 7);
