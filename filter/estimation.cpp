@@ -18,9 +18,7 @@ EstimationRun run_estimation(Ensemble& ensemble, const EstimationOptions& option
   ChangeDetector detector(options.detector);
   ParameterChangeTest change_test(options.change_test);
   // A jump is never opened wider than the prior (the parameter's initial std, log units).
-  const Eigen::VectorXd prior_std = options.roukf.initial_std.size() == options.roukf.initial_theta.size()
-                                        ? options.roukf.initial_std
-                                        : Eigen::VectorXd::Constant(options.roukf.initial_theta.size(), options.roukf.initial_log_std);
+  const Eigen::VectorXd& prior_std = filter.prior_std();
   RecoveryCheck recovery(options.recovery);
   // The first parameters that are log-stiffnesses (the rest are effect parameters).
   const Eigen::Index parameters = options.roukf.initial_theta.size();

@@ -31,9 +31,9 @@ Roukf::Roukf(const RoukfOptions& options, Ensemble& ensemble)
   if (options.drift_std.size() != 0 && options.drift_std.size() != p)
     throw std::invalid_argument("Roukf: drift_std has " + std::to_string(options.drift_std.size()) +
                                 " values for " + std::to_string(p) + " parameters");
-  const Eigen::VectorXd prior_std = options.initial_std.size() == p
-                                        ? options.initial_std
-                                        : Eigen::VectorXd::Constant(p, options.initial_log_std);
+  prior_std_ = options.initial_std.size() == p ? options.initial_std
+                                               : Eigen::VectorXd::Constant(p, options.initial_log_std);
+  const Eigen::VectorXd& prior_std = prior_std_;
   if (!(prior_std.array() > 0.0).all())
     throw std::invalid_argument("Roukf: every prior std must be positive");
   drift_variance_ = options.drift_std.size() == p

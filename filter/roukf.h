@@ -109,6 +109,8 @@ class Roukf {
 
   const SigmaPoints& sigma_points() const { return points_; }
   const Eigen::VectorXd& theta() const { return theta_; }
+  // The prior std of each theta (RoukfOptions::initial_std, or initial_log_std for all).
+  const Eigen::VectorXd& prior_std() const { return prior_std_; }
   Eigen::MatrixXd theta_covariance() const;
   // The ROUKF factors, for tests against an exact Kalman filter.
   const Eigen::MatrixXd& theta_factor() const { return L_theta_; }
@@ -128,6 +130,7 @@ class Roukf {
   RoukfOptions options_;
   Ensemble& ensemble_;
   SigmaPoints points_;
+  Eigen::VectorXd prior_std_;           // p
   Eigen::VectorXd theta_;               // theta_hat
   Eigen::MatrixXd L_theta_;             // p x p
   Eigen::MatrixXd U_inv_;               // p x p
