@@ -26,8 +26,11 @@ EstimationRun run_estimation(Ensemble& ensemble, const EstimationOptions& option
       options.stiffness_count >= 0 ? std::min<Eigen::Index>(options.stiffness_count, parameters) : parameters;
   LigamentCutRule cut_rule(options.cut, static_cast<int>(stiffnesses));
   EstimationRun run;
-  // The step (data row) at which a parameter was last found changed: it drifts faster from then.
+  // Per parameter: the step of its last opening (its extra drift decays from there), and of
+  // the last opening by a fresh change (the follow-up runs for a while after it; a follow-up's
+  // own firing does not extend that, so false follow-ups cannot chain).
   std::vector<double> changed_at(static_cast<std::size_t>(parameters), -1e300);
+  std::vector<double> fresh_change_at(static_cast<std::size_t>(parameters), -1e300);
   // The estimates of the last steps the parameter-change test looks back on (keep_all_steps
   // may keep fewer): a cut is measured against the estimate before the window that fired.
   std::deque<std::pair<Eigen::VectorXd, Eigen::VectorXd>> recent;   // theta, log_std
@@ -110,16 +113,23 @@ EstimationRun run_estimation(Ensemble& ensemble, const EstimationOptions& option
     }
     recent.emplace_back(step.theta, step.log_std);
     if (recent.size() > look_back) recent.pop_front();
-    const ParameterChange change = change_test.update(result.score, result.score_covariance, filter.changeable());
+    // Recently changed: while the extra drift of a fresh change would be above a hundredth of
+    // its start.
+    std::vector<bool> follow_up(static_cast<std::size_t>(parameters));
+    for (std::size_t j = 0; j < follow_up.size(); ++j)
+      follow_up[j] = static_cast<double>(k) - fresh_change_at[j] < std::log(100.0) * options.change_test.drift_decay_steps;
+    const ParameterChange change = change_test.update(result.score, result.score_covariance, filter.changeable(), follow_up);
     if (change.fired && armed) {
       Eigen::VectorXd jump = change.jump;
       for (Eigen::Index j = 0; j < jump.size(); ++j) {
         jump[j] = std::clamp(jump[j], -prior_std[j], prior_std[j]);
-        if (jump[j] != 0.0) changed_at[static_cast<std::size_t>(j)] = static_cast<double>(k);
+        if (jump[j] == 0.0) continue;
+        changed_at[static_cast<std::size_t>(j)] = static_cast<double>(k);
+        if (!change.follow_up) fresh_change_at[static_cast<std::size_t>(j)] = static_cast<double>(k);
       }
       filter.open(jump * jump.transpose());
       step.parameters_changed = true;
-      run.parameter_changes.push_back({step.step, change.window, change.statistic, change.threshold, jump});
+      run.parameter_changes.push_back({step.step, change.window, change.statistic, change.threshold, jump, change.follow_up});
       if (!cut_rule.armed()) {
         const auto& before = recent[recent.size() - std::min(recent.size(), static_cast<std::size_t>(change.window) + 1)];
         cut_rule.arm(before.first, before.second);

@@ -110,6 +110,7 @@ struct EstimationRun {
     int window = 0;                // steps of the window that fired
     double statistic = 0.0, threshold = 0.0;
     Eigen::VectorXd jump;          // nu_hat (log units), as opened
+    bool follow_up = false;        // the follow-up test of a recently changed parameter fired
   };
   std::vector<ParameterChangeRecord> parameter_changes;
   // The adaptive observation noise (filter/adaptive_noise.h): the steps whose correction used

@@ -14,7 +14,8 @@ ParameterChangeTest::ParameterChangeTest(const ParameterChangeTestOptions& optio
 }
 
 ParameterChange ParameterChangeTest::update(const Eigen::VectorXd& score, const Eigen::MatrixXd& covariance,
-                                            const std::vector<bool>& active) {
+                                            const std::vector<bool>& active,
+                                            const std::vector<bool>& follow_up) {
   ParameterChange found;
   const Eigen::Index p = score.size();
   found.jump = Eigen::VectorXd::Zero(p);
@@ -68,6 +69,30 @@ ParameterChange ParameterChangeTest::update(const Eigen::VectorXd& score, const 
     Eigen::VectorXd nu_a = Eigen::VectorXd::Zero(G_a.size());
     if (V_a(culprit, culprit) > 0.0) nu_a[culprit] = G_a[culprit] / V_a(culprit, culprit);
     found.jump(tested) = nu_a;
+  }
+  // The follow-up: each recently changed parameter alone, if no joint window fired.
+  const bool joint = found.fired;
+  for (std::size_t i = 0; i < follow_up.size() && !joint; ++i) {
+    const auto j = static_cast<Eigen::Index>(i);
+    if (!follow_up[i] || !active[i]) continue;
+    const double threshold = chi_square_tail_quantile(options_.follow_up_false_alarm, 1);
+    for (int w : options_.windows) {
+      if (static_cast<int>(steps_.size()) < w) continue;
+      double G = 0.0, V = 0.0;
+      for (auto it = steps_.end() - w; it != steps_.end(); ++it) {
+        G += it->score[j];
+        V += it->covariance(j, j);
+      }
+      if (!(V > 0.0) || G * G / V <= threshold || G * G / V / threshold <= best_significance) continue;
+      best_significance = G * G / V / threshold;
+      found.fired = true;
+      found.window = w;
+      found.statistic = G * G / V;
+      found.threshold = threshold;
+      found.follow_up = true;
+      found.jump.setZero();
+      found.jump[j] = G / V;
+    }
   }
   if (found.fired) steps_.clear();
   return found;

@@ -9,7 +9,12 @@ the steps until the cut was followed (summary.json), and over the whole run the 
 largest ratio estimate / truth of a ligament whose truth is above 1 N/m (an uncut one).
 
     python3 scenarios/estimation_table.py build/sigmafem OUT scenarios/box.json scenarios/liver.json \
-        --seeds 1,2,3,4,5 [--noise-std 0] [--observation-std 1e-4] [--backend cpu]
+        --seeds 1,2,3,4,5 [--noise-std 0] [--observation-std 1e-4] [--backend cpu] \
+        [--truth-stiffness 90,420,260] [--truth-refine 1]
+
+--truth-stiffness sets the true ligament stiffnesses (N/m, in the scenario's ligament order) in
+a copy of the scenario written to OUT, the filter's prior unchanged: data the scenario was not
+tuned on. --truth-refine is passed to `generate` (the truth on a finer mesh).
 """
 import argparse
 import concurrent.futures
@@ -51,6 +56,26 @@ def figures(data, estimate):
     return phases, min(ratios), max(ratios)
 
 
+def with_truth_stiffness(scenario, stiffness, out):
+    """A copy of `scenario` in `out` with these true ligament stiffnesses, its files absolute."""
+    with open(scenario) as f:
+        spec = json.load(f)
+    if len(stiffness) != len(spec['ligaments']):
+        raise SystemExit(f'--truth-stiffness: {len(stiffness)} values for the {len(spec["ligaments"])} ligaments of {scenario}')
+    for ligament, k in zip(spec['ligaments'], stiffness):
+        ligament['stiffness'] = k
+    here = os.path.dirname(os.path.abspath(scenario))
+    spec['mesh']['file'] = os.path.join(here, spec['mesh']['file'])
+    trajectory = spec['control']['trajectory']
+    if 'file' in trajectory:
+        trajectory['file'] = os.path.join(here, trajectory['file'])
+    os.makedirs(out, exist_ok=True)
+    copy = os.path.join(out, os.path.basename(scenario))
+    with open(copy, 'w') as f:
+        json.dump(spec, f, indent=1)
+    return copy
+
+
 def main():
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument('sigmafem')
@@ -61,7 +86,12 @@ def main():
     parser.add_argument('--observation-std')
     parser.add_argument('--backend', default='cpu')
     parser.add_argument('--jobs', type=int, default=2)
+    parser.add_argument('--truth-stiffness')
+    parser.add_argument('--truth-refine')
     args = parser.parse_args()
+    if args.truth_stiffness:
+        stiffness = [float(k) for k in args.truth_stiffness.split(',')]
+        args.scenarios = [with_truth_stiffness(s, stiffness, args.out) for s in args.scenarios]
 
     def run(job):
         scenario, seed = job
@@ -69,6 +99,7 @@ def main():
         data = os.path.join(args.out, f'{name}-seed{seed}')
         generate = [args.sigmafem, 'generate', scenario, '--out', data, '--seed', str(seed), '--vtk-every', '0', '--quiet']
         if args.noise_std is not None: generate += ['--noise-std', args.noise_std]
+        if args.truth_refine is not None: generate += ['--truth-refine', args.truth_refine]
         subprocess.run(generate, check=True)
         estimate = [args.sigmafem, 'estimate', scenario, '--data', data, '--out', os.path.join(data, 'estimate'),
                     '--backend', args.backend, '--quiet']

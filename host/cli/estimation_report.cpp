@@ -172,6 +172,7 @@ nlohmann::ordered_json parameter_changes_json(const EstimationRun& run, const st
                        {"window_steps", change.window},
                        {"statistic", change.statistic},
                        {"threshold", change.threshold},
+                       {"follow_up", change.follow_up},
                        {"opened_log_jump", jump}});
   }
   return changes;

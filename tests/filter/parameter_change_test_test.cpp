@@ -28,7 +28,8 @@ struct Firing {
 
 // Steps 0..steps-1, the parameters jumped by `jump` from step `at` on; the firings.
 std::vector<Firing> feed(ParameterChangeTest& test, int steps, int at, const Eigen::VectorXd& jump,
-                         unsigned seed, const std::vector<bool>& active = {true, true, true}) {
+                         unsigned seed, const std::vector<bool>& active = {true, true, true},
+                         const std::vector<bool>& follow_up = {}) {
   const Eigen::MatrixXd V = information();
   const Eigen::MatrixXd root = V.llt().matrixL();
   std::mt19937 random(seed);
@@ -38,7 +39,7 @@ std::vector<Firing> feed(ParameterChangeTest& test, int steps, int at, const Eig
     Eigen::VectorXd noise(3);
     for (int i = 0; i < 3; ++i) noise[i] = normal(random);
     const Eigen::VectorXd score = (k >= at ? Eigen::VectorXd(V * jump) : Eigen::VectorXd::Zero(3)) + root * noise;
-    const ParameterChange change = test.update(score, V, active);
+    const ParameterChange change = test.update(score, V, active, follow_up);
     if (change.fired) firings.push_back({k, change});
   }
   return firings;
@@ -87,6 +88,35 @@ TEST(ParameterChangeTest, LeavesInactiveParametersOut) {
   const std::vector<Firing> firings =
       feed(test, 400, 100, Eigen::Vector3d(-2.0, 0.0, 0.0), 4, {false, true, true});
   for (const Firing& firing : firings) EXPECT_EQ(firing.change.jump[0], 0.0);
+}
+
+TEST(ParameterChangeTest, FollowsUpARecentChangeAtALowerThreshold) {
+  // A jump of 0.12 log units on the first parameter (the rest of a change the filter is still
+  // following): over 160 steps the joint T is about 3 + 160 * 0.0144 * 4 = 12 against 30.7,
+  // silent; the first parameter alone, marked recently changed, has G^2 / V about
+  // 1 + 9.2 against chi-square(1) at 1e-3, 10.8, and is found.
+  const Eigen::Vector3d rest(0.12, 0.0, 0.0);
+  ParameterChangeTest fresh{ParameterChangeTestOptions{}};
+  EXPECT_TRUE(feed(fresh, 1000, 0, rest, 5).empty());
+  ParameterChangeTest following{ParameterChangeTestOptions{}};
+  const std::vector<Firing> firings = feed(following, 1000, 0, rest, 5, {true, true, true}, {true, false, false});
+  ASSERT_FALSE(firings.empty());
+  for (const Firing& firing : firings) {
+    EXPECT_TRUE(firing.change.follow_up);
+    EXPECT_GT(firing.change.jump[0], 0.0);
+    EXPECT_EQ(firing.change.jump[1], 0.0);
+    EXPECT_EQ(firing.change.jump[2], 0.0);
+  }
+}
+
+TEST(ParameterChangeTest, TheFollowUpFiresAtItsRateWhileNothingChanges) {
+  // White scores, the first parameter marked: at most its false alarm per window and step
+  // (3 x 20000 x 1e-3 = 60; the windows overlap and restart after a firing, so fewer).
+  ParameterChangeTest test{ParameterChangeTestOptions{}};
+  const std::vector<Firing> firings = feed(test, 20000, 20000, Eigen::VectorXd::Zero(3), 6, {true, true, true},
+                                           {true, false, false});
+  EXPECT_LE(firings.size(), 60u);
+  for (const Firing& firing : firings) EXPECT_EQ(firing.change.jump[1], 0.0);
 }
 
 }  // namespace
