@@ -31,15 +31,18 @@ EstimationRun run_estimation(Ensemble& ensemble, const EstimationOptions& option
   // own firing does not extend that, so false follow-ups cannot chain).
   std::vector<double> changed_at(static_cast<std::size_t>(parameters), -1e300);
   std::vector<double> fresh_change_at(static_cast<std::size_t>(parameters), -1e300);
+  std::vector<double> fresh_jump(static_cast<std::size_t>(parameters), 0.0);   // log units, as opened
   // The estimates of the last steps the parameter-change test looks back on (keep_all_steps
   // may keep fewer): a cut is measured against the estimate before the window that fired.
   std::deque<std::pair<Eigen::VectorXd, Eigen::VectorXd>> recent;   // theta, log_std
   std::size_t look_back = 1;
   for (int w : options.change_test.windows) look_back = std::max(look_back, static_cast<std::size_t>(w) + 1);
-  std::deque<bool> scaled;   // the last 2W steps: did the correction use lambda > 1?
+  // The last W + max(W, quiet_steps) steps: did the correction use lambda > 1?
+  std::deque<bool> scaled;
   int catch_up_start = -1;   // step index (made steps, from 0) of the firing that began the catch-up; -1: none
   int dropped = 0;           // steps made and no longer kept (keep_all_steps false)
   const auto W = static_cast<std::size_t>(options.detector.window);
+  const std::size_t quiet = std::max(W, static_cast<std::size_t>(options.change_test.quiet_steps));
   for (Eigen::Index k = 1; k < so.rows(); ++k) {
     const auto start = std::chrono::steady_clock::now();
     EstimationStep step;
@@ -86,9 +89,17 @@ EstimationRun run_estimation(Ensemble& ensemble, const EstimationOptions& option
     // stayed 1 over the W steps before the detector's window of W (the adaptive noise, on a
     // shorter window, may engage inside it); then P opens and lambda stays 1 while the filter
     // follows. In the first 2W steps there is no such history and the detector is not armed.
+    // The parameter-change test asks for a longer quiet history (quiet_steps): a model error
+    // engages the adaptive noise now and then, and between times shows as jumps.
     scaled.push_back(result.noise_scale > 1.0);   // scaled[i]: step k - scaled.size() + 1 + i
-    if (scaled.size() > 2 * W) scaled.pop_front();
-    const bool armed = scaled.size() == 2 * W && std::none_of(scaled.begin(), scaled.begin() + W, [](bool b) { return b; });
+    if (scaled.size() > quiet + W) scaled.pop_front();
+    const auto quiet_before_window = [&](std::size_t steps) {
+      return scaled.size() >= steps + W &&
+             std::none_of(scaled.end() - static_cast<std::ptrdiff_t>(steps + W), scaled.end() - static_cast<std::ptrdiff_t>(W),
+                          [](bool b) { return b; });
+    };
+    const bool armed = quiet_before_window(W);
+    const bool change_test_armed = quiet_before_window(quiet);
     step.change_detected = detector.update(result.normalised_innovation, result.observed_rows) && armed;
     if (step.change_detected) {
       filter.inflate(options.detector.inflation_log_std);
@@ -118,14 +129,24 @@ EstimationRun run_estimation(Ensemble& ensemble, const EstimationOptions& option
     std::vector<bool> follow_up(static_cast<std::size_t>(parameters));
     for (std::size_t j = 0; j < follow_up.size(); ++j)
       follow_up[j] = static_cast<double>(k) - fresh_change_at[j] < std::log(100.0) * options.change_test.drift_decay_steps;
-    const ParameterChange change = change_test.update(result.score, result.score_covariance, filter.changeable(), follow_up);
-    if (change.fired && armed) {
+    std::vector<bool> tested = filter.changeable();
+    for (std::size_t j = 0; j < tested.size(); ++j)
+      tested[j] = tested[j] && step.log_std[static_cast<Eigen::Index>(j)] <
+                                   options.change_test.learned_fraction * prior_std[static_cast<Eigen::Index>(j)];
+    const ParameterChange change = change_test.update(result.score, result.score_covariance, tested, follow_up);
+    // The rest of a change goes the way it began: a follow-up the other way is not one.
+    bool follows_on = true;
+    for (Eigen::Index j = 0; j < change.jump.size() && change.follow_up; ++j)
+      if (change.jump[j] * fresh_jump[static_cast<std::size_t>(j)] < 0.0) follows_on = false;
+    if (change.fired && change_test_armed && follows_on) {
       Eigen::VectorXd jump = change.jump;
       for (Eigen::Index j = 0; j < jump.size(); ++j) {
         jump[j] = std::clamp(jump[j], -prior_std[j], prior_std[j]);
         if (jump[j] == 0.0) continue;
         changed_at[static_cast<std::size_t>(j)] = static_cast<double>(k);
-        if (!change.follow_up) fresh_change_at[static_cast<std::size_t>(j)] = static_cast<double>(k);
+        if (change.follow_up) continue;
+        fresh_change_at[static_cast<std::size_t>(j)] = static_cast<double>(k);
+        fresh_jump[static_cast<std::size_t>(j)] = jump[j];
       }
       filter.open(jump * jump.transpose());
       step.parameters_changed = true;
