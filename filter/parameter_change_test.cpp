@@ -72,10 +72,10 @@ ParameterChange ParameterChangeTest::update(const Eigen::VectorXd& score, const 
   }
   // The follow-up: each recently changed parameter alone, if no joint window fired.
   const bool joint = found.fired;
+  const double follow_up_threshold = chi_square_tail_quantile(options_.follow_up_false_alarm, 1);
   for (std::size_t i = 0; i < follow_up.size() && !joint; ++i) {
     const auto j = static_cast<Eigen::Index>(i);
     if (!follow_up[i] || !active[i]) continue;
-    const double threshold = chi_square_tail_quantile(options_.follow_up_false_alarm, 1);
     for (int w : options_.windows) {
       if (static_cast<int>(steps_.size()) < w) continue;
       double G = 0.0, V = 0.0;
@@ -83,12 +83,12 @@ ParameterChange ParameterChangeTest::update(const Eigen::VectorXd& score, const 
         G += it->score[j];
         V += it->covariance(j, j);
       }
-      if (!(V > 0.0) || G * G / V <= threshold || G * G / V / threshold <= best_significance) continue;
-      best_significance = G * G / V / threshold;
+      if (!(V > 0.0) || G * G / V <= follow_up_threshold || G * G / V / follow_up_threshold <= best_significance) continue;
+      best_significance = G * G / V / follow_up_threshold;
       found.fired = true;
       found.window = w;
       found.statistic = G * G / V;
-      found.threshold = threshold;
+      found.threshold = follow_up_threshold;
       found.follow_up = true;
       found.jump.setZero();
       found.jump[j] = G / V;

@@ -15,6 +15,8 @@ import subprocess
 import sys
 import tempfile
 
+from scenario_copy import relocatable_scenario
+
 
 def observations(path):
     with open(path) as f:
@@ -26,12 +28,7 @@ def observations(path):
 
 
 def simulate(sigmafem, scenario, stiffness, folder):
-    with open(scenario) as f:
-        spec = json.load(f)
-    spec["mesh"]["file"] = os.path.join(os.path.dirname(os.path.abspath(scenario)), spec["mesh"]["file"])
-    trajectory = spec["control"]["trajectory"]
-    if "file" in trajectory:
-        trajectory["file"] = os.path.join(os.path.dirname(os.path.abspath(scenario)), trajectory["file"])
+    spec = relocatable_scenario(scenario)
     spec["events"][0]["stiffness"] = stiffness
     path = os.path.join(folder, f"cut_{stiffness}.json")
     with open(path, "w") as f:

@@ -23,6 +23,8 @@ import json
 import os
 import subprocess
 
+from scenario_copy import relocatable_scenario
+
 
 def rows_of(path):
     with open(path) as f:
@@ -58,17 +60,11 @@ def figures(data, estimate):
 
 def with_truth_stiffness(scenario, stiffness, out):
     """A copy of `scenario` in `out` with these true ligament stiffnesses, its files absolute."""
-    with open(scenario) as f:
-        spec = json.load(f)
+    spec = relocatable_scenario(scenario)
     if len(stiffness) != len(spec['ligaments']):
         raise SystemExit(f'--truth-stiffness: {len(stiffness)} values for the {len(spec["ligaments"])} ligaments of {scenario}')
     for ligament, k in zip(spec['ligaments'], stiffness):
         ligament['stiffness'] = k
-    here = os.path.dirname(os.path.abspath(scenario))
-    spec['mesh']['file'] = os.path.join(here, spec['mesh']['file'])
-    trajectory = spec['control']['trajectory']
-    if 'file' in trajectory:
-        trajectory['file'] = os.path.join(here, trajectory['file'])
     os.makedirs(out, exist_ok=True)
     copy = os.path.join(out, os.path.basename(scenario))
     with open(copy, 'w') as f:
