@@ -33,11 +33,14 @@ bool ChangeDetector::update(double normalised_innovation, int degrees_of_freedom
   const bool model_error = reference_dof > 0 &&
       reference > chi_square_tail_quantile(options_.model_error_false_alarm, reference_dof);
   reference_level_ = model_error ? reference / reference_dof : 1.0;
+  tested_ = true;
   threshold_ = model_error ? reference_level_ * tested_dof_ * f_tail_quantile(options_.false_alarm, tested_dof_, reference_dof)
                            : chi_square_tail_quantile(options_.false_alarm, tested_dof_);
+  if (!fired_) settle_threshold_per_dof_ = threshold_ / tested_dof_;
   if (statistic_ <= threshold_) return false;
   silent_for_ = options_.hold_off;
-  threshold_per_dof_at_firing_ = threshold_ / tested_dof_;
+  fired_ = true;
+  settle_threshold_per_dof_ = threshold_ / tested_dof_;
   nis_.clear();
   dof_.clear();
   return true;

@@ -51,12 +51,16 @@ class ChangeDetector {
   double threshold() const { return threshold_; }
   // The reference window's NIS per degree of freedom when it showed a model error, else 1.
   double reference_level() const { return reference_level_; }
+  // True when the last test's reference showed no model error: the model explained the data
+  // before the tested window (false before the first test).
+  bool model_explained_reference() const { return tested_ && reference_level_ == 1.0; }
   // True when the last window is full and its NIS per degree of freedom is within the
-  // threshold per degree of freedom of the last firing: the innovations are back to what the
-  // model explained before the change (ends a catch-up).
+  // threshold per degree of freedom of the last firing (before any firing: of the last test):
+  // the innovations are back to what the model explained before the change (ends a catch-up,
+  // also one that the parameter-change test began).
   bool settled() const {
     return static_cast<int>(nis_.size()) >= options_.window &&
-           statistic_ <= threshold_per_dof_at_firing_ * tested_dof_;
+           statistic_ <= settle_threshold_per_dof_ * tested_dof_;
   }
 
  private:
@@ -66,7 +70,8 @@ class ChangeDetector {
   int silent_for_ = 0;
   double statistic_ = 0.0, threshold_ = 0.0;
   int tested_dof_ = 0;   // the degrees of freedom of the tested window (its last W steps)
-  double reference_level_ = 1.0, threshold_per_dof_at_firing_ = 0.0;
+  double reference_level_ = 1.0, settle_threshold_per_dof_ = 0.0;
+  bool fired_ = false, tested_ = false;
 };
 
 }  // namespace sigmafem

@@ -32,16 +32,16 @@ EstimationRun run_estimation(Ensemble& ensemble, const EstimationOptions& option
   std::vector<double> changed_at(static_cast<std::size_t>(parameters), -1e300);
   std::vector<double> fresh_change_at(static_cast<std::size_t>(parameters), -1e300);
   std::vector<double> fresh_jump(static_cast<std::size_t>(parameters), 0.0);   // log units, as opened
-  // The estimates of the last steps the parameter-change test looks back on (keep_all_steps
-  // may keep fewer): a cut is measured against the estimate before the window that fired.
-  std::deque<std::pair<Eigen::VectorXd, Eigen::VectorXd>> recent;   // theta, log_std
-  std::size_t look_back = 1;
-  for (int w : options.change_test.windows) look_back = std::max(look_back, static_cast<std::size_t>(w) + 1);
   // The last W + max(W, quiet_steps) steps: did the correction use lambda > 1?
   std::deque<bool> scaled;
   int catch_up_start = -1;   // step index (made steps, from 0) of the firing that began the catch-up; -1: none
   int dropped = 0;           // steps made and no longer kept (keep_all_steps false)
   const auto W = static_cast<std::size_t>(options.detector.window);
+  // The steps kept at least: the longest window that can find a change (the detector's or
+  // the change test's), as a change is measured from before its window and its catch-up
+  // marks the window's steps.
+  std::size_t look_back = W;
+  for (int w : options.change_test.windows) look_back = std::max(look_back, static_cast<std::size_t>(w));
   const std::size_t quiet = std::max(W, static_cast<std::size_t>(options.change_test.quiet_steps));
   for (Eigen::Index k = 1; k < so.rows(); ++k) {
     const auto start = std::chrono::steady_clock::now();
@@ -100,30 +100,36 @@ EstimationRun run_estimation(Ensemble& ensemble, const EstimationOptions& option
     };
     const bool armed = quiet_before_window(W);
     const bool change_test_armed = quiet_before_window(quiet);
+    // A change began inside the window of `window` steps that found it: its earlier steps
+    // are part of the catch-up. A firing during a catch-up continues it (the cap counts from
+    // its start). Returns whether a catch-up began.
+    const auto begin_catch_up = [&](std::size_t window) {
+      if (catch_up_start >= 0) return false;
+      catch_up_start = dropped + static_cast<int>(run.steps.size());
+      for (std::size_t i = run.steps.size() - std::min(run.steps.size(), window - 1); i < run.steps.size(); ++i)
+        if (!run.steps[i].catching_up) {
+          run.steps[i].catching_up = true;
+          ++run.catch_up_steps;
+        }
+      return true;
+    };
+    // The estimate before the change began (the step before the window that found it) is
+    // what a cut is measured against.
+    const auto arm_cut_rule = [&](std::size_t window) {
+      if (run.steps.empty()) {
+        cut_rule.arm(step.theta, step.log_std);
+        return;
+      }
+      const EstimationStep& before = run.steps[run.steps.size() - std::min(run.steps.size(), window)];
+      cut_rule.arm(before.theta, before.log_std);
+    };
     step.change_detected = detector.update(result.normalised_innovation, result.observed_rows) && armed;
     if (step.change_detected) {
       filter.inflate(options.detector.inflation_log_std);
       filter.hold_adaptive_noise(options.detector.hold_off);
       ++run.changes_detected;
-      // The change began inside the window that fired: its earlier steps are part of the
-      // catch-up. A firing during a catch-up continues it (the cap counts from its start).
-      if (catch_up_start < 0) {
-        catch_up_start = dropped + static_cast<int>(run.steps.size());
-        // The estimate before the change began (the step before the window that fired) is
-        // what a cut is measured against.
-        if (!run.steps.empty()) {
-          const EstimationStep& before = run.steps[run.steps.size() - std::min(run.steps.size(), W)];
-          cut_rule.arm(before.theta, before.log_std);
-        }
-        for (std::size_t i = run.steps.size() - std::min(run.steps.size(), W - 1); i < run.steps.size(); ++i)
-          if (!run.steps[i].catching_up) {
-            run.steps[i].catching_up = true;
-            ++run.catch_up_steps;
-          }
-      }
+      if (begin_catch_up(W)) arm_cut_rule(W);
     }
-    recent.emplace_back(step.theta, step.log_std);
-    if (recent.size() > look_back) recent.pop_front();
     // Recently changed: while the extra drift of a fresh change would be above a hundredth of
     // its start.
     std::vector<bool> follow_up(static_cast<std::size_t>(parameters));
@@ -151,10 +157,16 @@ EstimationRun run_estimation(Ensemble& ensemble, const EstimationOptions& option
       filter.open(jump * jump.transpose());
       step.parameters_changed = true;
       run.parameter_changes.push_back({step.step, change.window, change.statistic, change.threshold, jump, change.follow_up});
-      if (!cut_rule.armed()) {
-        const auto& before = recent[recent.size() - std::min(recent.size(), static_cast<std::size_t>(change.window) + 1)];
-        cut_rule.arm(before.first, before.second);
-      }
+      // The state catches up on a found change as on one the NIS detector finds (which may
+      // fire later or, for a change the data show slowly, never): its innovations are not
+      // evidence about the model meanwhile. Only where the model explained the data before
+      // (the detector's last reference): under a model error the change test fires now and
+      // then (an undeclared lag on box_diagnose), the innovations never come back to a level
+      // that ends a catch-up, and each fit would leave out up to max_catch_up steps of the
+      // evidence against it. A follow-up belongs to its change's catch-up.
+      const bool began = !change.follow_up && detector.model_explained_reference() &&
+                         begin_catch_up(static_cast<std::size_t>(change.window));
+      if (began || !cut_rule.armed()) arm_cut_rule(static_cast<std::size_t>(change.window));
     }
     {
       Eigen::VectorXd drift = Eigen::VectorXd::Zero(parameters);
@@ -189,7 +201,7 @@ EstimationRun run_estimation(Ensemble& ensemble, const EstimationOptions& option
     filter.hold_constants(catch_up_start >= 0);
     step.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
     run.steps.push_back(step);
-    if (!options.keep_all_steps && run.steps.size() > W) {   // the look-back above needs W
+    if (!options.keep_all_steps && run.steps.size() > look_back) {
       run.steps.erase(run.steps.begin());
       ++dropped;
     }

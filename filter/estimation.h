@@ -38,7 +38,8 @@ struct EstimationOptions {
   // above; the rest (effect parameters, host/model/effects.h) are not stiffnesses.
   // -1: all of them.
   int stiffness_count = -1;
-  // false: the run keeps only the steps the change detection looks back on (its window), so
+  // false: the run keeps only the steps the change detection looks back on (its longest
+  // window: the detector's or the parameter-change test's), so
   // that memory stays flat over an unbounded run (a navigation session; the soak run,
   // bench/soak_main.cpp); on_step sees every step. true: every step, for the reports.
   bool keep_all_steps = true;
@@ -70,7 +71,8 @@ struct EstimationStep {
   // The parameter-change test fired at this step and P was opened along the jump it estimated.
   bool parameters_changed = false;
   // The step lies in the catch-up after a detected change: from the first step of the
-  // detector's window that fired until the innovations are back within the detector's
+  // window that found it (the NIS detector's, or the parameter-change test's on a fresh
+  // change; whichever fired first) until the innovations are back within the detector's
   // threshold after its hold-off and their mean is back at zero (RecoveryCheck; at most
   // detector.max_catch_up steps). The reduced-order
   // filter corrects the state only along the parameters' sensitivities, so after a cut the
