@@ -1,4 +1,4 @@
-// A whole box estimation (550 steps, the cut at step 300, 0.5 mm noise, simplex) on a device back end
+// A whole box estimation (450 steps, the cut at step 250, 0.5 mm noise, simplex) on a device back end
 // agrees with the same run on the CPU back end: every estimate at every step within 0.5%
 // (issues 4 and 5), for every device back end present (OpenCL, Vulkan). The device runs in float32 with a CG tolerance of 1e-6; the filter sees the
 // observed positions to about 1e-7 m (tests/conformance/ensemble_conformance_test.cpp)
@@ -41,15 +41,15 @@ TEST_P(WholeRun, EstimatesMatchTheCpuBackEnd) {
   // Shorter than the shipped run (1500 steps, the cut at step 750: 280 s on lavapipe on the
   // 2-core machine, the longest test of the suite), with the same parts: the estimates
   // moving fast from twice the truth (where the back ends differed most, steps 25-36), the
-  // cut, and the filter following it through its drift (the middle ligament from about 280
-  // to 14 N/m within 50 steps of the cut and about 3 N/m 250 steps after it, in
-  // estimates.csv of `sigmafem estimate scenarios/box.json`, seed 1).
+  // cut, and the filter following it (since issue 16 the cut rule finds the middle ligament
+  // cut and sets it next to zero; the test prints when). Until stop 39 550 steps with the
+  // cut at 300; shortened for the test command's time (63 s on lavapipe on a fresh machine).
   ASSERT_EQ(s.events.size(), 1u);
   const int middle = 1;   // the cut ligament's row among the estimated ones
   ASSERT_EQ(s.ligaments[s.filter->estimate[middle]].name, s.events[0].ligament_name);
-  s.events[0].time = 3.0;
-  s.time.steps = 550;
-  const int cut_step = static_cast<int>(std::lround(s.events[0].time / s.time.dt));   // 300
+  s.events[0].time = 2.5;
+  s.time.steps = 450;
+  const int cut_step = static_cast<int>(std::lround(s.events[0].time / s.time.dt));   // 250
   const ObservationTable data = test::generated_observations(s);
 
   const EstimationRun cpu = estimate_box(s, data, "cpu");
@@ -65,7 +65,8 @@ TEST_P(WholeRun, EstimatesMatchTheCpuBackEnd) {
   const double at_end = cpu.steps.back().stiffness[middle];
   EXPECT_LT(at_end, 0.1 * at_cut) << "middle ligament at the cut and at the end (N/m)";
   std::cout << "middle ligament (CPU back end): " << at_cut << " N/m at the cut, " << at_end
-            << " N/m at step " << cpu.steps.back().step << "\n";
+            << " N/m at step " << cpu.steps.back().step << "; found cut at step "
+            << (cpu.cuts.empty() ? -1 : cpu.cuts[0].step) << "\n";
   double largest = 0.0;
   int worst = 0;
   for (std::size_t k = 0; k < cpu.steps.size(); ++k) {
