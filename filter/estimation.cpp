@@ -3,11 +3,35 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
-#include <deque>
 #include <sstream>
 #include <stdexcept>
 
+#include "filter/catch_up.h"
+#include "filter/noise_scale_history.h"
+#include "filter/parameter_drift.h"
+
 namespace sigmafem {
+namespace {
+
+// The `window` - 1 kept steps before the one being made belong to a catch-up that began with
+// it: the change began inside the window that found it.
+void mark_catching_up(EstimationRun& run, std::size_t window) {
+  for (std::size_t i = run.steps.size() - std::min(run.steps.size(), window - 1); i < run.steps.size(); ++i)
+    if (!run.steps[i].catching_up) {
+      run.steps[i].catching_up = true;
+      ++run.catch_up_steps;
+    }
+}
+
+// A cut is measured against the estimate before the change began: the step before the
+// `window` that found it (the oldest kept one; `now` when none is kept).
+void arm_cut_rule(LigamentCutRule& rule, const EstimationRun& run, const EstimationStep& now, std::size_t window) {
+  const EstimationStep& before =
+      run.steps.empty() ? now : run.steps[run.steps.size() - std::min(run.steps.size(), window)];
+  rule.arm(before.theta, before.log_std);
+}
+
+}  // namespace
 
 EstimationRun run_estimation(Ensemble& ensemble, const EstimationOptions& options,
                              const std::vector<double>& times, const Eigen::MatrixX3d& so,
@@ -25,17 +49,10 @@ EstimationRun run_estimation(Ensemble& ensemble, const EstimationOptions& option
   const Eigen::Index stiffnesses =
       options.stiffness_count >= 0 ? std::min<Eigen::Index>(options.stiffness_count, parameters) : parameters;
   LigamentCutRule cut_rule(options.cut, static_cast<int>(stiffnesses));
+  ParameterDrift drift(options.change_test, parameters);
+  CatchUp catch_up(options.detector.hold_off, options.detector.max_catch_up);
   EstimationRun run;
-  // Per parameter: the step of its last opening (its extra drift decays from there), and of
-  // the last opening by a fresh change (the follow-up runs for a while after it; a follow-up's
-  // own firing does not extend that, so false follow-ups cannot chain).
-  std::vector<double> changed_at(static_cast<std::size_t>(parameters), -1e300);
-  std::vector<double> fresh_change_at(static_cast<std::size_t>(parameters), -1e300);
-  std::vector<double> fresh_jump(static_cast<std::size_t>(parameters), 0.0);   // log units, as opened
-  // The last W + max(W, quiet_steps) steps: did the correction use lambda > 1?
-  std::deque<bool> scaled;
-  int catch_up_start = -1;   // step index (made steps, from 0) of the firing that began the catch-up; -1: none
-  int dropped = 0;           // steps made and no longer kept (keep_all_steps false)
+  int dropped = 0;   // steps made and no longer kept (keep_all_steps false)
   const auto W = static_cast<std::size_t>(options.detector.window);
   // The steps kept at least: the longest window that can find a change (the detector's or
   // the change test's), as a change is measured from before its window and its catch-up
@@ -43,6 +60,7 @@ EstimationRun run_estimation(Ensemble& ensemble, const EstimationOptions& option
   std::size_t look_back = W;
   for (int w : options.change_test.windows) look_back = std::max(look_back, static_cast<std::size_t>(w));
   const std::size_t quiet = std::max(W, static_cast<std::size_t>(options.change_test.quiet_steps));
+  NoiseScaleHistory noise_history(W, quiet);
   for (Eigen::Index k = 1; k < so.rows(); ++k) {
     const auto start = std::chrono::steady_clock::now();
     EstimationStep step;
@@ -84,76 +102,33 @@ EstimationRun run_estimation(Ensemble& ensemble, const EstimationOptions& option
       step.max_cg_iterations = std::max(step.max_cg_iterations, result.ensemble.cg_iterations[s]);
     step.unconverged_sigma_points = result.ensemble.unconverged_count();
     recovery.update(step.innovation, step.innovation_std);
-    // One mechanism with the adaptive noise (filter/adaptive_noise.h): a jump of the NIS is a
-    // change of the parameters only if the model explained the data before it, i.e. lambda
-    // stayed 1 over the W steps before the detector's window of W (the adaptive noise, on a
-    // shorter window, may engage inside it); then P opens and lambda stays 1 while the filter
-    // follows. In the first 2W steps there is no such history and the detector is not armed.
-    // The parameter-change test asks for a longer quiet history (quiet_steps): a model error
-    // engages the adaptive noise now and then, and between times shows as jumps.
-    scaled.push_back(result.noise_scale > 1.0);   // scaled[i]: step k - scaled.size() + 1 + i
-    if (scaled.size() > quiet + W) scaled.pop_front();
-    const auto quiet_before_window = [&](std::size_t steps) {
-      return scaled.size() >= steps + W &&
-             std::none_of(scaled.end() - static_cast<std::ptrdiff_t>(steps + W), scaled.end() - static_cast<std::ptrdiff_t>(W),
-                          [](bool b) { return b; });
-    };
-    const bool armed = quiet_before_window(W);
-    const bool change_test_armed = quiet_before_window(quiet);
-    // A change began inside the window of `window` steps that found it: its earlier steps
-    // are part of the catch-up. A firing during a catch-up continues it (the cap counts from
-    // its start). Returns whether a catch-up began.
+    // A change is acted on only where the model explained the data before it (NoiseScaleHistory).
+    noise_history.record(result.noise_scale > 1.0);
+    const bool armed = noise_history.quiet_before_window(W);
+    const bool change_test_armed = noise_history.quiet_before_window(quiet);
+    const int index = dropped + static_cast<int>(run.steps.size());   // of this step, from 0
     const auto begin_catch_up = [&](std::size_t window) {
-      if (catch_up_start >= 0) return false;
-      catch_up_start = dropped + static_cast<int>(run.steps.size());
-      for (std::size_t i = run.steps.size() - std::min(run.steps.size(), window - 1); i < run.steps.size(); ++i)
-        if (!run.steps[i].catching_up) {
-          run.steps[i].catching_up = true;
-          ++run.catch_up_steps;
-        }
+      if (!catch_up.begin(index)) return false;
+      mark_catching_up(run, window);
       return true;
-    };
-    // The estimate before the change began (the step before the window that found it) is
-    // what a cut is measured against.
-    const auto arm_cut_rule = [&](std::size_t window) {
-      if (run.steps.empty()) {
-        cut_rule.arm(step.theta, step.log_std);
-        return;
-      }
-      const EstimationStep& before = run.steps[run.steps.size() - std::min(run.steps.size(), window)];
-      cut_rule.arm(before.theta, before.log_std);
     };
     step.change_detected = detector.update(result.normalised_innovation, result.observed_rows) && armed;
     if (step.change_detected) {
       filter.inflate(options.detector.inflation_log_std);
       filter.hold_adaptive_noise(options.detector.hold_off);
       ++run.changes_detected;
-      if (begin_catch_up(W)) arm_cut_rule(W);
+      if (begin_catch_up(W)) arm_cut_rule(cut_rule, run, step, W);
     }
-    // Recently changed: while the extra drift of a fresh change would be above a hundredth of
-    // its start.
-    std::vector<bool> follow_up(static_cast<std::size_t>(parameters));
-    for (std::size_t j = 0; j < follow_up.size(); ++j)
-      follow_up[j] = static_cast<double>(k) - fresh_change_at[j] < std::log(100.0) * options.change_test.drift_decay_steps;
     std::vector<bool> tested = filter.changeable();
     for (std::size_t j = 0; j < tested.size(); ++j)
       tested[j] = tested[j] && step.log_std[static_cast<Eigen::Index>(j)] <
                                    options.change_test.learned_fraction * prior_std[static_cast<Eigen::Index>(j)];
-    const ParameterChange change = change_test.update(result.score, result.score_covariance, tested, follow_up);
-    // The rest of a change goes the way it began: a follow-up the other way is not one.
-    bool follows_on = true;
-    for (Eigen::Index j = 0; j < change.jump.size() && change.follow_up; ++j)
-      if (change.jump[j] * fresh_jump[static_cast<std::size_t>(j)] < 0.0) follows_on = false;
-    if (change.fired && change_test_armed && follows_on) {
+    const ParameterChange change =
+        change_test.update(result.score, result.score_covariance, tested, drift.followed_up(static_cast<double>(k)));
+    if (change.fired && change_test_armed && drift.goes_on(change)) {
       Eigen::VectorXd jump = change.jump;
-      for (Eigen::Index j = 0; j < jump.size(); ++j) {
-        jump[j] = std::clamp(jump[j], -prior_std[j], prior_std[j]);
-        if (jump[j] == 0.0) continue;
-        changed_at[static_cast<std::size_t>(j)] = static_cast<double>(k);
-        if (change.follow_up) continue;
-        fresh_change_at[static_cast<std::size_t>(j)] = static_cast<double>(k);
-        fresh_jump[static_cast<std::size_t>(j)] = jump[j];
-      }
+      for (Eigen::Index j = 0; j < jump.size(); ++j) jump[j] = std::clamp(jump[j], -prior_std[j], prior_std[j]);
+      drift.record(static_cast<double>(k), jump, change);
       filter.open(jump * jump.transpose());
       step.parameters_changed = true;
       run.parameter_changes.push_back({step.step, change.window, change.statistic, change.threshold, jump, change.follow_up});
@@ -166,25 +141,13 @@ EstimationRun run_estimation(Ensemble& ensemble, const EstimationOptions& option
       // evidence against it. A follow-up belongs to its change's catch-up.
       const bool began = !change.follow_up && detector.model_explained_reference() &&
                          begin_catch_up(static_cast<std::size_t>(change.window));
-      if (began || !cut_rule.armed()) arm_cut_rule(static_cast<std::size_t>(change.window));
+      if (began || !cut_rule.armed()) arm_cut_rule(cut_rule, run, step, static_cast<std::size_t>(change.window));
     }
-    {
-      Eigen::VectorXd drift = Eigen::VectorXd::Zero(parameters);
-      const double q = options.change_test.drift_log_std, tau = options.change_test.drift_decay_steps;
-      for (Eigen::Index j = 0; j < parameters; ++j)
-        drift[j] = q * q * std::exp(-2.0 * (static_cast<double>(k) - changed_at[static_cast<std::size_t>(j)]) / tau);
-      if (drift.maxCoeff() > 0.0) filter.open(drift.asDiagonal());
-    }
-    if (catch_up_start >= 0) {
-      const int since = dropped + static_cast<int>(run.steps.size()) - catch_up_start;   // 0: the firing step
-      // Over when the NIS is back (settled) and the innovations' mean too (RecoveryCheck).
-      if ((since > options.detector.hold_off && detector.settled() && recovery.recovered()) ||
-          since >= options.detector.max_catch_up) {
-        catch_up_start = -1;
-      } else {
-        step.catching_up = true;
-        ++run.catch_up_steps;
-      }
+    const Eigen::VectorXd drift_variance = drift.variance(static_cast<double>(k));
+    if (drift_variance.maxCoeff() > 0.0) filter.open(drift_variance.asDiagonal());
+    if (catch_up.update(index, detector.settled() && recovery.recovered())) {
+      step.catching_up = true;
+      ++run.catch_up_steps;
     }
     for (int j : cut_rule.update(step.theta, step.log_std)) {
       const double before = cut_rule.stiffness_before(j);
@@ -198,7 +161,7 @@ EstimationRun run_estimation(Ensemble& ensemble, const EstimationOptions& option
       step.stiffness_std[cut.parameter] = 0.5 * cut.upper_bound;
     }
     // While the state catches up, its innovations are not evidence about the constants.
-    filter.hold_constants(catch_up_start >= 0);
+    filter.hold_constants(catch_up.running());
     step.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
     run.steps.push_back(step);
     if (!options.keep_all_steps && run.steps.size() > look_back) {
