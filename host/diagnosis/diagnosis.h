@@ -196,6 +196,14 @@ ModelFit fit_model(const Scenario& scenario, const ObservationTable& data,
                    const DiagnoseOptions& options, const Eigen::VectorXd& start = {},
                    const Eigen::VectorXd& start_std = {});
 
+// Where the refined pass of `first` (a candidate's first pass) starts: its final estimate with
+// ten times its std (at least 0.05 per coordinate), except that a ligament it found cut starts
+// at its stiffness before the cut, as the refit runs from the first step, before the cut.
+struct RefitStart {
+  Eigen::VectorXd theta, std;
+};
+RefitStart refit_start(const ModelFit& first);
+
 // The steps (filter step indices) where any of `fits` that completed was catching up after a
 // detected change, and a fit's log-likelihood summed over the other steps: how diagnose
 // compares fits on the same steps.

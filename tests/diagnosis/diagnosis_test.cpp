@@ -138,6 +138,23 @@ TEST(DiagnoseLikelihood, FitsAreComparedOnTheStepsNoneIsCatchingUp) {
   EXPECT_EQ(log_likelihood_outside(a, {}), 63) << "nothing left out";
 }
 
+TEST(DiagnoseRefit, StartsFromTheFirstPassWithACutLigamentAtItsStiffnessBeforeTheCut) {
+  // Three log-stiffnesses and one effect coordinate; the middle ligament found cut (held at a
+  // millionth of its 307 N/m, no std left).
+  ModelFit first;
+  first.theta = Eigen::Vector4d(std::log(150.0), std::log(307e-6), std::log(200.0), 0.4);
+  first.theta_std = Eigen::Vector4d(0.01, 0.0, 0.02, 0.001);
+  first.run.cuts.push_back({1, 1051, 10.51, 307.0, 29.0});
+  const RefitStart start = refit_start(first);
+  EXPECT_DOUBLE_EQ(start.theta[0], first.theta[0]);
+  EXPECT_DOUBLE_EQ(start.theta[1], std::log(307.0)) << "the refit runs through the steps before the cut";
+  EXPECT_DOUBLE_EQ(start.theta[3], 0.4);
+  EXPECT_DOUBLE_EQ(start.std[0], 0.1);
+  EXPECT_DOUBLE_EQ(start.std[1], 0.05);
+  EXPECT_DOUBLE_EQ(start.std[2], 0.2);
+  EXPECT_DOUBLE_EQ(start.std[3], 0.05);
+}
+
 TEST(DiagnoseMisfit, SharesOfTheDeclaredModelsExcessNisAlongThePath) {
   // Mean NIS 136, 66, 61 against 36 rows: excess 100, 30, 25. The first effect removed 70% of
   // the declared model's excess, the second 5%, and 25% remains.
