@@ -3,7 +3,7 @@
 #   ./setup.sh run    install what is missing, build, run the main job on the default scenario
 #   ./setup.sh test   install what is missing, build, run the whole test suite: a Release build
 #                     with warnings as errors and every test, then the readers' fuzzers
-#                     (SIGMAFEM_FUZZ_SECONDS each, default 15): what CI runs (.ci/run)
+#                     (SIGMAFEM_FUZZ_SECONDS each, default 10): what CI runs (.ci/run)
 #   ./setup.sh sanitize  install what is missing, build with AddressSanitizer and
 #                     UndefinedBehaviorSanitizer (clang: a second compiler's warnings too), run
 #                     the tests that fit under them. Not in the test command since stop 33:
@@ -70,7 +70,7 @@ fi
 
 step "tests (Release)"
 ctest --test-dir build --output-on-failure -j "$jobs"
-fuzz_seconds=${SIGMAFEM_FUZZ_SECONDS:-15}
+fuzz_seconds=${SIGMAFEM_FUZZ_SECONDS:-10}
 step "building the input readers' fuzzers (clang, libFuzzer, ASan and UBSan)"
 cmake -S tests/fuzz -B build-fuzz -G Ninja -DCMAKE_CXX_COMPILER=clang++ \
   -DSIGMAFEM_FUZZ_SECONDS="$fuzz_seconds" >/dev/null
