@@ -31,7 +31,7 @@
 // What lambda does not change: the innovations, S and the NIS that the residual diagnostics
 // and the likelihood read stay nominal (sigma^2), so a model that needed lambda > 1 is still
 // called inconsistent; only the gain is tempered.
-// With the change detector it is one mechanism (filter/estimation.cpp): a jump of the NIS
+// With the change detector it is one mechanism (filter/noise_scale_history.h): a jump of the NIS
 // while the model explained the data (lambda = 1 on the step before) is a change of the
 // parameters: the detector opens P and lambda is held at 1 through its hold-off, so that the
 // filter follows (measured on the liver under full gravity: a cut makes the organ swing, a

@@ -55,11 +55,11 @@ struct ParameterChangeTestOptions {
   // the prior std five times by step 123, and the declared model's filter diverged at step 137.
   double learned_fraction = 0.5;
   // Acted on only when the adaptive observation noise has not engaged in this many steps
-  // before the NIS detector's window (filter/estimation.cpp): a model error engages it now
+  // before the NIS detector's window (filter/noise_scale_history.h): a model error engages it now
   // and then, and between times shows as jumps (the same lag: firings at steps 153-947 with
   // the noise scaled on 840 steps, the ligaments ending at 0.003 N/m and 1.4e7 N/m).
   int quiet_steps = 100;
-  // The response (filter/estimation.cpp): P opened by nu_hat nu_hat^T at the firing, and the
+  // The response (filter/parameter_drift.h): P opened by nu_hat nu_hat^T at the firing, and the
   // parameters it concerns drift by this much per step (log units), decaying with this
   // time constant (steps) back to the scenario's drift.
   double drift_log_std = 0.035;
