@@ -52,7 +52,6 @@ EstimationRun run_estimation(Ensemble& ensemble, const EstimationOptions& option
   ParameterDrift drift(options.change_test, parameters);
   CatchUp catch_up(options.detector.hold_off, options.detector.max_catch_up);
   EstimationRun run;
-  int dropped = 0;   // steps made and no longer kept (keep_all_steps false)
   const auto W = static_cast<std::size_t>(options.detector.window);
   // The steps kept at least: the longest window that can find a change (the detector's or
   // the change test's), as a change is measured from before its window and its catch-up
@@ -106,7 +105,7 @@ EstimationRun run_estimation(Ensemble& ensemble, const EstimationOptions& option
     noise_history.record(result.noise_scale > 1.0);
     const bool armed = noise_history.quiet_before_window(W);
     const bool change_test_armed = noise_history.quiet_before_window(quiet);
-    const int index = dropped + static_cast<int>(run.steps.size());   // of this step, from 0
+    const int index = static_cast<int>(k) - 1;   // of this step among the steps made, from 0
     const auto begin_catch_up = [&](std::size_t window) {
       if (!catch_up.begin(index)) return false;
       mark_catching_up(run, window);
@@ -164,10 +163,7 @@ EstimationRun run_estimation(Ensemble& ensemble, const EstimationOptions& option
     filter.hold_constants(catch_up.running());
     step.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
     run.steps.push_back(step);
-    if (!options.keep_all_steps && run.steps.size() > look_back) {
-      run.steps.erase(run.steps.begin());
-      ++dropped;
-    }
+    if (!options.keep_all_steps && run.steps.size() > look_back) run.steps.erase(run.steps.begin());
     if (on_step) on_step(step);
     for (Eigen::Index j = 0; j < stiffnesses; ++j) {
       const double k_j = step.stiffness[j];
