@@ -20,7 +20,7 @@
  * Per-sigma scalars (arrays of S): bb = b.b, rr = r.r, rz = r.z, active (1 while iterating),
  * converged (1 converged, 0 hit the cap or broke down), iterations (products done). */
 #include "element_chunk.h"
-#include "node_assembly.h"
+#include "node_rows.h"
 
 /* Sigma points per work-item of the blocked kernels, a divisor of S. */
 #ifndef SF_CG_BLOCK
@@ -480,8 +480,9 @@ static inline __attribute__((always_inline)) void sf_block_node_product(
   for (uint n = 0; n < node_count; ++n) {
     real nodal[SF_BLOCK_MAX];    /* (1 + h b) m + h (h + a) k: the nodal terms of A */
     for (uint i = 0; i < count; ++i) {
-      real spring = sf_node_spring(ligament_offsets, ligament_of_node, ligament_k, control_k, n,
-                                   first + i, S);
+      real spring;
+      SF_NODE_SPRING(ligament_offsets, ligament_of_node, ligament_k, control_k, n, first + i, S,
+                     spring)
       nodal[i] = mass_factor[i] * sf_solver_mass(mass[n], spring) + spring_factor[i] * spring;
     }
     SF_UNROLL

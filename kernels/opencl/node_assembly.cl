@@ -4,7 +4,8 @@
  *   node_product: q = A d, in every CG iteration (work-items as in element_product.cl: on a
  *                 CPU a node for all sigma points, vectorised over them, summing the element
  *                 chunks' copies instead of gathering element outputs). */
-#include "node_assembly.h"
+#include "ensemble_layout.h"
+#include "node_rows.h"
 
 __kernel void node_rhs(uint S, uint node_count, __global const real* c,
                        __global const int* incidence_offsets, __global const int* incidence,
@@ -18,36 +19,24 @@ __kernel void node_rhs(uint S, uint node_count, __global const real* c,
   if (gid >= (size_t)node_count * S) return;
   uint s = (uint)(gid % S);
   uint n = (uint)(gid / S);
-  real spring = sf_node_spring(ligament_offsets, ligament_of_node, ligament_k, control_k, n, s, S);
+  real spring;
+  SF_NODE_SPRING(ligament_offsets, ligament_of_node, ligament_k, control_k, n, s, S, spring)
   real m = sf_solver_mass(mass[n], spring);
-  /* This sigma point's loads (step_constants.h): at[k * S] is load k. */
-  __global const real* at = c + SF_STEP_CONSTANTS + s;
-  /* The ligament law's explicit part, k u |u|^2/d0^2 (its linear part k u is in spring): 0
-   * for the linear law. */
-  real u2 = (real)0;
-  for (int k = 0; k < 3; ++k) {
-    real u = x[((size_t)3 * n + k) * S + s] - rest_positions[3 * n + k];
-    u2 += u * u;
-  }
-  real law = (spring - control_k[n]) * u2 * at[SF_INVERSE_D0_SQUARED * S];
-  real young = at[SF_YOUNG_SCALE * S];
+  struct SfNodeConstants at;
+  SF_LOAD_NODE_CONSTANTS(c, s, S, at)
+  real f_elements[3];
+  real diagonal[3];
+  SF_CORNER_SUMS(element_rhs_out, incidence_offsets, incidence, n, s, S, f_elements)
+  SF_CORNER_SUMS(element_diagonal, incidence_offsets, incidence, n, s, S, diagonal)
+  real u[3];
+  for (int k = 0; k < 3; ++k) u[k] = x[((size_t)3 * n + k) * S + s] - rest_positions[3 * n + k];
+  real law = sf_ligament_law(spring, control_k[n], u, at.inverse_d0_squared);
   SF_UNROLL
   for (int k = 0; k < 3; ++k) {
     size_t row = ((size_t)3 * n + k) * S + s;
-    real xr = x[row];
-    real vr = v[row];
-    /* elastic force and (h + a) K v from the elements; springs pull towards rest (control
-     * springs towards rest + so_shift); the springs' own (h + a) k v term. */
-    real f = young * sf_corner_sum(element_rhs_out, incidence_offsets, incidence, n, k, s, S);
-    real u = xr - rest_positions[3 * n + k];
-    f -= spring * u - control_k[n] * at[(SF_SO_SHIFT + k) * S];
-    f -= law * u;
-    f += mass[n] * at[(SF_GRAVITY + k) * S];
-    f -= at[SF_VELOCITY_FACTOR * S] * spring * vr;
-    rhs[row] = c[SF_H] * (f - at[SF_RAYLEIGH_MASS * S] * m * vr);
-    real diagonal = young * sf_corner_sum(element_diagonal, incidence_offsets, incidence, n, k, s, S);
-    inverse_diagonal[row] =
-        (real)1 / (at[SF_MASS_FACTOR * S] * m + at[SF_STIFFNESS_FACTOR * S] * (diagonal + spring));
+    rhs[row] = sf_node_rhs_row(at, k, f_elements[k], u[k], v[row], spring, control_k[n], law,
+                               mass[n], m);
+    inverse_diagonal[row] = sf_node_inverse_diagonal(at, diagonal[k], spring, m);
   }
 }
 
@@ -89,12 +78,7 @@ __kernel void node_product(uint S, uint node_count, __global const real* restric
       for (uint b = 0; b < SF_SIGMA_BLOCK; ++b) sum[b] += out[b];
     }
 #endif
-    for (uint b = 0; b < SF_SIGMA_BLOCK; ++b) {
-      uint s = first + b;
-      real db = d[row + b];
-      q[row + b] = SF_SIGMA_CONSTANT(c, SF_STIFFNESS_FACTOR, s, S) *
-                       (SF_SIGMA_CONSTANT(c, SF_YOUNG_SCALE, s, S) * sum[b] + spring[b] * db) +
-                   SF_SIGMA_CONSTANT(c, SF_MASS_FACTOR, s, S) * m[b] * db;
-    }
+    for (uint b = 0; b < SF_SIGMA_BLOCK; ++b)
+      q[row + b] = SF_SYSTEM_ROW(c, first + b, S, sum[b], spring[b], m[b], d[row + b]);
   }
 }

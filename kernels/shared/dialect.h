@@ -14,6 +14,9 @@
 #  define SF_OUT(n, N) SF_REAL n[N]
 #  define SF_LIT(x) static_cast<SF_REAL>(x)
 #  define SF_UNROLL
+#  define SF_STRUCT(name) name
+#  define SF_INDEX_TYPE std::size_t
+#  define SF_INDEX(x) static_cast<std::size_t>(x)
 typedef unsigned int uint;
 #elif defined(__OPENCL_VERSION__) /* OpenCL C on PoCL or a GPU driver */
 #  ifndef SF_REAL
@@ -28,6 +31,9 @@ typedef unsigned int uint;
  * what lets PoCL vectorise across work-items (ARCHITECTURE.md: 3e7 -> 1.5e8 element-
  * iterations per second on the 2-core machine). */
 #  define SF_UNROLL _Pragma("unroll")
+#  define SF_STRUCT(name) struct name
+#  define SF_INDEX_TYPE size_t
+#  define SF_INDEX(x) ((size_t)(x))
 #elif defined(VULKAN) /* GLSL through glslang for Vulkan */
 #  ifndef SF_REAL
 #    define SF_REAL float
@@ -38,6 +44,9 @@ typedef unsigned int uint;
 #  define SF_OUT(n, N) out SF_REAL n[N]
 #  define SF_LIT(x) SF_REAL(x)
 #  define SF_UNROLL
+#  define SF_STRUCT(name) name
+#  define SF_INDEX_TYPE uint
+#  define SF_INDEX(x) uint(x)
 #else
 #  error "dialect.h: expected C++, OpenCL C or Vulkan GLSL"
 #endif

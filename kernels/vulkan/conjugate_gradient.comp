@@ -101,13 +101,14 @@ void sf_start_rows(uint s, uint S, uint begin, uint end, out real sum_bb, out re
   sum_rr = real(0);
   sum_rz = real(0);
   for (uint n = begin + gl_LocalInvocationID.x; n < end; n += gl_WorkGroupSize.x) {
-    real spring = sf_node_spring(n, s, S);
+    real spring;
+    SF_SPRING_OF(n, s, S, spring)
     real m = sf_solver_mass(mass[n], spring);
     real Kd[3];
-    SF_CORNER_SUMS(element_out, n, s, S, Kd)
+    SF_CORNER_SUMS(element_out, incidence_offsets, incidence, n, s, S, Kd)
     for (uint k = 0u; k < 3u; ++k) {
       uint row = (3u * n + k) * S + s;
-      real q = sf_system_row(Kd[k], spring, m, x[row], s, S);
+      real q = SF_SYSTEM_ROW(c, s, S, Kd[k], spring, m, x[row]);
       real bi = b[row];
       real ri = bi - q;
       real zi = inverse_diagonal[row] * ri;

@@ -26,38 +26,23 @@ void main() {
   if (gid >= sf_push.count * S) return;
   uint s = gid % S;
   uint n = gid / S;
-  real spring = sf_node_spring(n, s, S);
+  real spring;
+  SF_SPRING_OF(n, s, S, spring)
   real m = sf_solver_mass(mass[n], spring);
+  SfNodeConstants at;
+  SF_LOAD_NODE_CONSTANTS(c, s, S, at)
   real f_elements[3];
   real diagonal[3];
-  SF_CORNER_SUMS(element_rhs_out, n, s, S, f_elements)
-  SF_CORNER_SUMS(element_diagonal, n, s, S, diagonal)
-  /* This sigma point's loads (step_constants.h): c[at + k S] is load k. */
-  uint at = SF_STEP_CONSTANTS + s;
-  /* The ligament law's explicit part, k u |u|^2/d0^2 (its linear part k u is in spring): 0
-   * for the linear law. */
-  real u2 = real(0);
-  for (uint k = 0u; k < 3u; ++k) {
-    real u = x[(3u * n + k) * S + s] - rest_positions[3u * n + k];
-    u2 += u * u;
-  }
-  real law = (spring - control_k[n]) * u2 * c[at + SF_INVERSE_D0_SQUARED * S];
-  real young = c[at + SF_YOUNG_SCALE * S];
+  SF_CORNER_SUMS(element_rhs_out, incidence_offsets, incidence, n, s, S, f_elements)
+  SF_CORNER_SUMS(element_diagonal, incidence_offsets, incidence, n, s, S, diagonal)
+  real u[3];
+  for (uint k = 0u; k < 3u; ++k) u[k] = x[(3u * n + k) * S + s] - rest_positions[3u * n + k];
+  real law = sf_ligament_law(spring, control_k[n], u, at.inverse_d0_squared);
   for (uint k = 0u; k < 3u; ++k) {
     uint row = (3u * n + k) * S + s;
-    real xr = x[row];
-    real vr = v[row];
-    /* elastic force and (h + a) K v from the elements; springs pull towards rest (control
-     * springs towards rest + so_shift); the springs' own (h + a) k v term. */
-    real f = young * f_elements[k];
-    real u = xr - rest_positions[3u * n + k];
-    f -= spring * u - control_k[n] * c[at + (SF_SO_SHIFT + k) * S];
-    f -= law * u;
-    f += mass[n] * c[at + (SF_GRAVITY + k) * S];
-    f -= c[at + SF_VELOCITY_FACTOR * S] * spring * vr;
-    rhs[row] = c[SF_H] * (f - c[at + SF_RAYLEIGH_MASS * S] * m * vr);
-    inverse_diagonal[row] = real(1) / (c[at + SF_MASS_FACTOR * S] * m +
-                                       c[at + SF_STIFFNESS_FACTOR * S] * (young * diagonal[k] + spring));
+    rhs[row] = sf_node_rhs_row(at, int(k), f_elements[k], u[k], v[row], spring, control_k[n], law,
+                               mass[n], m);
+    inverse_diagonal[row] = sf_node_inverse_diagonal(at, diagonal[k], spring, m);
   }
 }
 
@@ -72,13 +57,14 @@ void main() {
   if (gid >= sf_push.count * S) return;
   uint s = gid % S;
   uint n = gid / S;
-  real spring = sf_node_spring(n, s, S);
+  real spring;
+  SF_SPRING_OF(n, s, S, spring)
   real m = sf_solver_mass(mass[n], spring);
   real sum[3];
-  SF_CORNER_SUMS(element_out, n, s, S, sum)
+  SF_CORNER_SUMS(element_out, incidence_offsets, incidence, n, s, S, sum)
   for (uint k = 0u; k < 3u; ++k) {
     uint row = (3u * n + k) * S + s;
-    q[row] = sf_system_row(sum[k], spring, m, d[row], s, S);
+    q[row] = SF_SYSTEM_ROW(c, s, S, sum[k], spring, m, d[row]);
   }
 }
 
