@@ -19,11 +19,12 @@
 #include "host/model/effects.h"
 #include "host/model/model.h"
 #include "host/model/so_history.h"
+#include "step_constants.h"
 
 namespace sigmafem {
 
-// Estimated parameters a device ensemble takes at most (SF_MAX_PARAMETERS in recenter).
-constexpr int kDeviceMaxParameters = 16;
+// Estimated parameters a device ensemble takes at most (kernels/shared/step_constants.h).
+constexpr int kDeviceMaxParameters = SF_MAX_PARAMETERS;
 
 struct EnsembleTables {
   // Elements: element_nodes[4 e + c]; element_rest[16 e + i]: grad[12], vlambda, vmu, 0, 0.

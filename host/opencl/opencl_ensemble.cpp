@@ -13,7 +13,7 @@ namespace sigmafem {
 namespace {
 
 constexpr std::size_t kGroup = 64;        // work-group size of the element and node kernels
-constexpr int kMaxParameters = kDeviceMaxParameters;   // SF_MAX_PARAMETERS in recenter.cl
+constexpr int kMaxParameters = kDeviceMaxParameters;
 
 std::size_t round_up(std::size_t n, std::size_t multiple) {
   return (n + multiple - 1) / multiple * multiple;

@@ -1,17 +1,7 @@
 /* recenter: the ROUKF's re-sampling of every sigma point's state around the corrected
- * estimate, done where the states are (host: CpuEnsemble::recenter; filter/ensemble.h,
- * struct Recentering). Per dof row, with X_s the sigma states and I_s the directions:
- *   mean = alpha sum_s X_s,  L_j = alpha sum_s X_s I_js,  X_hat = mean + L correction,
- *   X_s <- X_hat + sum_j L_j W_js  (W = C I, formed on the host),
- * and the same for the velocities V (the state of a dynamic simulation is both).
- * The sums are taken relative to sigma point 0: the directions sum to zero and the weights
- * to one, so this is the same in exact arithmetic, and in float32 it keeps the rounding at
- * the size of the spread between sigma points rather than of the organ's position. */
+ * estimate, one dof row per work-item, done where the states are (kernels/shared/recenter.h). */
 #include "ensemble_layout.h"
-
-#ifndef SF_MAX_PARAMETERS
-#  define SF_MAX_PARAMETERS 16
-#endif
+#include "recenter.h"
 
 /* scalars: [0] alpha, [1 .. p] the correction. directions, weights: p x S, [j * S + s]. */
 __kernel void recenter(uint S, uint rows, uint p, __global const real* scalars,
@@ -21,43 +11,33 @@ __kernel void recenter(uint S, uint rows, uint p, __global const real* scalars,
   if (row >= rows) return;
   __global real* xr = x + row * S;
   __global real* vr = v + row * S;
-  real alpha = scalars[0];
-  real x0 = xr[0];
-  real v0 = vr[0];
-  real mean = (real)0;
-  real velocity = (real)0;
+  real correction[SF_MAX_PARAMETERS];
+  real column[SF_MAX_PARAMETERS];   /* sigma point s's directions, then its weights */
   real L[SF_MAX_PARAMETERS];
   real Lv[SF_MAX_PARAMETERS];
   for (uint j = 0; j < p; ++j) {
+    correction[j] = scalars[1 + j];
     L[j] = (real)0;
     Lv[j] = (real)0;
   }
+  real x0 = xr[0];
+  real v0 = vr[0];
+  real sum = (real)0;
+  real sum_v = (real)0;
   for (uint s = 0; s < S; ++s) {
+    for (uint j = 0; j < p; ++j) column[j] = directions[j * S + s];
     real dx = xr[s] - x0;
-    mean += dx;
     real dv = vr[s] - v0;
-    velocity += dv;
-    for (uint j = 0; j < p; ++j) {
-      L[j] += dx * directions[j * S + s];
-      Lv[j] += dv * directions[j * S + s];
-    }
+    sum += dx;
+    sum_v += dv;
+    sf_recenter_add(dx, column, p, L);
+    sf_recenter_add(dv, column, p, Lv);
   }
-  real x_hat = x0 + alpha * mean;
-  real v_hat = v0 + alpha * velocity;
-  for (uint j = 0; j < p; ++j) {
-    L[j] *= alpha;
-    Lv[j] *= alpha;
-    x_hat += L[j] * scalars[1 + j];
-    v_hat += Lv[j] * scalars[1 + j];
-  }
+  real x_hat = sf_recentred_mean(x0, scalars[0], sum, correction, p, L);
+  real v_hat = sf_recentred_mean(v0, scalars[0], sum_v, correction, p, Lv);
   for (uint s = 0; s < S; ++s) {
-    real xs = x_hat;
-    real vs = v_hat;
-    for (uint j = 0; j < p; ++j) {
-      xs += L[j] * weights[j * S + s];
-      vs += Lv[j] * weights[j * S + s];
-    }
-    xr[s] = xs;
-    vr[s] = vs;
+    for (uint j = 0; j < p; ++j) column[j] = weights[j * S + s];
+    xr[s] = sf_resampled(x_hat, L, column, p);
+    vr[s] = sf_resampled(v_hat, Lv, column, p);
   }
 }

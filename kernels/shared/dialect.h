@@ -12,6 +12,7 @@
 #  define SF_SQRT(x) std::sqrt(x)
 #  define SF_IN(n, N) const SF_REAL n[N]
 #  define SF_OUT(n, N) SF_REAL n[N]
+#  define SF_INOUT(n, N) SF_REAL n[N]
 #  define SF_LIT(x) static_cast<SF_REAL>(x)
 #  define SF_UNROLL
 #  define SF_STRUCT(name) name
@@ -26,6 +27,7 @@ typedef unsigned int uint;
 #  define SF_SQRT(x) sqrt(x)
 #  define SF_IN(n, N) const SF_REAL n[N]
 #  define SF_OUT(n, N) SF_REAL n[N]
+#  define SF_INOUT(n, N) SF_REAL n[N]
 #  define SF_LIT(x) ((SF_REAL)(x))
 /* Fully unrolled fixed-size loops turn the small private arrays into registers, which is
  * what lets PoCL vectorise across work-items (ARCHITECTURE.md: 3e7 -> 1.5e8 element-
@@ -42,6 +44,7 @@ typedef unsigned int uint;
 #  define SF_SQRT(x) sqrt(x)
 #  define SF_IN(n, N) in SF_REAL n[N]
 #  define SF_OUT(n, N) out SF_REAL n[N]
+#  define SF_INOUT(n, N) inout SF_REAL n[N]
 #  define SF_LIT(x) SF_REAL(x)
 #  define SF_UNROLL
 #  define SF_STRUCT(name) name

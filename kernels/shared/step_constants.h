@@ -25,6 +25,10 @@
 #define SF_LAMBDA_SCALE 12       /* multiplies the elements' Lame lambda (lambda_scale; mu kept) */
 #define SF_SIGMA_CONSTANT_COUNT 13
 
+/* The most parameters a device ensemble estimates (the re-centring's arrays, recenter.h;
+ * the host's kDeviceMaxParameters). */
+#define SF_MAX_PARAMETERS 16
+
 /* Constant k of sigma point s, with S sigma points, in the buffer c. */
 #define SF_SIGMA_CONSTANT(c, k, s, S) ((c)[SF_STEP_CONSTANTS + (k) * (S) + (s)])
 

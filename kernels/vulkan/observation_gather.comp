@@ -1,9 +1,10 @@
 /* observation_gather: the observed points' positions of every sigma point, y[(3 k + axis) S + s]
- * (as kernels/opencl/observation_gather.cl): point k is sum_c w_c x(node_c) over its four
- * corners. The only per-step read-back of the state. */
+ * (kernels/shared/observation_gather.h; as kernels/opencl/observation_gather.cl). The only
+ * per-step read-back of the state. */
 #version 450
 #extension GL_GOOGLE_include_directive : require
 #include "ensemble_layout.h"
+#include "observation_gather.h"
 
 layout(local_size_x = SF_ITEMS_PER_GROUP) in;
 layout(std430, binding = 0) restrict readonly buffer Nodes { int nodes[]; };
@@ -19,8 +20,11 @@ void main() {
   uint row = gid / S;
   uint k = row / 3u;
   uint axis = row % 3u;
-  real value = real(0);
-  for (uint c = 0u; c < 4u; ++c)
-    value += weights[4u * k + c] * x[(3u * uint(nodes[4u * k + c]) + axis) * S + s];
-  y[gid] = value;
+  real weight[4];
+  real corner[4];
+  for (uint c = 0u; c < 4u; ++c) {
+    weight[c] = weights[4u * k + c];
+    corner[c] = x[(3u * uint(nodes[4u * k + c]) + axis) * S + s];
+  }
+  y[gid] = sf_observed_coordinate(weight, corner);
 }
