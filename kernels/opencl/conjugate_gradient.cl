@@ -19,6 +19,7 @@
  *
  * Per-sigma scalars (arrays of S): bb = b.b, rr = r.r, rz = r.z, active (1 while iterating),
  * converged (1 converged, 0 hit the cap or broke down), iterations (products done). */
+#include "cg_rows.h"
 #include "element_chunk.h"
 #include "node_rows.h"
 
@@ -31,15 +32,13 @@
 #endif
 
 /* Sigma point s's scalars after the warm start, from its sums b.b, r.r and r.z; returns
- * whether it iterates. An overflowed load (|b|^2 not finite) would pass the stop test as
- * inf <= inf: a breakdown instead, neither converged nor iterating, as in the CPU reference.
- * b = 0 counts as converged: the state update then uses dv = 0, the exact solution. */
+ * whether it iterates (cg_rows.h). */
 static inline int sf_cg_start_scalars(uint s, real sum_bb, real sum_rr, real sum_rz,
                                       __global const real* c, __global real* bb,
                                       __global real* rr, __global real* rz, __global uint* active,
                                       __global uint* converged, __global int* iterations) {
-  int breakdown = !isfinite(sum_bb) || !isfinite(sum_rr);
-  int done = !breakdown && (sum_bb == (real)0 || sum_rr <= c[SF_CG_TOLERANCE2] * sum_bb);
+  bool breakdown = sf_cg_start_breakdown(sum_bb, sum_rr);
+  bool done = sf_cg_start_converged(breakdown, sum_bb, sum_rr, c[SF_CG_TOLERANCE2]);
   bb[s] = sum_bb;
   rr[s] = sum_rr;
   rz[s] = sum_rz;
@@ -79,15 +78,7 @@ static inline void sf_start_rows(uint S, uint s, uint begin, uint end, __global 
   real sum_rz = (real)0;
   for (uint row = begin + get_local_id(0); row < end; row += SF_GROUP_SIZE) {
     size_t at = (size_t)row * S + s;
-    real bi = b[at];
-    real ri = bi - q[at];
-    real zi = inverse_diagonal[at] * ri;
-    r[at] = ri;
-    z[at] = zi;
-    d[at] = zi;
-    sum_bb += bi * bi;
-    sum_rr += ri * ri;
-    sum_rz += ri * zi;
+    SF_CG_START_ROW(at, q[at], b, inverse_diagonal, r, z, d, sum_bb, sum_rr, sum_rz)
   }
   sums[0] = sf_group_sum(scratch, sum_bb);
   sums[1] = sf_group_sum(scratch, sum_rr);
@@ -145,20 +136,14 @@ void cg_iteration(uint S, uint node_count, int max_iterations, __global const re
     SF_UNROLL
     for (int k = 0; k < 3; ++k) {
       size_t row = ((size_t)3 * n + k) * S + s;
-      x[row] += alpha * d[row];
-      real ri = r[row] - alpha * q[row];
-      real zi = inverse_diagonal[row] * ri;
-      r[row] = ri;
-      z[row] = zi;
-      sum_rr += ri * ri;
-      sum_rz += ri * zi;
+      SF_CG_UPDATE_ROW(row, alpha, x, r, z, d, q, inverse_diagonal, sum_rr, sum_rz)
     }
   }
   sum_rr = sf_group_sum(scratch, sum_rr);
   sum_rz = sf_group_sum(scratch, sum_rz);
 
-  int done = sum_rr <= c[SF_CG_TOLERANCE2] * bb[s];
-  int stop = done || !isfinite(sum_rr) || count >= max_iterations;
+  bool done = sf_cg_converged(sum_rr, c[SF_CG_TOLERANCE2], bb[s]);
+  bool stop = sf_cg_stops(done, sum_rr, count, max_iterations);
   barrier(CLK_GLOBAL_MEM_FENCE); /* everyone has read the old scalars before they change */
   if (first == 0) {
     iterations[s] = count;
@@ -290,13 +275,7 @@ void cg_update(uint S, uint node_count, __global const real* inverse_diagonal, _
   real sum_rz = (real)0;
   for (uint row = begin + get_local_id(0); row < end; row += SF_GROUP_SIZE) {
     size_t at = (size_t)row * S + s;
-    x[at] += alpha * d[at];
-    real ri = r[at] - alpha * q[at];
-    real zi = inverse_diagonal[at] * ri;
-    r[at] = ri;
-    z[at] = zi;
-    sum_rr += ri * ri;
-    sum_rz += ri * zi;
+    SF_CG_UPDATE_ROW(at, alpha, x, r, z, d, q, inverse_diagonal, sum_rr, sum_rz)
   }
   sum_rr = sf_group_sum(scratch, sum_rr);
   sum_rz = sf_group_sum(scratch, sum_rz);
@@ -322,8 +301,8 @@ void cg_direction(uint S, uint node_count, int max_iterations, __global const re
   real rz_old = own_rz[g];
   real sum_rr = sf_partials_sum(partial, SF_PARTIAL_RR, S, s);
   real sum_rz = sf_partials_sum(partial, SF_PARTIAL_RZ, S, s);
-  int done = sum_rr <= c[SF_CG_TOLERANCE2] * bb[s];
-  int stop = done || !isfinite(sum_rr) || count >= max_iterations;
+  bool done = sf_cg_converged(sum_rr, c[SF_CG_TOLERANCE2], bb[s]);
+  bool stop = sf_cg_stops(done, sum_rr, count, max_iterations);
   barrier(CLK_GLOBAL_MEM_FENCE); /* everyone has read the old copies before they change */
   if (get_local_id(0) == 0) {
     own_iterations[g] = count;
@@ -369,15 +348,7 @@ static inline __attribute__((always_inline)) int sf_block_cg_start(
   for (uint row = 0; row < rows; ++row) {
     for (uint i = 0; i < count; ++i) {
       size_t at = (size_t)row * S + first + i;
-      real bi = b[at];
-      real ri = bi - q[at];
-      real zi = inverse_diagonal[at] * ri;
-      r[at] = ri;
-      z[at] = zi;
-      d[at] = zi;
-      sum_bb[i] += bi * bi;
-      sum_rr[i] += ri * ri;
-      sum_rz[i] += ri * zi;
+      SF_CG_START_ROW(at, q[at], b, inverse_diagonal, r, z, d, sum_bb[i], sum_rr[i], sum_rz[i])
     }
   }
   int any = 0;
@@ -422,13 +393,7 @@ static inline __attribute__((always_inline)) int sf_block_cg_iteration(
   for (uint row = 0; row < rows; ++row) {
     for (uint i = 0; i < count; ++i) {
       size_t at = (size_t)row * S + first + i;
-      x[at] += alpha[i] * d[at];
-      real ri = r[at] - alpha[i] * q[at];
-      real zi = inverse_diagonal[at] * ri;
-      r[at] = ri;
-      z[at] = zi;
-      rr_new[i] += ri * ri;
-      rz_new[i] += ri * zi;
+      SF_CG_UPDATE_ROW(at, alpha[i], x, r, z, d, q, inverse_diagonal, rr_new[i], rz_new[i])
     }
   }
   real beta[SF_BLOCK_MAX];
@@ -438,8 +403,8 @@ static inline __attribute__((always_inline)) int sf_block_cg_iteration(
     beta[i] = (real)1;
     if (!going[i]) continue;
     int products = iterations[s] + 1;
-    int done = rr_new[i] <= c[SF_CG_TOLERANCE2] * bb[s];
-    going[i] = !(done || !isfinite(rr_new[i]) || products >= max_iterations);
+    bool done = sf_cg_converged(rr_new[i], c[SF_CG_TOLERANCE2], bb[s]);
+    going[i] = !sf_cg_stops(done, rr_new[i], products, max_iterations);
     beta[i] = rz_new[i] / rz[s];
     iterations[s] = products;
     rr[s] = rr_new[i];

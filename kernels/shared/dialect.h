@@ -10,6 +10,7 @@
 #  endif
 #  define SF_FN inline
 #  define SF_SQRT(x) std::sqrt(x)
+#  define SF_ISFINITE(x) std::isfinite(x)
 #  define SF_IN(n, N) const SF_REAL n[N]
 #  define SF_OUT(n, N) SF_REAL n[N]
 #  define SF_INOUT(n, N) SF_REAL n[N]
@@ -25,6 +26,7 @@ typedef unsigned int uint;
 #  endif
 #  define SF_FN static inline __attribute__((always_inline))
 #  define SF_SQRT(x) sqrt(x)
+#  define SF_ISFINITE(x) isfinite(x)
 #  define SF_IN(n, N) const SF_REAL n[N]
 #  define SF_OUT(n, N) SF_REAL n[N]
 #  define SF_INOUT(n, N) SF_REAL n[N]
@@ -42,6 +44,7 @@ typedef unsigned int uint;
 #  endif
 #  define SF_FN
 #  define SF_SQRT(x) sqrt(x)
+#  define SF_ISFINITE(x) (!isinf(x) && !isnan(x))
 #  define SF_IN(n, N) in SF_REAL n[N]
 #  define SF_OUT(n, N) out SF_REAL n[N]
 #  define SF_INOUT(n, N) inout SF_REAL n[N]

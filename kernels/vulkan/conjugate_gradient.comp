@@ -33,6 +33,7 @@
 #else
 #  include "ensemble_layout.h"
 #endif
+#include "cg_rows.h"
 
 layout(local_size_x_id = 0) in;
 layout(constant_id = 1) const uint SF_PARTITIONS = 1u;
@@ -109,15 +110,7 @@ void sf_start_rows(uint s, uint S, uint begin, uint end, out real sum_bb, out re
     for (uint k = 0u; k < 3u; ++k) {
       uint row = (3u * n + k) * S + s;
       real q = SF_SYSTEM_ROW(c, s, S, Kd[k], spring, m, x[row]);
-      real bi = b[row];
-      real ri = bi - q;
-      real zi = inverse_diagonal[row] * ri;
-      r[row] = ri;
-      z[row] = zi;
-      d[row] = zi;
-      sum_bb += bi * bi;
-      sum_rr += ri * ri;
-      sum_rz += ri * zi;
+      SF_CG_START_ROW(row, q, b, inverse_diagonal, r, z, d, sum_bb, sum_rr, sum_rz)
     }
   }
   sum_bb = sf_group_sum(sum_bb);
@@ -125,13 +118,10 @@ void sf_start_rows(uint s, uint S, uint begin, uint end, out real sum_bb, out re
   sum_rz = sf_group_sum(sum_rz);
 }
 
-/* Sigma point s's scalars after the warm start; whether it iterates. An overflowed load
- * (|b|^2 not finite) would pass the stop test as inf <= inf: a breakdown instead, neither
- * converged nor iterating, as in the CPU reference. b = 0 counts as converged: the state
- * update then uses dv = 0, the exact solution. */
+/* Sigma point s's scalars after the warm start; whether it iterates (cg_rows.h). */
 bool sf_start_scalars(uint s, real sum_bb, real sum_rr, real sum_rz) {
-  bool breakdown = isinf(sum_bb) || isnan(sum_bb) || isinf(sum_rr) || isnan(sum_rr);
-  bool done = !breakdown && (sum_bb == real(0) || sum_rr <= c[SF_CG_TOLERANCE2] * sum_bb);
+  bool breakdown = sf_cg_start_breakdown(sum_bb, sum_rr);
+  bool done = sf_cg_start_converged(breakdown, sum_bb, sum_rr, c[SF_CG_TOLERANCE2]);
   bb[s] = sum_bb;
   rr[s] = sum_rr;
   rz[s] = sum_rz;
@@ -224,13 +214,7 @@ void sf_update_rows(uint s, uint S, uint begin, uint end, real alpha, out real s
   for (uint n = begin + gl_LocalInvocationID.x; n < end; n += gl_WorkGroupSize.x)
     for (uint k = 0u; k < 3u; ++k) {
       uint row = (3u * n + k) * S + s;
-      x[row] += alpha * d[row];
-      real ri = r[row] - alpha * q[row];
-      real zi = inverse_diagonal[row] * ri;
-      r[row] = ri;
-      z[row] = zi;
-      sum_rr += ri * ri;
-      sum_rz += ri * zi;
+      SF_CG_UPDATE_ROW(row, alpha, x, r, z, d, q, inverse_diagonal, sum_rr, sum_rz)
     }
   sum_rr = sf_group_sum(sum_rr);
   sum_rz = sf_group_sum(sum_rz);
@@ -245,11 +229,10 @@ void sf_direction_rows(uint s, uint S, uint begin, uint end, real beta) {
     }
 }
 
-/* The convergence test (|r|^2 <= tol^2 |b|^2), the cap and breakdown (a residual that is not
- * finite: the matrix is not SPD or the input held a NaN) after `count` products. */
-bool sf_done(uint s, real sum_rr) { return sum_rr <= c[SF_CG_TOLERANCE2] * bb[s]; }
+/* The stop test of cg_rows.h with sigma point s's |b|^2 and the push constants' cap. */
+bool sf_done(uint s, real sum_rr) { return sf_cg_converged(sum_rr, c[SF_CG_TOLERANCE2], bb[s]); }
 bool sf_stop(bool done, real sum_rr, int count) {
-  return done || isnan(sum_rr) || isinf(sum_rr) || count >= sf_push.max_iterations;
+  return sf_cg_stops(done, sum_rr, count, sf_push.max_iterations);
 }
 
 /* Sigma point s's scalars after an iteration (read by the host and the other shaders). */
