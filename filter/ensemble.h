@@ -10,6 +10,8 @@
 #pragma once
 
 #include <Eigen/Core>
+#include <stdexcept>
+#include <string>
 #include <vector>
 
 namespace sigmafem {
@@ -71,5 +73,13 @@ class Ensemble {
   virtual std::vector<int> rejected_points() const { return {}; }
   virtual void recenter(const Recentering& recentering) = 0;
 };
+
+// set_parameters' check of theta: p x S for an ensemble of p parameters and S sigma points;
+// std::invalid_argument naming `who` otherwise.
+inline void check_parameter_matrix(const Eigen::MatrixXd& theta, int p, int S, const std::string& who) {
+  if (theta.rows() != p || theta.cols() != S)
+    throw std::invalid_argument(who + "::set_parameters: expected a " + std::to_string(p) + " x " +
+                                std::to_string(S) + " matrix");
+}
 
 }  // namespace sigmafem

@@ -77,10 +77,7 @@ int CpuEnsemble::factorisations() const {
 }
 
 void CpuEnsemble::set_parameters(const Eigen::MatrixXd& theta) {
-  if (theta.rows() != parameter_count() || theta.cols() != sigma_count())
-    throw std::invalid_argument("CpuEnsemble::set_parameters: expected a " +
-                                std::to_string(parameter_count()) + " x " +
-                                std::to_string(sigma_count()) + " matrix");
+  check_parameter_matrix(theta, parameter_count(), sigma_count(), "CpuEnsemble");
   for (int s = 0; s < sigma_count(); ++s) {
     std::vector<double> stiffness = simulations_[s].ligament_stiffness();
     for (int j = 0; j < parameter_count(); ++j) stiffness[estimated_[j]] = std::exp(theta(j, s));

@@ -6,6 +6,7 @@
 #include <stdexcept>
 #include <string>
 
+#include "host/ensemble/device_readout.h"
 #include "host/ensemble/ensemble_tables.h"
 #include "step_constants.h"
 
@@ -237,47 +238,23 @@ cl::Buffer OpenClEnsemble::make_buffer(const std::vector<int>& values, const cha
 
 void OpenClEnsemble::write(const cl::Buffer& buffer, const std::vector<double>& values) const {
   if (values.empty()) return;
-  if (device_.precision() == Precision::single) {
-    const std::vector<float> converted(values.begin(), values.end());
-    device_.queue().enqueueWriteBuffer(buffer, CL_TRUE, 0, converted.size() * sizeof(float),
-                                       converted.data());
-  } else {
-    device_.queue().enqueueWriteBuffer(buffer, CL_TRUE, 0, values.size() * sizeof(double),
-                                       values.data());
-  }
-}
-
-std::vector<double> OpenClEnsemble::to_doubles(const std::vector<unsigned char>& bytes) const {
-  if (device_.precision() == Precision::single) {
-    std::vector<float> values(bytes.size() / sizeof(float));
-    std::memcpy(values.data(), bytes.data(), values.size() * sizeof(float));
-    return std::vector<double>(values.begin(), values.end());
-  }
-  std::vector<double> values(bytes.size() / sizeof(double));
-  std::memcpy(values.data(), bytes.data(), values.size() * sizeof(double));
-  return values;
+  const std::vector<unsigned char> bytes = to_device_reals(values, device_.precision());
+  device_.queue().enqueueWriteBuffer(buffer, CL_TRUE, 0, bytes.size(), bytes.data());
 }
 
 std::vector<double> OpenClEnsemble::read(const cl::Buffer& buffer, std::size_t count) const {
   std::vector<unsigned char> bytes(count * device_.real_size());
   device_.queue().enqueueReadBuffer(buffer, CL_TRUE, 0, bytes.size(), bytes.data());
-  return to_doubles(bytes);
+  return from_device_reals(bytes.data(), count, device_.precision());
 }
 
-std::vector<double> OpenClEnsemble::sigma_column(const cl::Buffer& buffer, std::size_t rows,
-                                                 int s) const {
-  if (s < 0 || s >= S_) throw std::out_of_range("OpenClEnsemble: no sigma point " + std::to_string(s));
-  const std::vector<double> all = read(buffer, rows * S_);
-  std::vector<double> column(rows);
-  for (std::size_t row = 0; row < rows; ++row) column[row] = all[row * S_ + s];
-  return column;
+std::vector<double> OpenClEnsemble::column_of(const cl::Buffer& buffer, std::size_t rows,
+                                              int s) const {
+  return sigma_column(read(buffer, rows * S_), rows, S_, s, "OpenClEnsemble");
 }
 
 void OpenClEnsemble::set_parameters(const Eigen::MatrixXd& theta) {
-  if (theta.rows() != parameter_count() || theta.cols() != sigma_count())
-    throw std::invalid_argument("OpenClEnsemble::set_parameters: expected a " +
-                                std::to_string(parameter_count()) + " x " +
-                                std::to_string(sigma_count()) + " matrix");
+  check_parameter_matrix(theta, parameter_count(), sigma_count(), "OpenClEnsemble");
   set_ligament_stiffness(model_, estimated_, theta, S_, ligament_k_);
   write(ligament_k_buffer_, ligament_k_);
 }
@@ -390,12 +367,9 @@ StepReport OpenClEnsemble::advance(const Eigen::Vector3d& so_position) {
     queue.enqueueReadBuffer(rr_, CL_FALSE, 0, rr_bytes.size(), rr_bytes.data());
     queue.enqueueReadBuffer(bb_, CL_FALSE, 0, bb_bytes.size(), bb_bytes.data());
     queue.finish();
-    const std::vector<double> rr = to_doubles(rr_bytes), bb = to_doubles(bb_bytes);
-    report.cg_iterations.assign(iterations.begin(), iterations.end());
-    report.converged.assign(converged.begin(), converged.end());
-    report.relative_residual.resize(S_);
-    for (int s = 0; s < S_; ++s)
-      report.relative_residual[s] = bb[s] > 0.0 ? std::sqrt(rr[s] / bb[s]) : 0.0;
+    const Precision precision = device_.precision();
+    report = solver_report(iterations, converged, from_device_reals(rr_bytes.data(), S_, precision),
+                           from_device_reals(bb_bytes.data(), S_, precision));
     expected_iterations_ = *std::max_element(iterations.begin(), iterations.end());
   } catch (const cl::Error& error) {
     throw opencl_failure("advancing the OpenCL ensemble", error);
@@ -405,13 +379,13 @@ StepReport OpenClEnsemble::advance(const Eigen::Vector3d& so_position) {
 
 void OpenClEnsemble::predicted_observations(Eigen::MatrixXd& y) const {
   const std::size_t rows = observed_.size() * 3;
-  y.resize(static_cast<Eigen::Index>(rows), S_);
-  if (rows == 0) return;
+  if (rows == 0) {
+    y.resize(0, S_);
+    return;
+  }
   try {
     run(k_observation_gather_, rows * S_);
-    const std::vector<double> values = read(observations_, rows * S_);
-    for (std::size_t row = 0; row < rows; ++row)
-      for (int s = 0; s < S_; ++s) y(static_cast<Eigen::Index>(row), s) = values[row * S_ + s];
+    y = from_sigma_rows(read(observations_, rows * S_), rows, S_);
   } catch (const cl::Error& error) {
     throw opencl_failure("reading the observations", error);
   }
@@ -431,44 +405,35 @@ void OpenClEnsemble::recenter(const Recentering& r) {
 }
 
 Eigen::VectorXd OpenClEnsemble::positions(int s) const {
-  const std::vector<double> column = sigma_column(x_, 3 * static_cast<std::size_t>(nodes_), s);
+  const std::vector<double> column = column_of(x_, 3 * static_cast<std::size_t>(nodes_), s);
   return Eigen::Map<const Eigen::VectorXd>(column.data(), static_cast<Eigen::Index>(column.size()));
 }
 
 Eigen::VectorXd OpenClEnsemble::velocities(int s) const {
-  const std::vector<double> column = sigma_column(v_, 3 * static_cast<std::size_t>(nodes_), s);
+  const std::vector<double> column = column_of(v_, 3 * static_cast<std::size_t>(nodes_), s);
   return Eigen::Map<const Eigen::VectorXd>(column.data(), static_cast<Eigen::Index>(column.size()));
 }
 
 std::vector<double> OpenClEnsemble::frames(int s) const {
-  return sigma_column(frames_, 9 * static_cast<std::size_t>(elements_), s);
+  return column_of(frames_, 9 * static_cast<std::size_t>(elements_), s);
 }
 
 Eigen::MatrixXd OpenClEnsemble::system_product(const Eigen::MatrixXd& d) {
   const std::size_t rows = 3 * static_cast<std::size_t>(nodes_);
   if (static_cast<std::size_t>(d.rows()) != rows || d.cols() != S_)
     throw std::invalid_argument("OpenClEnsemble::system_product: expected 3N x S");
-  std::vector<double> values(rows * S_);
-  for (std::size_t row = 0; row < rows; ++row)
-    for (int s = 0; s < S_; ++s) values[row * S_ + s] = d(static_cast<Eigen::Index>(row), s);
-  Eigen::MatrixXd y(d.rows(), d.cols());
   try {
-    write(d_, values);
+    write(d_, to_sigma_rows(d));
     element_product(d_, all_active_);
     node_product(d_, q_);
-    const std::vector<double> q = read(q_, rows * S_);
-    for (std::size_t row = 0; row < rows; ++row)
-      for (int s = 0; s < S_; ++s) y(static_cast<Eigen::Index>(row), s) = q[row * S_ + s];
+    return from_sigma_rows(read(q_, rows * S_), rows, S_);
   } catch (const cl::Error& error) {
     throw opencl_failure("the system product", error);
   }
-  return y;
 }
 
 std::string OpenClEnsemble::description() const {
-  return std::string("opencl ") +
-         (device_.precision() == Precision::single ? "single" : "double") + " on " +
-         device_.info().name;
+  return device_ensemble_description("opencl", device_.precision(), device_.info().name);
 }
 
 }  // namespace sigmafem

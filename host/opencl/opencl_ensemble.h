@@ -56,9 +56,8 @@ class OpenClEnsemble : public DeviceEnsemble {
   cl::Buffer make_buffer(const std::vector<int>& values, const char* what);
   void write(const cl::Buffer& buffer, const std::vector<double>& values) const;
   std::vector<double> read(const cl::Buffer& buffer, std::size_t count) const;
-  // Device reals (float or double, as the precision) read as raw bytes, as doubles.
-  std::vector<double> to_doubles(const std::vector<unsigned char>& bytes) const;
-  std::vector<double> sigma_column(const cl::Buffer& buffer, std::size_t rows, int s) const;
+  // Sigma point s's column of a per-row buffer (host/ensemble/device_readout.h).
+  std::vector<double> column_of(const cl::Buffer& buffer, std::size_t rows, int s) const;
   void write_step_constants(const Eigen::Vector3d& so_position);
 
   // Enqueue the kernels of one step (kernels/opencl/<file>.cl holds the kernel of the same

@@ -6,6 +6,7 @@
 #include <stdexcept>
 #include <string>
 
+#include "host/ensemble/device_readout.h"
 #include "host/ensemble/ensemble_tables.h"
 #include "step_constants.h"
 
@@ -182,53 +183,24 @@ VulkanBuffer VulkanEnsemble::make_buffer(const std::vector<int>& values, const c
   return buffer;
 }
 
-std::vector<unsigned char> VulkanEnsemble::to_device(const std::vector<double>& values) const {
-  std::vector<unsigned char> bytes(values.size() * device_.real_size());
-  if (device_.precision() == Precision::single) {
-    const std::vector<float> converted(values.begin(), values.end());
-    std::memcpy(bytes.data(), converted.data(), bytes.size());
-  } else {
-    std::memcpy(bytes.data(), values.data(), bytes.size());
-  }
-  return bytes;
-}
-
-std::vector<double> VulkanEnsemble::from_device(const void* data, std::size_t count) const {
-  if (device_.precision() == Precision::single) {
-    std::vector<float> values(count);
-    std::memcpy(values.data(), data, count * sizeof(float));
-    return std::vector<double>(values.begin(), values.end());
-  }
-  std::vector<double> values(count);
-  std::memcpy(values.data(), data, count * sizeof(double));
-  return values;
-}
-
 void VulkanEnsemble::write(const VulkanBuffer& buffer, const std::vector<double>& values) const {
-  const std::vector<unsigned char> bytes = to_device(values);
+  const std::vector<unsigned char> bytes = to_device_reals(values, device_.precision());
   device_.upload(buffer, bytes.data(), bytes.size());
 }
 
 std::vector<double> VulkanEnsemble::read(const VulkanBuffer& buffer, std::size_t count) const {
   std::vector<unsigned char> bytes(count * device_.real_size());
   device_.download(buffer, bytes.data(), bytes.size());
-  return from_device(bytes.data(), count);
+  return from_device_reals(bytes.data(), count, device_.precision());
 }
 
-std::vector<double> VulkanEnsemble::sigma_column(const VulkanBuffer& buffer, std::size_t rows,
-                                                 int s) const {
-  if (s < 0 || s >= S_) throw std::out_of_range("VulkanEnsemble: no sigma point " + std::to_string(s));
-  const std::vector<double> all = read(buffer, rows * S_);
-  std::vector<double> column(rows);
-  for (std::size_t row = 0; row < rows; ++row) column[row] = all[row * S_ + s];
-  return column;
+std::vector<double> VulkanEnsemble::column_of(const VulkanBuffer& buffer, std::size_t rows,
+                                              int s) const {
+  return sigma_column(read(buffer, rows * S_), rows, S_, s, "VulkanEnsemble");
 }
 
 void VulkanEnsemble::set_parameters(const Eigen::MatrixXd& theta) {
-  if (theta.rows() != parameter_count() || theta.cols() != sigma_count())
-    throw std::invalid_argument("VulkanEnsemble::set_parameters: expected a " +
-                                std::to_string(parameter_count()) + " x " +
-                                std::to_string(sigma_count()) + " matrix");
+  check_parameter_matrix(theta, parameter_count(), sigma_count(), "VulkanEnsemble");
   set_ligament_stiffness(model_, estimated_, theta, S_, ligament_k_);
   write(ligament_k_buffer_, ligament_k_);
 }
@@ -284,7 +256,8 @@ StepReport VulkanEnsemble::advance(const Eigen::Vector3d& so_position) {
   // The right-hand side, the warm start and the first batch of iterations: as many as the
   // last step needed (warm-started steps need about the same).
   VkCommandBuffer cmd = device_.begin();
-  const std::vector<unsigned char> constants = to_device(step_constants_.next_step(model_, so_position));
+  const std::vector<unsigned char> constants =
+      to_device_reals(step_constants_.next_step(model_, so_position), device_.precision());
   device_.update(cmd, constants_, constants.data(), constants.size());
   device_.barrier(cmd);
   dispatch_items(cmd, k_element_rhs_, s_element_rhs_, elements_ * S, elements_);
@@ -345,38 +318,32 @@ StepReport VulkanEnsemble::advance(const Eigen::Vector3d& so_position) {
   std::vector<std::uint32_t> converged(S);
   std::memcpy(iterations.data(), area + at_iterations, 4 * S);
   std::memcpy(converged.data(), area + at_converged, 4 * S);
-  const std::vector<double> rr = from_device(area + at_rr, S);
-  const std::vector<double> bb = from_device(area + at_bb, S);
+  const Precision precision = device_.precision();
   if (rows > 0) {
-    observations_cache_ = from_device(area + at_observations, rows * S);
+    observations_cache_ = from_device_reals(area + at_observations, rows * S, precision);
     observations_current_ = true;
   }
-  StepReport report;
-  report.cg_iterations.assign(iterations.begin(), iterations.end());
-  report.converged.assign(converged.begin(), converged.end());
-  report.relative_residual.resize(S);
-  for (std::size_t s = 0; s < S; ++s)
-    report.relative_residual[s] = bb[s] > 0.0 ? std::sqrt(rr[s] / bb[s]) : 0.0;
   expected_iterations_ = *std::max_element(iterations.begin(), iterations.end());
-  return report;
+  return solver_report(iterations, converged, from_device_reals(area + at_rr, S, precision),
+                       from_device_reals(area + at_bb, S, precision));
 }
 
 void VulkanEnsemble::predicted_observations(Eigen::MatrixXd& y) const {
   const std::size_t rows = observed_.size() * 3;
-  y.resize(static_cast<Eigen::Index>(rows), S_);
-  if (rows == 0) return;
+  if (rows == 0) {
+    y.resize(0, S_);
+    return;
+  }
   if (!observations_current_) {
     VkCommandBuffer cmd = device_.begin();
     dispatch_items(cmd, k_observation_gather_, s_observation_gather_, rows * S_,
                    static_cast<std::uint32_t>(observed_.size()));
     device_.copy_to_host(cmd, observations_, rows * S_ * device_.real_size(), 0);
     device_.submit_and_wait(cmd);
-    observations_cache_ = from_device(device_.read_back(), rows * S_);
+    observations_cache_ = from_device_reals(device_.read_back(), rows * S_, device_.precision());
     observations_current_ = true;
   }
-  for (std::size_t row = 0; row < rows; ++row)
-    for (int s = 0; s < S_; ++s)
-      y(static_cast<Eigen::Index>(row), s) = observations_cache_[row * S_ + s];
+  y = from_sigma_rows(observations_cache_, rows, S_);
 }
 
 void VulkanEnsemble::set_physics_effects(const std::vector<PhysicsEffects>& effects) {
@@ -397,41 +364,32 @@ void VulkanEnsemble::recenter(const Recentering& r) {
 }
 
 Eigen::VectorXd VulkanEnsemble::positions(int s) const {
-  const std::vector<double> column = sigma_column(x_, 3 * static_cast<std::size_t>(nodes_), s);
+  const std::vector<double> column = column_of(x_, 3 * static_cast<std::size_t>(nodes_), s);
   return Eigen::Map<const Eigen::VectorXd>(column.data(), static_cast<Eigen::Index>(column.size()));
 }
 
 Eigen::VectorXd VulkanEnsemble::velocities(int s) const {
-  const std::vector<double> column = sigma_column(v_, 3 * static_cast<std::size_t>(nodes_), s);
+  const std::vector<double> column = column_of(v_, 3 * static_cast<std::size_t>(nodes_), s);
   return Eigen::Map<const Eigen::VectorXd>(column.data(), static_cast<Eigen::Index>(column.size()));
 }
 
 std::vector<double> VulkanEnsemble::frames(int s) const {
-  return sigma_column(frames_, 9 * static_cast<std::size_t>(elements_), s);
+  return column_of(frames_, 9 * static_cast<std::size_t>(elements_), s);
 }
 
 Eigen::MatrixXd VulkanEnsemble::system_product(const Eigen::MatrixXd& d) {
   const std::size_t rows = 3 * static_cast<std::size_t>(nodes_);
   if (static_cast<std::size_t>(d.rows()) != rows || d.cols() != S_)
     throw std::invalid_argument("VulkanEnsemble::system_product: expected 3N x S");
-  std::vector<double> values(rows * S_);
-  for (std::size_t row = 0; row < rows; ++row)
-    for (int s = 0; s < S_; ++s) values[row * S_ + s] = d(static_cast<Eigen::Index>(row), s);
-  write(d_, values);
+  write(d_, to_sigma_rows(d));
   VkCommandBuffer cmd = device_.begin();
   record_system_product(cmd, s_product_all_);
   device_.submit_and_wait(cmd);
-  const std::vector<double> q = read(q_, rows * S_);
-  Eigen::MatrixXd y(d.rows(), d.cols());
-  for (std::size_t row = 0; row < rows; ++row)
-    for (int s = 0; s < S_; ++s) y(static_cast<Eigen::Index>(row), s) = q[row * S_ + s];
-  return y;
+  return from_sigma_rows(read(q_, rows * S_), rows, S_);
 }
 
 std::string VulkanEnsemble::description() const {
-  return std::string("vulkan ") +
-         (device_.precision() == Precision::single ? "single" : "double") + " on " +
-         device_.info().name;
+  return device_ensemble_description("vulkan", device_.precision(), device_.info().name);
 }
 
 }  // namespace sigmafem

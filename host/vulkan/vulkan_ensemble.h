@@ -63,11 +63,10 @@ class VulkanEnsemble : public DeviceEnsemble {
   VulkanBuffer make_buffer(std::size_t count, const char* what);
   VulkanBuffer make_buffer(const std::vector<double>& values, const char* what);
   VulkanBuffer make_buffer(const std::vector<int>& values, const char* what);
-  std::vector<unsigned char> to_device(const std::vector<double>& values) const;
-  std::vector<double> from_device(const void* data, std::size_t count) const;
   void write(const VulkanBuffer& buffer, const std::vector<double>& values) const;
   std::vector<double> read(const VulkanBuffer& buffer, std::size_t count) const;
-  std::vector<double> sigma_column(const VulkanBuffer& buffer, std::size_t rows, int s) const;
+  // Sigma point s's column of a per-row buffer (host/ensemble/device_readout.h).
+  std::vector<double> column_of(const VulkanBuffer& buffer, std::size_t rows, int s) const;
 
   // Recording (kernels/vulkan/<file>.comp holds the shader of the same name).
   void dispatch_items(VkCommandBuffer cmd, const VulkanKernel& kernel, VkDescriptorSet set,
