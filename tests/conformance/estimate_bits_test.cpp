@@ -141,6 +141,9 @@ struct BitsCase {
   std::string backend;
 };
 
+// How ctest and gtest name a case: "box/cpu".
+void PrintTo(const BitsCase& c, std::ostream* out) { *out << c.scenario << "/" << c.backend; }
+
 class EstimateBits : public ::testing::TestWithParam<BitsCase> {};
 
 TEST_P(EstimateBits, StayTheSameOnThisMachine) {
