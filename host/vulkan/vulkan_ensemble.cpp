@@ -196,13 +196,39 @@ std::vector<double> VulkanEnsemble::read(const VulkanBuffer& buffer, std::size_t
 
 std::vector<double> VulkanEnsemble::column_of(const VulkanBuffer& buffer, std::size_t rows,
                                               int s) const {
+  flush_pending();
   return sigma_column(read(buffer, rows * S_), rows, S_, s, "VulkanEnsemble");
 }
 
 void VulkanEnsemble::set_parameters(const Eigen::MatrixXd& theta) {
   check_parameter_matrix(theta, parameter_count(), sigma_count(), "VulkanEnsemble");
   set_ligament_stiffness(model_, estimated_, theta, S_, ligament_k_);
-  write(ligament_k_buffer_, ligament_k_);
+  pending_ligament_k_ = to_device_reals(ligament_k_, device_.precision());
+}
+
+void VulkanEnsemble::record_pending(VkCommandBuffer cmd) const {
+  if (pending_ligament_k_.empty() && !pending_recenter_) return;
+  if (!pending_ligament_k_.empty())
+    device_.update(cmd, ligament_k_buffer_, pending_ligament_k_.data(), pending_ligament_k_.size());
+  pending_ligament_k_.clear();
+  if (pending_recenter_) {
+    device_.update(cmd, recenter_scalars_, pending_scalars_.data(), pending_scalars_.size());
+    device_.update(cmd, directions_, pending_directions_.data(), pending_directions_.size());
+    device_.update(cmd, weights_, pending_weights_.data(), pending_weights_.size());
+    device_.barrier(cmd);
+    dispatch_items(cmd, k_recenter_, s_recenter_, 3 * static_cast<std::size_t>(nodes_),
+                   static_cast<std::uint32_t>(3 * nodes_));
+    pending_recenter_ = false;
+  } else {
+    device_.barrier(cmd);
+  }
+}
+
+void VulkanEnsemble::flush_pending() const {
+  if (pending_ligament_k_.empty() && !pending_recenter_) return;
+  VkCommandBuffer cmd = device_.begin();
+  record_pending(cmd);
+  device_.submit_and_wait(cmd);
 }
 
 void VulkanEnsemble::dispatch_items(VkCommandBuffer cmd, const VulkanKernel& kernel,
@@ -256,6 +282,7 @@ StepReport VulkanEnsemble::advance(const Eigen::Vector3d& so_position) {
   // The right-hand side, the warm start and the first batch of iterations: as many as the
   // last step needed (warm-started steps need about the same).
   VkCommandBuffer cmd = device_.begin();
+  record_pending(cmd);
   const std::vector<unsigned char> constants =
       to_device_reals(step_constants_.next_step(model_, so_position), device_.precision());
   device_.update(cmd, constants_, constants.data(), constants.size());
@@ -336,6 +363,7 @@ void VulkanEnsemble::predicted_observations(Eigen::MatrixXd& y) const {
   }
   if (!observations_current_) {
     VkCommandBuffer cmd = device_.begin();
+    record_pending(cmd);
     dispatch_items(cmd, k_observation_gather_, s_observation_gather_, rows * S_,
                    static_cast<std::uint32_t>(observed_.size()));
     device_.copy_to_host(cmd, observations_, rows * S_ * device_.real_size(), 0);
@@ -353,13 +381,11 @@ void VulkanEnsemble::set_physics_effects(const std::vector<PhysicsEffects>& effe
 void VulkanEnsemble::recenter(const Recentering& r) {
   const RecenteringInputs in = pack_recentering(r, S_, "VulkanEnsemble");
   recenter_parameters_ = in.p;
-  write(recenter_scalars_, in.scalars);
-  write(directions_, in.directions);
-  write(weights_, in.weights);
-  VkCommandBuffer cmd = device_.begin();
-  dispatch_items(cmd, k_recenter_, s_recenter_, 3 * static_cast<std::size_t>(nodes_),
-                 static_cast<std::uint32_t>(3 * nodes_));
-  device_.submit_and_wait(cmd);
+  const Precision precision = device_.precision();
+  pending_scalars_ = to_device_reals(in.scalars, precision);
+  pending_directions_ = to_device_reals(in.directions, precision);
+  pending_weights_ = to_device_reals(in.weights, precision);
+  pending_recenter_ = true;
   observations_current_ = false;
 }
 
@@ -383,6 +409,7 @@ Eigen::MatrixXd VulkanEnsemble::system_product(const Eigen::MatrixXd& d) {
     throw std::invalid_argument("VulkanEnsemble::system_product: expected 3N x S");
   write(d_, to_sigma_rows(d));
   VkCommandBuffer cmd = device_.begin();
+  record_pending(cmd);
   record_system_product(cmd, s_product_all_);
   device_.submit_and_wait(cmd);
   return from_sigma_rows(read(q_, rows * S_), rows, S_);

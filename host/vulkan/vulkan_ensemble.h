@@ -9,6 +9,9 @@
 // in one, then more batches if some sigma point is still iterating (the host reads the S
 // active flags after each), then the state update with the observation gather. Typically
 // two host waits per step; predicted_observations() then reads what the step gathered.
+// set_parameters() and recenter() wait for nothing: what they write (the stiffnesses, the
+// re-centring's inputs and its dispatch) is recorded at the head of the next command buffer
+// (until stop 41 each wrote with its own submission: seven host waits per filter step).
 //
 // Arithmetic and tolerances as OpenClEnsemble: float32 by default, the CG tolerance raised
 // to kSingleCgTolerance; --precision double needs shaderFloat64.
@@ -73,6 +76,10 @@ class VulkanEnsemble : public DeviceEnsemble {
                       std::size_t items, std::uint32_t count) const;
   void record_cg_iterations(VkCommandBuffer cmd, int count) const;
   void record_system_product(VkCommandBuffer cmd, VkDescriptorSet element_product_set) const;
+  // Records what set_parameters() and recenter() left for the next submission; flush_pending()
+  // submits it alone, before a read-out.
+  void record_pending(VkCommandBuffer cmd) const;
+  void flush_pending() const;
 
   mutable VulkanDevice device_;
   Model model_;
@@ -91,6 +98,11 @@ class VulkanEnsemble : public DeviceEnsemble {
   mutable std::vector<double> observations_cache_;
   mutable bool observations_current_ = false;
   std::uint32_t recenter_parameters_ = 0;   // p of the last recenter(): the recenter shader's loop
+  // Device reals waiting for the next command buffer (record_pending): the stiffnesses, and
+  // the re-centring's inputs with its dispatch.
+  mutable std::vector<unsigned char> pending_ligament_k_;
+  mutable std::vector<unsigned char> pending_scalars_, pending_directions_, pending_weights_;
+  mutable bool pending_recenter_ = false;
 
   // Shared data.
   VulkanBuffer element_nodes_, element_rest_, incidence_offsets_, incidence_;
