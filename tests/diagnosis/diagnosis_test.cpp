@@ -382,7 +382,14 @@ TEST(DiagnoseBox, ATruthFromTheRefinedMeshClaimsNoWrongEffect) {
 // Each diagnose is about 12 filter runs of 1 s.
 TEST(DiagnoseLiverOnOpenCl, FindsAnExtraLigamentAmongTheSurfaceRegions) {
   if (opencl_missing()) SIGMAFEM_MISSING("no OpenCL platform on this machine");
-  expect_found({"extra_ligament:surface_5", {250.0}}, {}, "liver_diagnose", "opencl");
+  // Among all six regions and the two effects that also move the whole surface (a load, a
+  // rigid offset); the whole library is the box tests' (DiagnoseBox). Until stop 41 the whole
+  // library here too: 15 filter runs, 43 s on a fresh machine, the longest diagnosis test.
+  expect_found({"extra_ligament:surface_5", {250.0}},
+               {"gravity", "camera_offset", "extra_ligament:surface_1", "extra_ligament:surface_2",
+                "extra_ligament:surface_3", "extra_ligament:surface_4", "extra_ligament:surface_5",
+                "extra_ligament:surface_6"},
+               "liver_diagnose", "opencl");
 }
 
 TEST(DiagnoseLiverOnOpenCl, FindsATimeLag) {
