@@ -20,9 +20,6 @@ namespace sigmafem {
 std::vector<unsigned char> to_device_reals(const std::vector<double>& values, Precision precision);
 // `count` device reals at `data`, as doubles.
 std::vector<double> from_device_reals(const void* data, std::size_t count, Precision precision);
-inline std::size_t device_real_size(Precision precision) {
-  return precision == Precision::single ? sizeof(float) : sizeof(double);
-}
 
 // d (rows x S) as values[row * S + s], and back.
 std::vector<double> to_sigma_rows(const Eigen::MatrixXd& d);

@@ -1,8 +1,6 @@
 #include "host/opencl/opencl_ensemble.h"
 
 #include <algorithm>
-#include <cmath>
-#include <cstring>
 #include <stdexcept>
 #include <string>
 

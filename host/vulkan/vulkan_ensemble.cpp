@@ -1,7 +1,6 @@
 #include "host/vulkan/vulkan_ensemble.h"
 
 #include <algorithm>
-#include <cmath>
 #include <cstring>
 #include <stdexcept>
 #include <string>
