@@ -2,10 +2,17 @@
 // the choices tests and benchmarks force: the CG launch and the kernels' form).
 #pragma once
 
+#include <cstddef>
+
 namespace sigmafem {
 
 // The arithmetic of a device ensemble: float32 by default; float64 where the device has it.
 enum class Precision { single, double_precision };
+
+// Bytes of one device real in that arithmetic.
+inline std::size_t real_size(Precision precision) {
+  return precision == Precision::single ? sizeof(float) : sizeof(double);
+}
 
 // How a device back end runs its CG solve: a few launches per iteration (products over all
 // sigma points at once, on every core), the whole solve in one launch (no launch cost per

@@ -7,8 +7,7 @@
 namespace sigmafem {
 
 std::vector<unsigned char> to_device_reals(const std::vector<double>& values, Precision precision) {
-  std::vector<unsigned char> bytes(values.size() *
-                                   (precision == Precision::single ? sizeof(float) : sizeof(double)));
+  std::vector<unsigned char> bytes(values.size() * real_size(precision));
   if (bytes.empty()) return bytes;
   if (precision == Precision::single) {
     const std::vector<float> converted(values.begin(), values.end());

@@ -46,7 +46,7 @@ class OpenClDevice {
 
   const OpenClDeviceInfo& info() const { return info_; }
   Precision precision() const { return precision_; }
-  std::size_t real_size() const { return precision_ == Precision::single ? 4 : 8; }
+  std::size_t real_size() const { return sigmafem::real_size(precision_); }
   cl::Context& context() { return context_; }
   cl::CommandQueue& queue() { return queue_; }
   // Builds the embedded kernels with these extra -D options (once, before kernel()).

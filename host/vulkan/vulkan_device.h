@@ -70,7 +70,7 @@ class VulkanDevice {
 
   const VulkanDeviceInfo& info() const { return info_; }
   Precision precision() const { return precision_; }
-  std::size_t real_size() const { return precision_ == Precision::single ? 4 : 8; }
+  std::size_t real_size() const { return sigmafem::real_size(precision_); }
   std::uint32_t max_group_count() const { return max_group_count_; }
 
   // A device-local storage buffer of `bytes` (at least 4). Throws DeviceError naming `what`
