@@ -12,7 +12,6 @@ namespace sigmafem {
 namespace {
 
 constexpr std::size_t kGroup = 64;        // work-group size of the element and node kernels
-constexpr int kMaxParameters = kDeviceMaxParameters;
 
 std::size_t round_up(std::size_t n, std::size_t multiple) {
   return (n + multiple - 1) / multiple * multiple;
@@ -129,9 +128,9 @@ OpenClEnsemble::OpenClEnsemble(const Model& model, std::vector<int> estimated,
       own_active_ = make_buffer(flags, "CG flags");
       own_iterations_ = make_buffer(flags, "CG flags");
     }
-    recenter_scalars_ = make_buffer(1 + kMaxParameters, "re-centring");
-    directions_ = make_buffer(static_cast<std::size_t>(kMaxParameters) * S_, "re-centring");
-    weights_ = make_buffer(static_cast<std::size_t>(kMaxParameters) * S_, "re-centring");
+    recenter_scalars_ = make_buffer(1 + kDeviceMaxParameters, "re-centring");
+    directions_ = make_buffer(static_cast<std::size_t>(kDeviceMaxParameters) * S_, "re-centring");
+    weights_ = make_buffer(static_cast<std::size_t>(kDeviceMaxParameters) * S_, "re-centring");
 
     k_element_rhs_ = device_.kernel("element_rhs");
     k_node_rhs_ = device_.kernel("node_rhs");

@@ -205,26 +205,29 @@ void VulkanEnsemble::set_parameters(const Eigen::MatrixXd& theta) {
   pending_ligament_k_ = to_device_reals(ligament_k_, device_.precision());
 }
 
+bool VulkanEnsemble::has_pending() const {
+  return !pending_ligament_k_.empty() || pending_recenter_;
+}
+
 void VulkanEnsemble::record_pending(VkCommandBuffer cmd) const {
-  if (pending_ligament_k_.empty() && !pending_recenter_) return;
+  if (!has_pending()) return;
   if (!pending_ligament_k_.empty())
     device_.update(cmd, ligament_k_buffer_, pending_ligament_k_.data(), pending_ligament_k_.size());
-  pending_ligament_k_.clear();
   if (pending_recenter_) {
     device_.update(cmd, recenter_scalars_, pending_scalars_.data(), pending_scalars_.size());
     device_.update(cmd, directions_, pending_directions_.data(), pending_directions_.size());
     device_.update(cmd, weights_, pending_weights_.data(), pending_weights_.size());
-    device_.barrier(cmd);
+  }
+  device_.barrier(cmd);
+  if (pending_recenter_)
     dispatch_items(cmd, k_recenter_, s_recenter_, 3 * static_cast<std::size_t>(nodes_),
                    static_cast<std::uint32_t>(3 * nodes_));
-    pending_recenter_ = false;
-  } else {
-    device_.barrier(cmd);
-  }
+  pending_ligament_k_.clear();
+  pending_recenter_ = false;
 }
 
 void VulkanEnsemble::flush_pending() const {
-  if (pending_ligament_k_.empty() && !pending_recenter_) return;
+  if (!has_pending()) return;
   VkCommandBuffer cmd = device_.begin();
   record_pending(cmd);
   device_.submit_and_wait(cmd);

@@ -78,6 +78,7 @@ class VulkanEnsemble : public DeviceEnsemble {
   void record_system_product(VkCommandBuffer cmd, VkDescriptorSet element_product_set) const;
   // Records what set_parameters() and recenter() left for the next submission; flush_pending()
   // submits it alone, before a read-out.
+  bool has_pending() const;
   void record_pending(VkCommandBuffer cmd) const;
   void flush_pending() const;
 
