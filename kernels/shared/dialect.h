@@ -1,6 +1,10 @@
 /* dialect.h: the only file that knows which language compiles the shared headers.
- * The shared element math (element.h) is written once in the subset of C that C++, OpenCL C
- * and Vulkan GLSL all accept; these macros adapt the few places where they differ. */
+ * The shared math (element.h, node_rows.h, cg_rows.h, recenter.h, observation_gather.h) is
+ * written once in the subset of C that C++, OpenCL C and Vulkan GLSL all accept; these macros
+ * adapt the few places where they differ: SF_IN/SF_OUT/SF_INOUT array parameters (GLSL
+ * passes arrays by value with a direction), SF_STRUCT(name) a struct type (OpenCL C needs the
+ * keyword, GLSL forbids it), SF_INDEX_TYPE and SF_INDEX(x) the type that indexes a buffer
+ * (size_t, or GLSL's 32-bit uint), SF_ISFINITE (GLSL has no isfinite). */
 #ifndef SIGMAFEM_DIALECT_H
 #define SIGMAFEM_DIALECT_H
 
