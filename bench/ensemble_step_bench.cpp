@@ -13,13 +13,13 @@
 #include "bench/bench_scenarios.h"
 #include "filter/point_cloud_observation.h"
 #include "filter/roukf.h"
+#include "host/engine/estimation_options.h"
+#include "host/engine/make_ensemble.h"
+#include "host/engine/surface_cloud_estimation.h"
 #include "host/ensemble/cpu_ensemble.h"
-#include "host/ensemble/make_ensemble.h"
-#include "host/ensemble/surface_cloud_estimation.h"
 #include "host/generator/surface_cloud_sampler.h"
 #include "host/model/model.h"
 #include "host/reference/reference_simulation.h"
-#include "host/scenario/estimation_options.h"
 
 namespace sigmafem {
 namespace {
@@ -202,7 +202,7 @@ struct CloudBench {
         truth(model) {
     const ObservedPoints observed(surface.nodes);
     // The outlier gate in the observation, per point, as `estimate` has it
-    // (host/ensemble/surface_cloud_estimation.h).
+    // (host/engine/surface_cloud_estimation.h).
     RoukfOptions roukf = estimation_options(s).roukf;
     const PointCloudOptions options = take_outlier_gate(roukf);
     auto wrapped = std::make_unique<PointCloudObservation>(

@@ -18,9 +18,9 @@
 
 #include "filter/estimation.h"
 #include "host/data/observation_table.h"
-#include "host/ensemble/make_ensemble.h"
+#include "host/engine/estimation_options.h"
+#include "host/engine/make_ensemble.h"
 #include "host/model/model.h"
-#include "host/scenario/estimation_options.h"
 #include "host/scenario/scenario.h"
 
 namespace {

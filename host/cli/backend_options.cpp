@@ -1,6 +1,6 @@
 #include "host/cli/backend_options.h"
 
-#include "host/ensemble/make_ensemble.h"
+#include "host/engine/make_ensemble.h"
 
 namespace sigmafem::cli {
 

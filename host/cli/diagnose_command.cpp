@@ -8,18 +8,18 @@
 #include <optional>
 #include <sstream>
 
+#include "filter/sigma_points.h"
 #include "host/cli/backend_options.h"
 #include "host/cli/commands.h"
-#include "host/cli/option_checks.h"
 #include "host/cli/diagnosis_report.h"
+#include "host/cli/option_checks.h"
 #include "host/common/input_error.h"
 #include "host/common/input_file.h"
 #include "host/data/point_cloud_table.h"
-#include "filter/sigma_points.h"
 #include "host/diagnosis/diagnosis.h"
-#include "host/ensemble/choose_backend.h"
+#include "host/engine/choose_backend.h"
+#include "host/engine/estimation_options.h"
 #include "host/model/model.h"
-#include "host/scenario/estimation_options.h"
 #include "host/scenario/scenario.h"
 
 namespace sigmafem::cli {

@@ -13,18 +13,18 @@
 #include "filter/residual_diagnostics.h"
 #include "filter/timed_observation.h"
 #include "host/cli/estimation_report.h"
-#include "host/data/csv_format.h"
 #include "host/common/input_error.h"
 #include "host/common/progress.h"
+#include "host/data/csv_format.h"
 #include "host/data/observation_table.h"
 #include "host/data/point_cloud_table.h"
 #include "host/data/truth_table.h"
-#include "host/ensemble/choose_backend.h"
-#include "host/ensemble/make_ensemble.h"
-#include "host/ensemble/surface_cloud_estimation.h"
+#include "host/engine/choose_backend.h"
+#include "host/engine/estimation_options.h"
+#include "host/engine/make_ensemble.h"
+#include "host/engine/surface_cloud_estimation.h"
 #include "host/model/effects.h"
 #include "host/model/model.h"
-#include "host/scenario/estimation_options.h"
 
 namespace sigmafem::cli {
 namespace fs = std::filesystem;
@@ -63,7 +63,7 @@ json run_estimation_job(const Scenario& scenario, const EstimationJob& job) {
   if (job.out) *job.out << "backend: " << backend.backend << " (" << backend.reason << ")\n" << std::flush;
   // A surface cloud (observations.surface_cloud): the ensemble observes the surface's nodes
   // and each frame's points are observed by their distance to it
-  // (host/ensemble/surface_cloud_estimation.h).
+  // (host/engine/surface_cloud_estimation.h).
   std::optional<SurfaceCloudEstimation> cloud;
   std::unique_ptr<TimedObservation> tracked;
   nlohmann::ordered_json observations = {{"kind", "tracked_points"}, {"points", table.point_count()}};

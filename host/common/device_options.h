@@ -38,7 +38,7 @@ struct DeviceOptions {
   SolveLaunch solve_launch = SolveLaunch::automatic;
   KernelForm kernel_form = KernelForm::automatic;   // OpenCL only
   // Work-groups per sigma point in CG on a GPU (OpenCL's GPU form, Vulkan on a GPU;
-  // cg_partitions() in host/ensemble/ensemble_tables.h); 0 chooses by the mesh's size.
+  // cg_partitions() in host/ensemble/device_limits.h); 0 chooses by the mesh's size.
   int cg_partitions = 0;
   Preconditioner preconditioner = Preconditioner::automatic;
 };

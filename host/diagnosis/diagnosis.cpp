@@ -8,11 +8,11 @@
 #include "filter/timed_observation.h"
 #include "host/common/input_error.h"
 #include "host/common/interruption.h"
-#include "host/ensemble/effect_ensemble.h"
-#include "host/ensemble/surface_cloud_estimation.h"
+#include "host/engine/estimation_options.h"
+#include "host/engine/make_ensemble.h"
+#include "host/engine/surface_cloud_estimation.h"
 #include "host/model/effects.h"
 #include "host/model/model.h"
-#include "host/scenario/estimation_options.h"
 
 namespace sigmafem {
 namespace {
@@ -153,7 +153,7 @@ ModelFit fit_model(const Scenario& scenario, const ObservationTable& data,
                              stop_if_interrupted, [&](Eigen::Index row) { observed.before_step(row); });
   } else {
     // Frames at their own times (observations.csv's frame_time), as `estimate` observes them.
-    TimedObservation ensemble(EffectEnsemble::make(options.backend, model, spec.estimate,
+    TimedObservation ensemble(make_effect_ensemble(options.backend, model, spec.estimate,
                                                    scenario.observations.observed, sigma_count, options.device,
                                                    effects),
                               data.frame_shares);

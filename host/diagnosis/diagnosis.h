@@ -74,7 +74,7 @@ struct DiagnoseOptions {
   // The data's surface cloud (pointcloud.csv) when the scenario observes one
   // (observations.surface_cloud), and its path for messages; the observation table then
   // holds the times and the SO only. Every fit observes the cloud as `estimate` does
-  // (host/ensemble/surface_cloud_estimation.h), and its residual is judged by its step
+  // (host/engine/surface_cloud_estimation.h), and its residual is judged by its step
   // means (filter/residual_diagnostics.h, step_means).
   const PointCloudTable* surface_cloud = nullptr;
   std::string surface_cloud_path;

@@ -20,8 +20,8 @@
 #include <memory>
 #include <vector>
 
-#include "filter/ensemble.h"
 #include "host/common/device_options.h"
+#include "host/ensemble/simulation_ensemble.h"
 #include "host/mesh/observed_points.h"
 #include "host/model/model.h"
 #include "host/reference/factorised_preconditioner.h"
@@ -29,7 +29,7 @@
 
 namespace sigmafem {
 
-class CpuEnsemble : public Ensemble {
+class CpuEnsemble : public SimulationEnsemble {
  public:
   // `estimated`: indices into model.ligaments; `observed`: the observed points (node indices
   // convert); `threads` 0 = cores.
@@ -47,9 +47,7 @@ class CpuEnsemble : public Ensemble {
   void predicted_observations(Eigen::MatrixXd& y) const override;
   void recenter(const Recentering& recentering) override;
 
-  // Per sigma point s, physics effects on top of the model (diagnose's candidates; one entry
-  // per sigma point). Kept until changed.
-  void set_physics_effects(const std::vector<PhysicsEffects>& effects);
+  void set_physics_effects(const std::vector<PhysicsEffects>& effects) override;
 
   // Factorisations made so far (0 with Jacobi), and whether the sigma points share one.
   int factorisations() const;

@@ -1,37 +1,87 @@
-// DeviceEnsemble: an Ensemble whose state can be looked into, one sigma point at a time, so
-// that one conformance suite (tests/conformance/) checks every back end against the CPU
-// reference step by step: the rotations, the system product, one solve, whole trajectories.
-// These read-outs copy device memory to the host; the filter never calls them.
+// DeviceEnsemble: what the device back ends (OpenClEnsemble, VulkanEnsemble) have in common on
+// the host: the model, the estimated ligaments and observed points, the per-step constants,
+// the buffer table (host/ensemble/device_buffers.h) and the read-outs that let one
+// conformance suite (tests/conformance/) check every back end against the CPU reference step by
+// step: the rotations, the system product, one solve, whole trajectories. The read-outs copy
+// device memory to the host; the filter never calls them. A back end adds its transfers and
+// its launches.
 #pragma once
 
 #include <Eigen/Core>
+#include <cstddef>
 #include <string>
 #include <vector>
 
-#include "filter/ensemble.h"
-#include "host/model/effects.h"
+#include "host/common/device_options.h"
+#include "host/ensemble/device_buffers.h"
+#include "host/ensemble/device_step_constants.h"
+#include "host/ensemble/simulation_ensemble.h"
+#include "host/mesh/observed_points.h"
+#include "host/model/model.h"
 
 namespace sigmafem {
 
-class DeviceEnsemble : public Ensemble {
+class DeviceEnsemble : public SimulationEnsemble {
  public:
+  int sigma_count() const override { return S_; }
+  int parameter_count() const override { return static_cast<int>(estimated_.size()); }
+  int observation_count() const override { return 3 * static_cast<int>(observed_.size()); }
+  // The stiffnesses of the estimated ligaments from theta (p x S), for the next advance().
+  void set_parameters(const Eigen::MatrixXd& theta) override;
+  void set_physics_effects(const std::vector<PhysicsEffects>& effects) override;
+
   // Sigma point s's positions and velocities, 3 per node (node-major, as the CPU reference).
-  virtual Eigen::VectorXd positions(int s) const = 0;
-  virtual Eigen::VectorXd velocities(int s) const = 0;
+  Eigen::VectorXd positions(int s) const;
+  Eigen::VectorXd velocities(int s) const;
   // Sigma point s's element frames at the start of the last advance(), 9 per element.
-  virtual std::vector<double> frames(int s) const = 0;
+  std::vector<double> frames(int s) const;
   // Column s of the result is A_s d_s, with A_s the implicit Euler matrix of sigma point s
   // at the last advance() (its frames and springs). d: 3N x S.
-  virtual Eigen::MatrixXd system_product(const Eigen::MatrixXd& d) = 0;
+  Eigen::MatrixXd system_product(const Eigen::MatrixXd& d);
   // The CG tolerance the back end solves to (float32 back ends raise the scenario's).
-  virtual double cg_tolerance() const = 0;
+  double cg_tolerance() const { return tolerance_; }
   // "opencl single on <device>", for messages and reports.
-  virtual std::string description() const = 0;
+  std::string description() const;
+  // Bytes of device memory the ensemble holds.
+  std::size_t device_bytes() const { return device_bytes_; }
 
-  // Per sigma point s, physics effects on top of the model (diagnose's candidates; one entry
-  // per sigma point), kept until changed: per-sigma constants of each step
-  // (kernels/shared/step_constants.h).
-  virtual void set_physics_effects(const std::vector<PhysicsEffects>& effects) = 0;
+ protected:
+  // `backend` ("opencl"), `who` ("OpenClEnsemble", for errors). Checks the arguments.
+  DeviceEnsemble(const Model& model, std::vector<int> estimated, ObservedPoints observed,
+                 int sigma_count, Precision precision, const char* backend, const char* who);
+
+  // Throws DeviceError when the ensemble needs more than `memory` bytes, or a buffer larger
+  // than `largest_buffer`, of device `name`.
+  void check_device_memory(std::size_t real_size, const std::string& name, std::size_t memory,
+                           std::size_t largest_buffer) const;
+  // The table of buffers with this back end's sizes (device_buffer_specs).
+  // Also takes the model's stiffnesses into ligament_k_ (set_parameters() changes only the
+  // estimated ligaments').
+  std::vector<DeviceBufferSpec> buffer_specs(const DeviceBufferSizes& sizes);
+
+  // The back end's transfers: `count` reals of a buffer; the stiffnesses (ligament_k_) for
+  // the next step; the device's name; A d of the `d` buffer into `q` (system_product).
+  virtual std::vector<double> read_reals(DeviceBuffer buffer, std::size_t count) const = 0;
+  virtual void write_reals(DeviceBuffer buffer, const std::vector<double>& values) = 0;
+  virtual void write_ligament_stiffness() = 0;
+  virtual std::string device_name() const = 0;
+  virtual void run_system_product() = 0;
+
+  Model model_;                   // a copy: the ensemble outlives its caller's model
+  std::vector<int> estimated_;
+  ObservedPoints observed_;
+  int S_ = 0, nodes_ = 0, elements_ = 0;
+  Precision precision_;
+  double tolerance_ = 0.0;
+  StepConstants step_constants_;  // per step, with the per-sigma effects
+  std::vector<double> ligament_k_;   // per ligament and sigma, N/m per node: [l S + s]
+  std::size_t device_bytes_ = 0;
+  int expected_iterations_ = 1;   // CG iterations the last step needed (at most)
+  const char* backend_;
+  const char* who_;
+
+ private:
+  std::vector<double> column_of(DeviceBuffer buffer, std::size_t rows, int s) const;
 };
 
 }  // namespace sigmafem

@@ -5,25 +5,17 @@
 #include <stdexcept>
 
 #include "host/common/input_error.h"
-#include "host/ensemble/cpu_ensemble.h"
-#include "host/ensemble/device_ensemble.h"
-#include "host/ensemble/make_ensemble.h"
-#include "host/model/effects.h"
 
 namespace sigmafem {
 
-EffectEnsemble::EffectEnsemble(std::unique_ptr<Ensemble> inner, const std::vector<std::string>& effects)
+EffectEnsemble::EffectEnsemble(std::unique_ptr<SimulationEnsemble> inner, const std::vector<std::string>& effects)
     : inner_(std::move(inner)) {
-  cpu_ = dynamic_cast<CpuEnsemble*>(inner_.get());
-  device_ = dynamic_cast<DeviceEnsemble*>(inner_.get());
   declared_count_ = inner_->parameter_count();
   for (const std::string& name : effects) {
     const EffectDefinition* definition = find_effect(name);
     if (!definition || !definition->candidate)
       throw InputError("effect " + name + ": not in the candidate library (" + effect_names(true) + ")");
     if (std::count(effects.begin(), effects.end(), name) > 1) throw InputError("effect " + name + ": listed twice");
-    if (definition->side == EffectSide::physics && !cpu_ && !device_)
-      throw std::invalid_argument("EffectEnsemble: effect " + name + " needs a CPU or device ensemble");
     effects_.push_back(definition);
     effect_parameter_count_ += static_cast<int>(definition->parameters.size());
     if (definition->side == EffectSide::ligament) --declared_count_;
@@ -31,20 +23,6 @@ EffectEnsemble::EffectEnsemble(std::unique_ptr<Ensemble> inner, const std::vecto
   if (declared_count_ < 0)
     throw std::invalid_argument("EffectEnsemble: the inner ensemble lacks the extra ligaments' parameters");
   camera_offsets_ = Eigen::MatrixXd::Zero(3, sigma_count());
-}
-
-std::unique_ptr<EffectEnsemble> EffectEnsemble::make(const std::string& backend, Model model,
-                                                     std::vector<int> estimated, const ObservedPoints& observed,
-                                                     int sigma_count, const DeviceOptions& options,
-                                                     const std::vector<std::string>& effects) {
-  for (const std::string& name : effects) {
-    const EffectDefinition* definition = find_effect(name);
-    // The stiffness is a placeholder: set_parameters gives every sigma point its own.
-    if (definition && definition->side == EffectSide::ligament)
-      estimated.push_back(add_extra_ligament(model, name, 0.0));
-  }
-  return std::make_unique<EffectEnsemble>(make_ensemble(backend, model, estimated, observed, sigma_count, options),
-                                          effects);
 }
 
 std::vector<double> EffectEnsemble::effect_value(const EffectDefinition& definition,
@@ -98,8 +76,7 @@ void EffectEnsemble::set_parameters(const Eigen::MatrixXd& theta) {
     row += k;
   }
   inner_->set_parameters(inner_theta_);
-  if (cpu_) cpu_->set_physics_effects(physics);
-  if (device_) device_->set_physics_effects(physics);
+  inner_->set_physics_effects(physics);
 }
 
 StepReport EffectEnsemble::advance(const Eigen::Vector3d& so_position) { return inner_->advance(so_position); }

@@ -6,8 +6,7 @@
 // coordinates], the coordinate of an effect parameter being (u - prior_mean) / prior_std with
 // u = log(value) or value (its transform): prior N(0, 1) for every effect coordinate.
 //   physics effects (gravity, young_scale, ligament_law, time_lag, damping_scale): per sigma
-//     point through set_physics_effects of the CPU or the device ensemble (per-sigma step
-//     constants there: kernels/shared/step_constants.h);
+//     point through the inner SimulationEnsemble's set_physics_effects, on any back end;
 //   ligament effects (extra_ligament:REGION): one more estimated ligament of the inner
 //     ensemble (make() appends it to the model), its log-stiffness mapped from the
 //     coordinate: any back end;
@@ -20,29 +19,18 @@
 #include <string>
 #include <vector>
 
-#include "filter/ensemble.h"
-#include "host/common/device_options.h"
-#include "host/mesh/observed_points.h"
-#include "host/model/model.h"
+#include "host/ensemble/simulation_ensemble.h"
 #include "host/scenario/effect_catalogue.h"
 
 namespace sigmafem {
 
-class CpuEnsemble;
-class DeviceEnsemble;
-
 class EffectEnsemble : public Ensemble {
  public:
   // `effects`: names of candidate effects, each at most once. `inner` estimates the declared
-  // ligaments, then one ligament per ligament effect, in the order of `effects`. Throws
+  // ligaments, then one ligament per ligament effect, in the order of `effects`
+  // (make_effect_ensemble, host/engine/make_ensemble.h, builds such an inner). Throws
   // InputError for an unknown name or one that is not a candidate.
-  EffectEnsemble(std::unique_ptr<Ensemble> inner, const std::vector<std::string>& effects);
-
-  // The ensemble of `model` on `backend` (make_ensemble) with `effects` estimated: the
-  // ligament of every ligament effect is appended to the model and to `estimated` first.
-  static std::unique_ptr<EffectEnsemble> make(const std::string& backend, Model model, std::vector<int> estimated,
-                                              const ObservedPoints& observed, int sigma_count,
-                                              const DeviceOptions& options, const std::vector<std::string>& effects);
+  EffectEnsemble(std::unique_ptr<SimulationEnsemble> inner, const std::vector<std::string>& effects);
 
   int sigma_count() const override { return inner_->sigma_count(); }
   int parameter_count() const override { return declared_count_ + effect_parameter_count_; }
@@ -66,9 +54,7 @@ class EffectEnsemble : public Ensemble {
                               std::vector<double>& value_std);
 
  private:
-  std::unique_ptr<Ensemble> inner_;
-  CpuEnsemble* cpu_ = nullptr;                     // inner_ as the CPU back end, if it is
-  DeviceEnsemble* device_ = nullptr;               // inner_ as a device back end, if it is
+  std::unique_ptr<SimulationEnsemble> inner_;
   std::vector<const EffectDefinition*> effects_;
   int declared_count_ = 0;                         // p0: the declared estimated ligaments
   int effect_parameter_count_ = 0;

@@ -5,7 +5,7 @@
 #include <stdexcept>
 
 #include "host/common/input_error.h"
-#include "host/ensemble/make_ensemble.h"
+#include "host/engine/make_ensemble.h"
 
 namespace sigmafem {
 

@@ -5,8 +5,7 @@
 #include <string>
 
 #include "host/ensemble/device_readout.h"
-#include "host/ensemble/ensemble_tables.h"
-#include "step_constants.h"
+#include "host/ensemble/device_limits.h"
 
 namespace sigmafem {
 namespace {
@@ -17,39 +16,17 @@ std::size_t round_up(std::size_t n, std::size_t multiple) {
   return (n + multiple - 1) / multiple * multiple;
 }
 
-// Sets the kernel's arguments in order.
-template <class... Args>
-void set_args(cl::Kernel& kernel, const Args&... args) {
-  cl_uint index = 0;
-  (kernel.setArg(index++, args), ...);
-}
-
 }  // namespace
 
 OpenClEnsemble::OpenClEnsemble(const Model& model, std::vector<int> estimated,
                                ObservedPoints observed, int sigma_count,
                                const DeviceOptions& options)
-    : device_(options.device, options.precision),
-      model_(model),
-      step_constants_(model, sigma_count, device_cg_tolerance(model, options.precision)),
-      estimated_(std::move(estimated)),
-      observed_(std::move(observed)),
-      S_(sigma_count),
-      nodes_(model.node_count()),
-      elements_(model.element_count()) {
-  check_ensemble_arguments(model, estimated_, observed_, S_, "OpenClEnsemble");
-  tolerance_ = device_cg_tolerance(model, options.precision);
-
+    : DeviceEnsemble(model, std::move(estimated), std::move(observed), sigma_count,
+                     options.precision, "opencl", "OpenClEnsemble"),
+      device_(options.device, options.precision) {
   // Check the memory before asking for it, to say how much is needed.
-  const std::size_t dof = 3 * static_cast<std::size_t>(nodes_) * S_;
-  const std::size_t per_element = static_cast<std::size_t>(elements_) * S_;
-  const EnsembleMemory need = ensemble_memory(nodes_, elements_, S_, device_.real_size());
   const OpenClDeviceInfo& info = device_.info();
-  if (need.largest > info.max_allocation || need.total > info.global_memory)
-    throw DeviceError(out_of_device_memory_message(need, elements_, S_, info.name,
-                                                   info.global_memory, info.max_allocation));
-  EnsembleTables tables = make_ensemble_tables(model, S_);
-  ligament_k_ = std::move(tables.ligament_k);
+  check_device_memory(device_.real_size(), info.name, info.global_memory, info.max_allocation);
 
   // The CPU form or the GPU form of the kernels (DeviceOptions::kernel_form): the device's
   // type decides unless a test forces one.
@@ -89,48 +66,18 @@ OpenClEnsemble::OpenClEnsemble(const Model& model, std::vector<int> estimated,
                         " -DSF_CG_BLOCK=" + std::to_string(cg_block_) +
                         " -DSF_CG_PARTITIONS=" + std::to_string(cg_partitions_));
 
+  using B = DeviceBuffer;
   try {
-    element_nodes_ = make_buffer(tables.element_nodes, "element nodes");
-    element_rest_ = make_buffer(tables.element_rest, "element rest state");
-    incidence_offsets_ = make_buffer(tables.incidence_offsets, "node incidence");
-    incidence_ = make_buffer(tables.incidence, "node incidence");
-    ligament_offsets_ = make_buffer(tables.ligament_offsets, "ligament nodes");
-    ligament_of_node_ = make_buffer(tables.ligament_of_node, "ligament nodes");
-    control_k_ = make_buffer(tables.control_k, "control springs");
-    mass_ = make_buffer(tables.mass, "mass");
-    rest_positions_ = make_buffer(tables.rest_positions, "rest positions");
-    observed_nodes_ = make_buffer(corner_nodes(observed_), "observed points");
-    observed_weights_ = make_buffer(corner_weights(observed_), "observed points");
-    constants_ = make_buffer(step_constants_.size(), "step constants");
-    ligament_k_buffer_ = make_buffer(ligament_k_, "ligament stiffness");
-    x_ = make_buffer(tables.initial_positions, "positions");
-    const std::vector<double> zeros(dof, 0.0);
-    v_ = make_buffer(zeros, "velocities");
-    dv_ = make_buffer(zeros, "velocity change");
-    for (cl::Buffer* b : {&rhs_, &inverse_diagonal_, &r_, &z_, &d_, &q_})
-      *b = make_buffer(dof, "CG vectors");
-    frames_ = make_buffer(9 * per_element, "element frames");
-    // Per-corner outputs of element_rhs (and of element_product on a GPU), or the chunks'
-    // copies of K d on a CPU.
-    element_out_ = make_buffer(std::max(12 * per_element, element_chunks_ * dof), "element outputs");
-    element_diagonal_ = make_buffer(12 * per_element, "element diagonals");
-    observations_ = make_buffer(std::max<std::size_t>(1, observed_.size()) * 3 * S_, "observations");
-    for (cl::Buffer* b : {&bb_, &rr_, &rz_})
-      *b = make_buffer(static_cast<std::size_t>(S_), "CG scalars");
-    for (cl::Buffer* b : {&active_, &converged_, &iterations_})
-      *b = make_buffer(std::vector<int>(S_, 0), "CG flags");
-    all_active_ = make_buffer(std::vector<int>(S_, 1), "CG flags");
-    if (cg_partitions_ > 1) {
-      const std::size_t groups = static_cast<std::size_t>(S_) * cg_partitions_;
-      partial_ = make_buffer(4 * groups, "CG partial sums");
-      own_rz_ = make_buffer(groups, "CG scalars");
-      const std::vector<int> flags(groups, 0);
-      own_active_ = make_buffer(flags, "CG flags");
-      own_iterations_ = make_buffer(flags, "CG flags");
+    // The chunks' copies of K d on a CPU live in the element outputs (element_product.cl).
+    const std::size_t dof = 3 * static_cast<std::size_t>(nodes_) * S_;
+    for (const DeviceBufferSpec& spec : buffer_specs({element_chunks_ * dof, cg_partitions_})) {
+      const std::size_t bytes = spec.count * (spec.integer ? sizeof(cl_int) : device_.real_size());
+      device_bytes_ += bytes;
+      buffers_.emplace_back(device_.context(), CL_MEM_READ_WRITE, bytes);
+      if (spec.integer && !spec.integers.empty())
+        device_.queue().enqueueWriteBuffer(buffers_.back(), CL_TRUE, 0, bytes, spec.integers.data());
+      if (!spec.reals.empty()) write_reals(spec.id, spec.reals);
     }
-    recenter_scalars_ = make_buffer(1 + kDeviceMaxParameters, "re-centring");
-    directions_ = make_buffer(static_cast<std::size_t>(kDeviceMaxParameters) * S_, "re-centring");
-    weights_ = make_buffer(static_cast<std::size_t>(kDeviceMaxParameters) * S_, "re-centring");
 
     k_element_rhs_ = device_.kernel("element_rhs");
     k_node_rhs_ = device_.kernel("node_rhs");
@@ -151,118 +98,80 @@ OpenClEnsemble::OpenClEnsemble(const Model& model, std::vector<int> estimated,
     k_recenter_ = device_.kernel("recenter");
 
     const cl_uint S = S_, E = elements_, N = nodes_, rows = 3 * nodes_;
-    set_args(k_element_rhs_, S, E, element_nodes_, element_rest_, frames_, x_, v_, constants_,
-             element_out_, element_diagonal_);
-    set_args(k_node_rhs_, S, N, constants_, incidence_offsets_, incidence_, ligament_offsets_,
-             ligament_of_node_, ligament_k_buffer_, control_k_, mass_, rest_positions_, x_, v_,
-             element_out_, element_diagonal_, rhs_, inverse_diagonal_);
-    // Arguments 5-6 (d, active) and 10 (d), 12 (q) are set per call.
-    set_args(k_element_product_, S, E, element_nodes_, element_rest_, frames_);
-    k_element_product_.setArg(7, element_out_);
-    k_element_product_.setArg(8, N);
-    k_element_product_.setArg(9, constants_);
-    set_args(k_node_product_, S, N, constants_, incidence_offsets_, incidence_, ligament_offsets_,
-             ligament_of_node_, ligament_k_buffer_, control_k_, mass_);
-    k_node_product_.setArg(11, element_out_);
-    set_args(k_cg_start_, S, N, constants_, q_, rhs_, inverse_diagonal_, r_, z_, d_, bb_, rr_,
-             rz_, active_, converged_, iterations_);
-    set_args(k_cg_iteration_, S, N, static_cast<cl_int>(model.solver.cg_max_iterations),
-             constants_, inverse_diagonal_, dv_, r_, z_, d_, q_, bb_, rr_, rz_, active_,
-             converged_, iterations_);
-    if (!cg_per_group_) {  // the CPU form also does node_product's part (conjugate_gradient.cl)
-      k_cg_iteration_.setArg(16, ligament_offsets_);
-      k_cg_iteration_.setArg(17, ligament_of_node_);
-      k_cg_iteration_.setArg(18, ligament_k_buffer_);
-      k_cg_iteration_.setArg(19, control_k_);
-      k_cg_iteration_.setArg(20, mass_);
-      k_cg_iteration_.setArg(21, element_out_);
-    }
+    const cl_int cap = model.solver.cg_max_iterations;
+    set_arguments(k_element_rhs_, kernel_buffers(DeviceKernel::element_rhs), S, E);
+    set_arguments(k_node_rhs_, kernel_buffers(DeviceKernel::node_rhs), S, N);
+    set_arguments(k_element_product_, kernel_buffers(DeviceKernel::element_product), S, E, N);
+    set_arguments(k_node_product_, kernel_buffers(DeviceKernel::node_product), S, N);
+    set_arguments(k_state_update_, kernel_buffers(DeviceKernel::state_update), S, rows);
+    set_arguments(k_observation_gather_, kernel_buffers(DeviceKernel::observation_gather), S,
+                  static_cast<cl_uint>(observed_.size()));
+    set_arguments(k_recenter_, kernel_buffers(DeviceKernel::recenter), S, rows,
+                  static_cast<cl_uint>(estimated_.size()));
+    // The CG kernels' buffers (conjugate_gradient.cl).
+    set_arguments(k_cg_start_, {B::constants, B::q, B::rhs, B::inverse_diagonal, B::r, B::z, B::d,
+                                B::bb, B::rr, B::rz, B::active, B::converged, B::iterations}, S, N);
+    std::vector<DeviceBuffer> iteration = {B::constants, B::inverse_diagonal, B::dv, B::r, B::z,
+                                           B::d, B::q, B::bb, B::rr, B::rz, B::active,
+                                           B::converged, B::iterations};
+    if (!cg_per_group_)   // the CPU form also does node_product's part
+      iteration.insert(iteration.end(), {B::ligament_offsets, B::ligament_of_node, B::ligament_k,
+                                         B::control_k, B::mass, B::element_out});
+    set_arguments(k_cg_iteration_, iteration, S, N, cap);
     if (cg_partitions_ > 1) {
-      set_args(k_cg_start_partials_, S, N, q_, rhs_, inverse_diagonal_, r_, z_, d_, partial_);
-      set_args(k_cg_start_scalars_, S, constants_, partial_, bb_, rr_, rz_, active_, converged_,
-               iterations_, own_active_, own_iterations_, own_rz_);
-      set_args(k_cg_dot_, S, N, d_, q_, partial_, own_active_);
-      set_args(k_cg_update_, S, N, inverse_diagonal_, dv_, r_, z_, d_, q_, partial_, own_active_,
-               own_rz_);
-      set_args(k_cg_direction_, S, N, static_cast<cl_int>(model.solver.cg_max_iterations),
-               constants_, z_, d_, partial_, bb_, rr_, rz_, active_, converged_, iterations_,
-               own_active_, own_iterations_, own_rz_);
+      set_arguments(k_cg_start_partials_, {B::q, B::rhs, B::inverse_diagonal, B::r, B::z, B::d, B::partial},
+                    S, N);
+      set_arguments(k_cg_start_scalars_, {B::constants, B::partial, B::bb, B::rr, B::rz, B::active,
+                                          B::converged, B::iterations, B::own_active,
+                                          B::own_iterations, B::own_rz}, S);
+      set_arguments(k_cg_dot_, {B::d, B::q, B::partial, B::own_active}, S, N);
+      set_arguments(k_cg_update_, {B::inverse_diagonal, B::dv, B::r, B::z, B::d, B::q, B::partial,
+                                   B::own_active, B::own_rz}, S, N);
+      set_arguments(k_cg_direction_, {B::constants, B::z, B::d, B::partial, B::bb, B::rr, B::rz,
+                                      B::active, B::converged, B::iterations, B::own_active,
+                                      B::own_iterations, B::own_rz}, S, N, cap);
     }
     if (whole_solve_)
-      set_args(k_cg_solve_, S, E, N, static_cast<cl_int>(model.solver.cg_max_iterations),
-               constants_, element_nodes_, element_rest_, frames_, ligament_offsets_,
-               ligament_of_node_, ligament_k_buffer_, control_k_, mass_, rhs_,
-               inverse_diagonal_, dv_, r_, z_, d_, q_, element_out_, bb_, rr_, rz_, active_,
-               converged_, iterations_);
-    set_args(k_state_update_, S, rows, constants_, bb_, dv_, x_, v_);
-    set_args(k_observation_gather_, S, static_cast<cl_uint>(observed_.size()), observed_nodes_,
-             observed_weights_, x_, observations_);
-    set_args(k_recenter_, S, rows, static_cast<cl_uint>(estimated_.size()), recenter_scalars_,
-             directions_, weights_, x_, v_);
+      set_arguments(k_cg_solve_, {B::constants, B::element_nodes, B::element_rest, B::frames,
+                                  B::ligament_offsets, B::ligament_of_node, B::ligament_k,
+                                  B::control_k, B::mass, B::rhs, B::inverse_diagonal, B::dv, B::r,
+                                  B::z, B::d, B::q, B::element_out, B::bb, B::rr, B::rz, B::active,
+                                  B::converged, B::iterations}, S, E, N, cap);
     device_.queue().finish();
   } catch (const cl::Error& error) {
     throw opencl_failure("setting up the OpenCL ensemble", error);
   }
 }
 
-cl::Buffer OpenClEnsemble::make_buffer(std::size_t count, const char* what) {
-  try {
-    const std::size_t bytes = std::max<std::size_t>(1, count) * device_.real_size();
-    device_bytes_ += bytes;
-    return cl::Buffer(device_.context(), CL_MEM_READ_WRITE, bytes);
-  } catch (const cl::Error& error) {
-    throw opencl_failure(std::string("allocating ") + what, error);
-  }
+template <class... Scalars>
+void OpenClEnsemble::set_arguments(cl::Kernel& kernel, const std::vector<DeviceBuffer>& buffers,
+                                   const Scalars&... scalars) {
+  cl_uint index = 0;
+  (kernel.setArg(index++, scalars), ...);
+  for (DeviceBuffer id : buffers) kernel.setArg(index++, buffer(id));
 }
 
-cl::Buffer OpenClEnsemble::make_buffer(const std::vector<double>& values, const char* what) {
-  cl::Buffer buffer = make_buffer(values.size(), what);
-  write(buffer, values);
-  return buffer;
-}
-
-cl::Buffer OpenClEnsemble::make_buffer(const std::vector<int>& values, const char* what) {
-  try {
-    const std::size_t bytes = values.size() * sizeof(cl_int);
-    device_bytes_ += bytes;
-    cl::Buffer buffer(device_.context(), CL_MEM_READ_WRITE, bytes);
-    device_.queue().enqueueWriteBuffer(buffer, CL_TRUE, 0, bytes, values.data());
-    return buffer;
-  } catch (const cl::Error& error) {
-    throw opencl_failure(std::string("allocating ") + what, error);
-  }
-}
-
-void OpenClEnsemble::write(const cl::Buffer& buffer, const std::vector<double>& values) const {
+void OpenClEnsemble::write_reals(DeviceBuffer id, const std::vector<double>& values) {
   if (values.empty()) return;
   const std::vector<unsigned char> bytes = to_device_reals(values, device_.precision());
-  device_.queue().enqueueWriteBuffer(buffer, CL_TRUE, 0, bytes.size(), bytes.data());
+  try {
+    device_.queue().enqueueWriteBuffer(buffer(id), CL_TRUE, 0, bytes.size(), bytes.data());
+  } catch (const cl::Error& error) {
+    throw opencl_failure("writing to the device", error);
+  }
 }
 
-std::vector<double> OpenClEnsemble::read(const cl::Buffer& buffer, std::size_t count) const {
+std::vector<double> OpenClEnsemble::read_reals(DeviceBuffer id, std::size_t count) const {
   std::vector<unsigned char> bytes(count * device_.real_size());
-  device_.queue().enqueueReadBuffer(buffer, CL_TRUE, 0, bytes.size(), bytes.data());
+  try {
+    device_.queue().enqueueReadBuffer(buffer(id), CL_TRUE, 0, bytes.size(), bytes.data());
+  } catch (const cl::Error& error) {
+    throw opencl_failure("reading from the device", error);
+  }
   return from_device_reals(bytes.data(), count, device_.precision());
 }
 
-std::vector<double> OpenClEnsemble::column_of(const cl::Buffer& buffer, std::size_t rows,
-                                              int s) const {
-  return sigma_column(read(buffer, rows * S_), rows, S_, s, "OpenClEnsemble");
-}
-
-void OpenClEnsemble::set_parameters(const Eigen::MatrixXd& theta) {
-  check_parameter_matrix(theta, parameter_count(), sigma_count(), "OpenClEnsemble");
-  set_ligament_stiffness(model_, estimated_, theta, S_, ligament_k_);
-  write(ligament_k_buffer_, ligament_k_);
-}
-
-void OpenClEnsemble::write_step_constants(const Eigen::Vector3d& so_position) {
-  write(constants_, step_constants_.next_step(model_, so_position));
-}
-
-void OpenClEnsemble::set_physics_effects(const std::vector<PhysicsEffects>& effects) {
-  step_constants_.set_physics_effects(effects, "OpenClEnsemble");
-}
+void OpenClEnsemble::write_ligament_stiffness() { write_reals(DeviceBuffer::ligament_k, ligament_k_); }
 
 void OpenClEnsemble::run(cl::Kernel& kernel, std::size_t items, std::size_t local) const {
   const std::size_t group = local > 0 ? local : kGroup;
@@ -287,21 +196,18 @@ std::size_t OpenClEnsemble::element_items() const {
   return static_cast<std::size_t>(elements_) * (S_ / sigma_block_);
 }
 
-void OpenClEnsemble::element_rhs() { run(k_element_rhs_, element_items()); }
-
-void OpenClEnsemble::node_rhs() { run(k_node_rhs_, static_cast<std::size_t>(nodes_) * S_); }
-
-void OpenClEnsemble::element_product(const cl::Buffer& d, const cl::Buffer& active) {
-  k_element_product_.setArg(5, d);
-  k_element_product_.setArg(6, active);
+void OpenClEnsemble::element_product(DeviceBuffer d, DeviceBuffer active) {
+  const cl_uint scalars = 3;   // S, E, N
+  k_element_product_.setArg(scalars + buffer_slot(DeviceKernel::element_product, DeviceBuffer::d), buffer(d));
+  k_element_product_.setArg(scalars + buffer_slot(DeviceKernel::element_product, DeviceBuffer::active),
+                            buffer(active));
   run(k_element_product_, element_chunks_ > 0 ? static_cast<std::size_t>(element_chunks_)
                                               : element_items(),
       element_chunks_ > 0 ? 1 : 0);
 }
 
-void OpenClEnsemble::node_product(const cl::Buffer& d, const cl::Buffer& q) {
-  k_node_product_.setArg(10, d);
-  k_node_product_.setArg(12, q);
+void OpenClEnsemble::node_product(DeviceBuffer d) {
+  k_node_product_.setArg(2 + buffer_slot(DeviceKernel::node_product, DeviceBuffer::d), buffer(d));
   run(k_node_product_, static_cast<std::size_t>(nodes_) * (S_ / sigma_block_));
 }
 
@@ -311,8 +217,8 @@ void OpenClEnsemble::conjugate_gradient() {
     return;
   }
   // The warm start's residual (dv holds the last step's velocity change).
-  element_product(dv_, all_active_);
-  node_product(dv_, q_);
+  element_product(DeviceBuffer::dv, DeviceBuffer::all_active);
+  node_product(DeviceBuffer::dv);
   if (cg_partitions_ > 1) {
     run_partitions(k_cg_start_partials_);
     run(k_cg_start_scalars_, static_cast<std::size_t>(S_));
@@ -328,8 +234,8 @@ void OpenClEnsemble::conjugate_gradient() {
   for (int done = 0; done < cap;) {
     const int count = std::min(batch, cap - done);
     for (int i = 0; i < count; ++i) {
-      element_product(d_, active_);
-      if (cg_per_group_) node_product(d_, q_);   // on a CPU cg_iteration does it
+      element_product(DeviceBuffer::d, DeviceBuffer::active);
+      if (cg_per_group_) node_product(DeviceBuffer::d);   // on a CPU cg_iteration does it
       if (cg_partitions_ > 1) {
         run_partitions(k_cg_dot_);
         run_partitions(k_cg_update_);
@@ -339,7 +245,7 @@ void OpenClEnsemble::conjugate_gradient() {
       }
     }
     done += count;
-    device_.queue().enqueueReadBuffer(active_, CL_TRUE, 0, S_ * sizeof(cl_uint), active.data());
+    device_.queue().enqueueReadBuffer(buffer(DeviceBuffer::active), CL_TRUE, 0, S_ * sizeof(cl_uint), active.data());
     if (std::none_of(active.begin(), active.end(), [](cl_uint a) { return a != 0; })) break;
     batch = std::max(2, expected_iterations_ / 8);
   }
@@ -349,9 +255,9 @@ StepReport OpenClEnsemble::advance(const Eigen::Vector3d& so_position) {
   const std::size_t dof = 3 * static_cast<std::size_t>(nodes_) * S_;
   StepReport report;
   try {
-    write_step_constants(so_position);
-    element_rhs();
-    node_rhs();
+    write_reals(DeviceBuffer::constants, step_constants_.next_step(model_, so_position));
+    run(k_element_rhs_, element_items());
+    run(k_node_rhs_, static_cast<std::size_t>(nodes_) * S_);
     conjugate_gradient();
     run(k_state_update_, dof);
     // The solver report: four small reads, one wait.
@@ -359,10 +265,10 @@ StepReport OpenClEnsemble::advance(const Eigen::Vector3d& so_position) {
     std::vector<cl_uint> converged(S_);
     std::vector<unsigned char> rr_bytes(S_ * device_.real_size()), bb_bytes(rr_bytes.size());
     cl::CommandQueue& queue = device_.queue();
-    queue.enqueueReadBuffer(iterations_, CL_FALSE, 0, S_ * sizeof(cl_int), iterations.data());
-    queue.enqueueReadBuffer(converged_, CL_FALSE, 0, S_ * sizeof(cl_uint), converged.data());
-    queue.enqueueReadBuffer(rr_, CL_FALSE, 0, rr_bytes.size(), rr_bytes.data());
-    queue.enqueueReadBuffer(bb_, CL_FALSE, 0, bb_bytes.size(), bb_bytes.data());
+    queue.enqueueReadBuffer(buffer(DeviceBuffer::iterations), CL_FALSE, 0, S_ * sizeof(cl_int), iterations.data());
+    queue.enqueueReadBuffer(buffer(DeviceBuffer::converged), CL_FALSE, 0, S_ * sizeof(cl_uint), converged.data());
+    queue.enqueueReadBuffer(buffer(DeviceBuffer::rr), CL_FALSE, 0, rr_bytes.size(), rr_bytes.data());
+    queue.enqueueReadBuffer(buffer(DeviceBuffer::bb), CL_FALSE, 0, bb_bytes.size(), bb_bytes.data());
     queue.finish();
     const Precision precision = device_.precision();
     report = solver_report(iterations, converged, from_device_reals(rr_bytes.data(), S_, precision),
@@ -382,7 +288,7 @@ void OpenClEnsemble::predicted_observations(Eigen::MatrixXd& y) const {
   }
   try {
     run(k_observation_gather_, rows * S_);
-    y = from_sigma_rows(read(observations_, rows * S_), rows, S_);
+    y = from_sigma_rows(read_reals(DeviceBuffer::observations, rows * S_), rows, S_);
   } catch (const cl::Error& error) {
     throw opencl_failure("reading the observations", error);
   }
@@ -392,45 +298,22 @@ void OpenClEnsemble::recenter(const Recentering& r) {
   const RecenteringInputs in = pack_recentering(r, S_, "OpenClEnsemble");
   try {
     k_recenter_.setArg(2, static_cast<cl_uint>(in.p));
-    write(recenter_scalars_, in.scalars);
-    write(directions_, in.directions);
-    write(weights_, in.weights);
+    write_reals(DeviceBuffer::recenter_scalars, in.scalars);
+    write_reals(DeviceBuffer::directions, in.directions);
+    write_reals(DeviceBuffer::weights, in.weights);
     run(k_recenter_, 3 * static_cast<std::size_t>(nodes_));
   } catch (const cl::Error& error) {
     throw opencl_failure("re-centring the OpenCL ensemble", error);
   }
 }
 
-Eigen::VectorXd OpenClEnsemble::positions(int s) const {
-  const std::vector<double> column = column_of(x_, 3 * static_cast<std::size_t>(nodes_), s);
-  return Eigen::Map<const Eigen::VectorXd>(column.data(), static_cast<Eigen::Index>(column.size()));
-}
-
-Eigen::VectorXd OpenClEnsemble::velocities(int s) const {
-  const std::vector<double> column = column_of(v_, 3 * static_cast<std::size_t>(nodes_), s);
-  return Eigen::Map<const Eigen::VectorXd>(column.data(), static_cast<Eigen::Index>(column.size()));
-}
-
-std::vector<double> OpenClEnsemble::frames(int s) const {
-  return column_of(frames_, 9 * static_cast<std::size_t>(elements_), s);
-}
-
-Eigen::MatrixXd OpenClEnsemble::system_product(const Eigen::MatrixXd& d) {
-  const std::size_t rows = 3 * static_cast<std::size_t>(nodes_);
-  if (static_cast<std::size_t>(d.rows()) != rows || d.cols() != S_)
-    throw std::invalid_argument("OpenClEnsemble::system_product: expected 3N x S");
+void OpenClEnsemble::run_system_product() {
   try {
-    write(d_, to_sigma_rows(d));
-    element_product(d_, all_active_);
-    node_product(d_, q_);
-    return from_sigma_rows(read(q_, rows * S_), rows, S_);
+    element_product(DeviceBuffer::d, DeviceBuffer::all_active);
+    node_product(DeviceBuffer::d);
   } catch (const cl::Error& error) {
     throw opencl_failure("the system product", error);
   }
-}
-
-std::string OpenClEnsemble::description() const {
-  return device_ensemble_description("opencl", device_.precision(), device_.info().name);
 }
 
 }  // namespace sigmafem

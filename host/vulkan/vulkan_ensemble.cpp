@@ -6,8 +6,7 @@
 #include <string>
 
 #include "host/ensemble/device_readout.h"
-#include "host/ensemble/ensemble_tables.h"
-#include "step_constants.h"
+#include "host/ensemble/device_limits.h"
 
 namespace sigmafem {
 namespace {
@@ -23,25 +22,12 @@ std::uint32_t groups_for(std::size_t items) {
 VulkanEnsemble::VulkanEnsemble(const Model& model, std::vector<int> estimated,
                                ObservedPoints observed, int sigma_count,
                                const DeviceOptions& options)
-    : device_(options.device, options.precision),
-      model_(model),
-      step_constants_(model, sigma_count, device_cg_tolerance(model, options.precision)),
-      estimated_(std::move(estimated)),
-      observed_(std::move(observed)),
-      S_(sigma_count),
-      nodes_(model.node_count()),
-      elements_(model.element_count()) {
-  check_ensemble_arguments(model, estimated_, observed_, S_, "VulkanEnsemble");
-  tolerance_ = device_cg_tolerance(model, options.precision);
-
+    : DeviceEnsemble(model, std::move(estimated), std::move(observed), sigma_count,
+                     options.precision, "vulkan", "VulkanEnsemble"),
+      device_(options.device, options.precision) {
   // Check the memory before asking for it, to say how much is needed.
-  const std::size_t dof = 3 * static_cast<std::size_t>(nodes_) * S_;
-  const std::size_t per_element = static_cast<std::size_t>(elements_) * S_;
-  const EnsembleMemory need = ensemble_memory(nodes_, elements_, S_, device_.real_size());
   const VulkanDeviceInfo& info = device_.info();
-  if (need.largest > info.max_buffer || need.total > info.memory)
-    throw DeviceError(out_of_device_memory_message(need, elements_, S_, info.name,
-                                                   info.memory, info.max_buffer));
+  check_device_memory(device_.real_size(), info.name, info.memory, info.max_buffer);
   // CG's work-groups per sigma point (conjugate_gradient.comp): by the mesh on a GPU, one on
   // a CPU (lavapipe), where S groups already keep its few cores busy, unless a test forces it.
   cg_partitions_ = info.type == "cpu" && options.cg_partitions == 0
@@ -52,156 +38,101 @@ VulkanEnsemble::VulkanEnsemble(const Model& model, std::vector<int> estimated,
     throw DeviceError("Vulkan device " + info.name + " runs at most " +
                       std::to_string(device_.max_group_count() / cg_partitions_) +
                       " sigma points on this mesh");
-  EnsembleTables tables = make_ensemble_tables(model, S_);
-  ligament_k_ = std::move(tables.ligament_k);
   // Work-items per sigma point in CG: on a CPU (lavapipe) one SIMD register's worth, so that
   // a group's barriers cost nothing; on a GPU 64 (two warps, one wavefront).
   cg_group_ = info.type == "cpu" ? 8 : 64;
 
-  element_nodes_ = make_buffer(tables.element_nodes, "element nodes");
-  element_rest_ = make_buffer(tables.element_rest, "element rest state");
-  incidence_offsets_ = make_buffer(tables.incidence_offsets, "node incidence");
-  incidence_ = make_buffer(tables.incidence, "node incidence");
-  ligament_offsets_ = make_buffer(tables.ligament_offsets, "ligament nodes");
-  ligament_of_node_ = make_buffer(tables.ligament_of_node, "ligament nodes");
-  control_k_ = make_buffer(tables.control_k, "control springs");
-  mass_ = make_buffer(tables.mass, "mass");
-  rest_positions_ = make_buffer(tables.rest_positions, "rest positions");
-  observed_nodes_ = make_buffer(corner_nodes(observed_), "observed points");
-  observed_weights_ = make_buffer(corner_weights(observed_), "observed points");
-  constants_ = make_buffer(step_constants_.size(), "step constants");
-  ligament_k_buffer_ = make_buffer(ligament_k_, "ligament stiffness");
-  x_ = make_buffer(tables.initial_positions, "positions");
-  const std::vector<double> zeros(dof, 0.0);
-  v_ = make_buffer(zeros, "velocities");
-  dv_ = make_buffer(zeros, "velocity change");
-  for (VulkanBuffer* b : {&rhs_, &inverse_diagonal_, &r_, &z_, &d_, &q_})
-    *b = make_buffer(dof, "CG vectors");
-  frames_ = make_buffer(9 * per_element, "element frames");
-  element_out_ = make_buffer(12 * per_element, "element outputs");
-  element_diagonal_ = make_buffer(12 * per_element, "element diagonals");
-  const std::size_t observation_rows = std::max<std::size_t>(1, observed_.size()) * 3;
-  observations_ = make_buffer(observation_rows * S_, "observations");
-  for (VulkanBuffer* b : {&bb_, &rr_, &rz_}) *b = make_buffer(static_cast<std::size_t>(S_), "CG scalars");
-  for (VulkanBuffer* b : {&active_, &converged_, &iterations_})
-    *b = make_buffer(std::vector<int>(S_, 0), "CG flags");
-  all_active_ = make_buffer(std::vector<int>(S_, 1), "CG flags");
-  // The partitions' partial sums and each (sigma point, partition) group's own scalars (bound
-  // but unused with one partition).
-  const std::size_t cg_groups = static_cast<std::size_t>(S_) * cg_partitions_;
-  partial_ = make_buffer(4 * cg_groups, "CG partial sums");
-  own_rz_ = make_buffer(cg_groups, "CG scalars");
-  const std::vector<int> flags(cg_groups, 0);
-  own_active_ = make_buffer(flags, "CG flags");
-  own_iterations_ = make_buffer(flags, "CG flags");
-  recenter_scalars_ = make_buffer(1 + kDeviceMaxParameters, "re-centring");
-  directions_ = make_buffer(static_cast<std::size_t>(kDeviceMaxParameters) * S_, "re-centring");
-  weights_ = make_buffer(static_cast<std::size_t>(kDeviceMaxParameters) * S_, "re-centring");
+  // The partitions' buffers are bound but unused with one partition.
+  for (const DeviceBufferSpec& spec : buffer_specs({0, cg_partitions_})) {
+    const std::size_t bytes = spec.count * (spec.integer ? sizeof(std::int32_t) : device_.real_size());
+    device_bytes_ += bytes;
+    buffers_.push_back(device_.buffer(bytes, spec.what));
+    if (spec.integer) device_.upload(buffers_.back(), spec.integers.data(), bytes);
+    if (!spec.reals.empty()) write_reals(spec.id, spec.reals);
+  }
   // Read-back area: 3 flags and 2 scalars per sigma point, then the observations.
+  const std::size_t observation_rows = std::max<std::size_t>(1, observed_.size()) * 3;
   device_.reserve_read_back(3 * 4 * static_cast<std::size_t>(S_) +
                             (2 + observation_rows) * S_ * device_.real_size());
 
-  // Bindings in the order of each shader's (and the OpenCL kernel's) buffer arguments.
-  k_element_rhs_ = device_.kernel("element_rhs", 8);
-  k_node_rhs_ = device_.kernel("node_rhs", 15);
-  k_element_product_ = device_.kernel("element_product", 7);
-  k_node_product_ = device_.kernel("node_product", 11);
-  // The CG shaders: the start's three share 25 bindings, the iteration's four 17.
-  const std::uint32_t partitions = static_cast<std::uint32_t>(cg_partitions_);
-  k_cg_start_ = device_.kernel("cg_start", 25, cg_group_, partitions);
-  k_cg_iteration_ = device_.kernel("cg_iteration", 17, cg_group_, partitions);
-  if (cg_partitions_ > 1) {
-    k_cg_start_partials_ = device_.kernel("cg_start_partials", 25, cg_group_, partitions);
-    k_cg_start_scalars_ = device_.kernel("cg_start_scalars", 25, cg_group_, partitions);
-    k_cg_dot_ = device_.kernel("cg_dot", 17, cg_group_, partitions);
-    k_cg_update_ = device_.kernel("cg_update", 17, cg_group_, partitions);
-    k_cg_direction_ = device_.kernel("cg_direction", 17, cg_group_, partitions);
-  }
-  k_state_update_ = device_.kernel("state_update", 5);
-  k_observation_gather_ = device_.kernel("observation_gather", 4);
-  k_recenter_ = device_.kernel("recenter", 5);
-
-  s_element_rhs_ = device_.bind(k_element_rhs_, {element_nodes_, element_rest_, frames_, x_, v_,
-                                                 constants_, element_out_, element_diagonal_});
-  const std::vector<VulkanBuffer> node_shared = {constants_, incidence_offsets_, incidence_,
-                                                 ligament_offsets_, ligament_of_node_,
-                                                 ligament_k_buffer_, control_k_, mass_};
-  auto with_shared = [&](std::vector<VulkanBuffer> rest) {
-    std::vector<VulkanBuffer> all = node_shared;
-    all.insert(all.end(), rest.begin(), rest.end());
-    return all;
+  using B = DeviceBuffer;
+  auto kernel = [&](const char* name, DeviceKernel k) {
+    return device_.kernel(name, static_cast<int>(kernel_buffers(k).size()));
   };
-  s_node_rhs_ = device_.bind(k_node_rhs_, with_shared({rest_positions_, x_, v_, element_out_,
-                                                       element_diagonal_, rhs_, inverse_diagonal_}));
-  s_product_warm_start_ = device_.bind(
-      k_element_product_, {element_nodes_, element_rest_, frames_, dv_, all_active_, element_out_, constants_});
-  s_product_cg_ = device_.bind(k_element_product_,
-                               {element_nodes_, element_rest_, frames_, d_, active_, element_out_, constants_});
-  s_product_all_ = device_.bind(
-      k_element_product_, {element_nodes_, element_rest_, frames_, d_, all_active_, element_out_, constants_});
-  s_node_product_ = device_.bind(k_node_product_, with_shared({d_, element_out_, q_}));
-  const std::vector<VulkanBuffer> start_buffers = with_shared(
-      {element_out_, rhs_, inverse_diagonal_, dv_, r_, z_, d_, bb_, rr_, rz_, active_, converged_,
-       iterations_, partial_, own_active_, own_iterations_, own_rz_});
-  const std::vector<VulkanBuffer> iteration_buffers = {
-      constants_, inverse_diagonal_, dv_,     r_,          z_,         d_,
-      q_,         bb_,               rr_,     rz_,         active_,    converged_,
-      iterations_, partial_,         own_active_, own_iterations_, own_rz_};
-  s_cg_start_ = device_.bind(k_cg_start_, start_buffers);
-  s_cg_iteration_ = device_.bind(k_cg_iteration_, iteration_buffers);
+  k_element_rhs_ = kernel("element_rhs", DeviceKernel::element_rhs);
+  k_node_rhs_ = kernel("node_rhs", DeviceKernel::node_rhs);
+  k_element_product_ = kernel("element_product", DeviceKernel::element_product);
+  k_node_product_ = kernel("node_product", DeviceKernel::node_product);
+  k_state_update_ = kernel("state_update", DeviceKernel::state_update);
+  k_observation_gather_ = kernel("observation_gather", DeviceKernel::observation_gather);
+  k_recenter_ = kernel("recenter", DeviceKernel::recenter);
+  // The CG shaders (conjugate_gradient.comp): the start's three share one set of bindings
+  // (the node rows' buffers first: cg_start does the warm start's gather), the iteration's
+  // four another.
+  std::vector<DeviceBuffer> start = kernel_buffers(DeviceKernel::node_product);
+  start.resize(8);
+  start.insert(start.end(), {B::element_out, B::rhs, B::inverse_diagonal, B::dv, B::r, B::z, B::d,
+                             B::bb, B::rr, B::rz, B::active, B::converged, B::iterations,
+                             B::partial, B::own_active, B::own_iterations, B::own_rz});
+  const std::vector<DeviceBuffer> iteration = {
+      B::constants, B::inverse_diagonal, B::dv, B::r, B::z, B::d, B::q, B::bb, B::rr, B::rz,
+      B::active, B::converged, B::iterations, B::partial, B::own_active, B::own_iterations,
+      B::own_rz};
+  const std::uint32_t partitions = static_cast<std::uint32_t>(cg_partitions_);
+  auto cg_kernel = [&](const char* name, const std::vector<DeviceBuffer>& buffers) {
+    return device_.kernel(name, static_cast<int>(buffers.size()), cg_group_, partitions);
+  };
+  k_cg_start_ = cg_kernel("cg_start", start);
+  k_cg_iteration_ = cg_kernel("cg_iteration", iteration);
   if (cg_partitions_ > 1) {
-    s_cg_start_partials_ = device_.bind(k_cg_start_partials_, start_buffers);
-    s_cg_start_scalars_ = device_.bind(k_cg_start_scalars_, start_buffers);
-    s_cg_dot_ = device_.bind(k_cg_dot_, iteration_buffers);
-    s_cg_update_ = device_.bind(k_cg_update_, iteration_buffers);
-    s_cg_direction_ = device_.bind(k_cg_direction_, iteration_buffers);
+    k_cg_start_partials_ = cg_kernel("cg_start_partials", start);
+    k_cg_start_scalars_ = cg_kernel("cg_start_scalars", start);
+    k_cg_dot_ = cg_kernel("cg_dot", iteration);
+    k_cg_update_ = cg_kernel("cg_update", iteration);
+    k_cg_direction_ = cg_kernel("cg_direction", iteration);
   }
-  s_state_update_ = device_.bind(k_state_update_, {constants_, bb_, dv_, x_, v_});
-  s_observation_gather_ =
-      device_.bind(k_observation_gather_, {observed_nodes_, observed_weights_, x_, observations_});
-  s_recenter_ = device_.bind(k_recenter_, {recenter_scalars_, directions_, weights_, x_, v_});
+
+  s_element_rhs_ = bind(k_element_rhs_, kernel_buffers(DeviceKernel::element_rhs));
+  s_node_rhs_ = bind(k_node_rhs_, kernel_buffers(DeviceKernel::node_rhs));
+  const std::vector<DeviceBuffer>& product = kernel_buffers(DeviceKernel::element_product);
+  s_product_warm_start_ = bind(k_element_product_, with_buffer(with_buffer(product, B::d, B::dv),
+                                                               B::active, B::all_active));
+  s_product_cg_ = bind(k_element_product_, product);
+  s_product_all_ = bind(k_element_product_, with_buffer(product, B::active, B::all_active));
+  s_node_product_ = bind(k_node_product_, kernel_buffers(DeviceKernel::node_product));
+  s_cg_start_ = bind(k_cg_start_, start);
+  s_cg_iteration_ = bind(k_cg_iteration_, iteration);
+  if (cg_partitions_ > 1) {
+    s_cg_start_partials_ = bind(k_cg_start_partials_, start);
+    s_cg_start_scalars_ = bind(k_cg_start_scalars_, start);
+    s_cg_dot_ = bind(k_cg_dot_, iteration);
+    s_cg_update_ = bind(k_cg_update_, iteration);
+    s_cg_direction_ = bind(k_cg_direction_, iteration);
+  }
+  s_state_update_ = bind(k_state_update_, kernel_buffers(DeviceKernel::state_update));
+  s_observation_gather_ = bind(k_observation_gather_, kernel_buffers(DeviceKernel::observation_gather));
+  s_recenter_ = bind(k_recenter_, kernel_buffers(DeviceKernel::recenter));
 }
 
-VulkanBuffer VulkanEnsemble::make_buffer(std::size_t count, const char* what) {
-  const std::size_t bytes = std::max<std::size_t>(1, count) * device_.real_size();
-  device_bytes_ += bytes;
-  return device_.buffer(bytes, what);
+VkDescriptorSet VulkanEnsemble::bind(const VulkanKernel& kernel, const std::vector<DeviceBuffer>& buffers) {
+  std::vector<VulkanBuffer> bound;
+  for (DeviceBuffer id : buffers) bound.push_back(buffer(id));
+  return device_.bind(kernel, bound);
 }
 
-VulkanBuffer VulkanEnsemble::make_buffer(const std::vector<double>& values, const char* what) {
-  VulkanBuffer buffer = make_buffer(values.size(), what);
-  write(buffer, values);
-  return buffer;
-}
-
-VulkanBuffer VulkanEnsemble::make_buffer(const std::vector<int>& values, const char* what) {
-  const std::size_t bytes = values.size() * sizeof(std::int32_t);
-  device_bytes_ += bytes;
-  VulkanBuffer buffer = device_.buffer(bytes, what);
-  device_.upload(buffer, values.data(), bytes);
-  return buffer;
-}
-
-void VulkanEnsemble::write(const VulkanBuffer& buffer, const std::vector<double>& values) const {
+void VulkanEnsemble::write_reals(DeviceBuffer id, const std::vector<double>& values) {
   const std::vector<unsigned char> bytes = to_device_reals(values, device_.precision());
-  device_.upload(buffer, bytes.data(), bytes.size());
+  device_.upload(buffer(id), bytes.data(), bytes.size());
 }
 
-std::vector<double> VulkanEnsemble::read(const VulkanBuffer& buffer, std::size_t count) const {
+std::vector<double> VulkanEnsemble::read_reals(DeviceBuffer id, std::size_t count) const {
+  flush_pending();
   std::vector<unsigned char> bytes(count * device_.real_size());
-  device_.download(buffer, bytes.data(), bytes.size());
+  device_.download(buffer(id), bytes.data(), bytes.size());
   return from_device_reals(bytes.data(), count, device_.precision());
 }
 
-std::vector<double> VulkanEnsemble::column_of(const VulkanBuffer& buffer, std::size_t rows,
-                                              int s) const {
-  flush_pending();
-  return sigma_column(read(buffer, rows * S_), rows, S_, s, "VulkanEnsemble");
-}
-
-void VulkanEnsemble::set_parameters(const Eigen::MatrixXd& theta) {
-  check_parameter_matrix(theta, parameter_count(), sigma_count(), "VulkanEnsemble");
-  set_ligament_stiffness(model_, estimated_, theta, S_, ligament_k_);
+void VulkanEnsemble::write_ligament_stiffness() {
   pending_ligament_k_ = to_device_reals(ligament_k_, device_.precision());
 }
 
@@ -212,11 +143,11 @@ bool VulkanEnsemble::has_pending() const {
 void VulkanEnsemble::record_pending(VkCommandBuffer cmd) const {
   if (!has_pending()) return;
   if (!pending_ligament_k_.empty())
-    device_.update(cmd, ligament_k_buffer_, pending_ligament_k_.data(), pending_ligament_k_.size());
+    device_.update(cmd, buffer(DeviceBuffer::ligament_k), pending_ligament_k_.data(), pending_ligament_k_.size());
   if (pending_recenter_) {
-    device_.update(cmd, recenter_scalars_, pending_scalars_.data(), pending_scalars_.size());
-    device_.update(cmd, directions_, pending_directions_.data(), pending_directions_.size());
-    device_.update(cmd, weights_, pending_weights_.data(), pending_weights_.size());
+    device_.update(cmd, buffer(DeviceBuffer::recenter_scalars), pending_scalars_.data(), pending_scalars_.size());
+    device_.update(cmd, buffer(DeviceBuffer::directions), pending_directions_.data(), pending_directions_.size());
+    device_.update(cmd, buffer(DeviceBuffer::weights), pending_weights_.data(), pending_weights_.size());
   }
   device_.barrier(cmd);
   if (pending_recenter_)
@@ -287,7 +218,7 @@ StepReport VulkanEnsemble::advance(const Eigen::Vector3d& so_position) {
   record_pending(cmd);
   const std::vector<unsigned char> constants =
       to_device_reals(step_constants_.next_step(model_, so_position), device_.precision());
-  device_.update(cmd, constants_, constants.data(), constants.size());
+  device_.update(cmd, buffer(DeviceBuffer::constants), constants.data(), constants.size());
   device_.barrier(cmd);
   dispatch_items(cmd, k_element_rhs_, s_element_rhs_, elements_ * S, elements_);
   dispatch_items(cmd, k_node_rhs_, s_node_rhs_, nodes_ * S, nodes_);
@@ -316,7 +247,7 @@ StepReport VulkanEnsemble::advance(const Eigen::Vector3d& so_position) {
     const int count = std::min(batch, cap - done);
     record_cg_iterations(cmd, count);
     done += count;
-    device_.copy_to_host(cmd, active_, 4 * S, at_active);
+    device_.copy_to_host(cmd, buffer(DeviceBuffer::active), 4 * S, at_active);
     device_.submit_and_wait(cmd);
     ++last_step_waits_;
     std::memcpy(active.data(), static_cast<const unsigned char*>(device_.read_back()) + at_active,
@@ -333,12 +264,12 @@ StepReport VulkanEnsemble::advance(const Eigen::Vector3d& so_position) {
   if (rows > 0) {
     dispatch_items(cmd, k_observation_gather_, s_observation_gather_, rows * S,
                    static_cast<std::uint32_t>(observed_.size()));
-    device_.copy_to_host(cmd, observations_, rows * S * real, at_observations);
+    device_.copy_to_host(cmd, buffer(DeviceBuffer::observations), rows * S * real, at_observations);
   }
-  device_.copy_to_host(cmd, iterations_, 4 * S, at_iterations);
-  device_.copy_to_host(cmd, converged_, 4 * S, at_converged);
-  device_.copy_to_host(cmd, rr_, real * S, at_rr);
-  device_.copy_to_host(cmd, bb_, real * S, at_bb);
+  device_.copy_to_host(cmd, buffer(DeviceBuffer::iterations), 4 * S, at_iterations);
+  device_.copy_to_host(cmd, buffer(DeviceBuffer::converged), 4 * S, at_converged);
+  device_.copy_to_host(cmd, buffer(DeviceBuffer::rr), real * S, at_rr);
+  device_.copy_to_host(cmd, buffer(DeviceBuffer::bb), real * S, at_bb);
   device_.submit_and_wait(cmd);
   ++last_step_waits_;
 
@@ -368,16 +299,12 @@ void VulkanEnsemble::predicted_observations(Eigen::MatrixXd& y) const {
     record_pending(cmd);
     dispatch_items(cmd, k_observation_gather_, s_observation_gather_, rows * S_,
                    static_cast<std::uint32_t>(observed_.size()));
-    device_.copy_to_host(cmd, observations_, rows * S_ * device_.real_size(), 0);
+    device_.copy_to_host(cmd, buffer(DeviceBuffer::observations), rows * S_ * device_.real_size(), 0);
     device_.submit_and_wait(cmd);
     observations_cache_ = from_device_reals(device_.read_back(), rows * S_, device_.precision());
     observations_current_ = true;
   }
   y = from_sigma_rows(observations_cache_, rows, S_);
-}
-
-void VulkanEnsemble::set_physics_effects(const std::vector<PhysicsEffects>& effects) {
-  step_constants_.set_physics_effects(effects, "VulkanEnsemble");
 }
 
 void VulkanEnsemble::recenter(const Recentering& r) {
@@ -391,34 +318,11 @@ void VulkanEnsemble::recenter(const Recentering& r) {
   observations_current_ = false;
 }
 
-Eigen::VectorXd VulkanEnsemble::positions(int s) const {
-  const std::vector<double> column = column_of(x_, 3 * static_cast<std::size_t>(nodes_), s);
-  return Eigen::Map<const Eigen::VectorXd>(column.data(), static_cast<Eigen::Index>(column.size()));
-}
-
-Eigen::VectorXd VulkanEnsemble::velocities(int s) const {
-  const std::vector<double> column = column_of(v_, 3 * static_cast<std::size_t>(nodes_), s);
-  return Eigen::Map<const Eigen::VectorXd>(column.data(), static_cast<Eigen::Index>(column.size()));
-}
-
-std::vector<double> VulkanEnsemble::frames(int s) const {
-  return column_of(frames_, 9 * static_cast<std::size_t>(elements_), s);
-}
-
-Eigen::MatrixXd VulkanEnsemble::system_product(const Eigen::MatrixXd& d) {
-  const std::size_t rows = 3 * static_cast<std::size_t>(nodes_);
-  if (static_cast<std::size_t>(d.rows()) != rows || d.cols() != S_)
-    throw std::invalid_argument("VulkanEnsemble::system_product: expected 3N x S");
-  write(d_, to_sigma_rows(d));
+void VulkanEnsemble::run_system_product() {
   VkCommandBuffer cmd = device_.begin();
   record_pending(cmd);
   record_system_product(cmd, s_product_all_);
   device_.submit_and_wait(cmd);
-  return from_sigma_rows(read(q_, rows * S_), rows, S_);
-}
-
-std::string VulkanEnsemble::description() const {
-  return device_ensemble_description("vulkan", device_.precision(), device_.info().name);
 }
 
 }  // namespace sigmafem

@@ -1,7 +1,7 @@
 // VulkanEnsemble: the Ensemble (filter/ensemble.h) with all S sigma-point simulations
 // advancing together in Vulkan compute shaders (kernels/vulkan/, named as the OpenCL kernels
 // of kernels/opencl/), behind the same DeviceEnsemble interface as OpenClEnsemble, with the
-// same layout (host/ensemble/ensemble_tables.h) and the same deterministic assembly (a
+// same buffers (host/ensemble/device_buffers.h) and the same deterministic assembly (a
 // per-node gather in a fixed order, fixed-tree reductions; no float atomics).
 //
 // A step is recorded into command buffers, not enqueued kernel by kernel: the right-hand
@@ -21,7 +21,6 @@
 #include <vector>
 
 #include "host/ensemble/device_ensemble.h"
-#include "host/ensemble/ensemble_tables.h"
 #include "host/model/model.h"
 #include "host/vulkan/vulkan_device.h"
 
@@ -29,29 +28,16 @@ namespace sigmafem {
 
 class VulkanEnsemble : public DeviceEnsemble {
  public:
-
   // `estimated`: indices into model.ligaments whose log-stiffness the parameters are;
-  // `observed`: the observed points (node indices convert). Throws DeviceError (no device, shader failure, too little memory).
+  // `observed`: the observed points (node indices convert). Throws DeviceError (no device,
+  // shader failure, too little memory).
   VulkanEnsemble(const Model& model, std::vector<int> estimated, ObservedPoints observed,
                  int sigma_count, const DeviceOptions& options);
 
-  int sigma_count() const override { return S_; }
-  int parameter_count() const override { return static_cast<int>(estimated_.size()); }
-  int observation_count() const override { return 3 * static_cast<int>(observed_.size()); }
-  void set_parameters(const Eigen::MatrixXd& theta) override;
   StepReport advance(const Eigen::Vector3d& so_position) override;
   void predicted_observations(Eigen::MatrixXd& y) const override;
   void recenter(const Recentering& recentering) override;
-
-  Eigen::VectorXd positions(int s) const override;
-  Eigen::VectorXd velocities(int s) const override;
-  std::vector<double> frames(int s) const override;
-  Eigen::MatrixXd system_product(const Eigen::MatrixXd& d) override;
-  double cg_tolerance() const override { return tolerance_; }
-  std::string description() const override;
-  void set_physics_effects(const std::vector<PhysicsEffects>& effects) override;
   const VulkanDeviceInfo& device_info() const { return device_.info(); }
-  std::size_t device_bytes() const { return device_bytes_; }
   // Host waits (command-buffer submissions) of the last advance().
   int last_step_waits() const { return last_step_waits_; }
 
@@ -63,13 +49,14 @@ class VulkanEnsemble : public DeviceEnsemble {
     std::int32_t max_iterations = 0;
     std::uint32_t p = 0;
   };
-  VulkanBuffer make_buffer(std::size_t count, const char* what);
-  VulkanBuffer make_buffer(const std::vector<double>& values, const char* what);
-  VulkanBuffer make_buffer(const std::vector<int>& values, const char* what);
-  void write(const VulkanBuffer& buffer, const std::vector<double>& values) const;
-  std::vector<double> read(const VulkanBuffer& buffer, std::size_t count) const;
-  // Sigma point s's column of a per-row buffer (host/ensemble/device_readout.h).
-  std::vector<double> column_of(const VulkanBuffer& buffer, std::size_t rows, int s) const;
+  std::vector<double> read_reals(DeviceBuffer buffer, std::size_t count) const override;
+  void write_reals(DeviceBuffer buffer, const std::vector<double>& values) override;
+  void write_ligament_stiffness() override;
+  std::string device_name() const override { return device_.info().name; }
+  void run_system_product() override;
+  const VulkanBuffer& buffer(DeviceBuffer id) const { return buffers_[static_cast<int>(id)]; }
+  // A descriptor set of `kernel` with `buffers` at bindings 0, 1, ...
+  VkDescriptorSet bind(const VulkanKernel& kernel, const std::vector<DeviceBuffer>& buffers);
 
   // Recording (kernels/vulkan/<file>.comp holds the shader of the same name).
   void dispatch_items(VkCommandBuffer cmd, const VulkanKernel& kernel, VkDescriptorSet set,
@@ -83,17 +70,8 @@ class VulkanEnsemble : public DeviceEnsemble {
   void flush_pending() const;
 
   mutable VulkanDevice device_;
-  Model model_;
-  StepConstants step_constants_;            // per step, with the per-sigma effects
-  std::vector<int> estimated_;
-  ObservedPoints observed_;
-  int S_ = 0, nodes_ = 0, elements_ = 0;
-  double tolerance_ = 0.0;
-  std::size_t device_bytes_ = 0;
-  std::vector<double> ligament_k_;
   std::uint32_t cg_group_ = 64;              // work-items per sigma point in the CG shaders
   int cg_partitions_ = 1;                    // work-groups per sigma point in them (constant 1)
-  int expected_iterations_ = 1;              // CG iterations the last step needed (at most)
   int last_step_waits_ = 0;
   // The observations gathered at the end of the last advance(), until recenter() moves x.
   mutable std::vector<double> observations_cache_;
@@ -104,17 +82,7 @@ class VulkanEnsemble : public DeviceEnsemble {
   mutable std::vector<unsigned char> pending_ligament_k_;
   mutable std::vector<unsigned char> pending_scalars_, pending_directions_, pending_weights_;
   mutable bool pending_recenter_ = false;
-
-  // Shared data.
-  VulkanBuffer element_nodes_, element_rest_, incidence_offsets_, incidence_;
-  VulkanBuffer ligament_offsets_, ligament_of_node_, control_k_, mass_, rest_positions_;
-  VulkanBuffer observed_nodes_, observed_weights_, constants_;
-  // Per-sigma data.
-  VulkanBuffer ligament_k_buffer_, x_, v_, dv_, rhs_, inverse_diagonal_, r_, z_, d_, q_;
-  VulkanBuffer frames_, element_out_, element_diagonal_, observations_;
-  VulkanBuffer bb_, rr_, rz_, active_, converged_, iterations_, all_active_;
-  VulkanBuffer partial_, own_active_, own_iterations_, own_rz_;   // CG's partitions
-  VulkanBuffer recenter_scalars_, directions_, weights_;
+  std::vector<VulkanBuffer> buffers_;        // by DeviceBuffer
 
   VulkanKernel k_element_rhs_, k_node_rhs_, k_element_product_, k_node_product_;
   VulkanKernel k_cg_start_, k_cg_iteration_, k_state_update_, k_observation_gather_, k_recenter_;

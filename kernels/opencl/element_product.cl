@@ -14,11 +14,11 @@
  * went through memory twice per iteration. */
 #include "element_chunk.h"
 
-__kernel void element_product(uint S, uint element_count, __global const int* restrict nodes,
+__kernel void element_product(uint S, uint element_count, uint node_count,
+                              __global const int* restrict nodes,
                               __global const real* restrict rest, __global const real* restrict frames,
                               __global const real* restrict d, __global const uint* restrict active,
-                              __global real* restrict out, uint node_count,
-                              __global const real* restrict c) {
+                              __global real* restrict out, __global const real* restrict c) {
 #if SF_ELEMENT_CHUNKS > 0
   uint chunk = (uint)get_global_id(0);
   if (chunk >= SF_ELEMENT_CHUNKS) return;

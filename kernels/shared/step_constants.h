@@ -1,6 +1,6 @@
 /* step_constants.h: the implicit Euler constants of one step, in a small buffer the host
  * writes each step (a buffer, not a struct argument, so that host and device never disagree
- * on padding). Shared by the host (host/ensemble/ensemble_tables.cpp), the OpenCL kernels and
+ * on padding). Shared by the host (host/ensemble/device_step_constants.cpp), the OpenCL kernels and
  * the Vulkan shaders: one numbering. After the SF_STEP_CONSTANTS shared numbers come
  * SF_SIGMA_CONSTANT_COUNT numbers per sigma point s, at [SF_STEP_CONSTANTS + k S + s]
  * (SF_SIGMA_CONSTANT): what the candidate effects (host/model/effects.h) may set per sigma

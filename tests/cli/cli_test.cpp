@@ -15,7 +15,7 @@
 #include "cli/sigmafem_command.h"
 #include "host/data/observation_table.h"
 #include "host/data/point_cloud_table.h"
-#include "host/ensemble/choose_backend.h"
+#include "host/engine/choose_backend.h"
 #include "host/scenario/scenario.h"
 #include "requirement.h"
 #include "temp_path.h"

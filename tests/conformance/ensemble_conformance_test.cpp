@@ -9,7 +9,7 @@
 // to 1e-10 m. In single precision (float32, unit roundoff 6e-8) the positions of an organ
 // some 0.3 m from the origin are held to about 2e-8 m and each element's edge vectors to
 // a relative 1e-6 (1 cm edges), and the solve stops at a relative residual of 1e-6
-// (kSingleCgTolerance, host/ensemble/ensemble_tables.h).
+// (kSingleCgTolerance, host/ensemble/device_limits.h).
 //
 // Each tolerance is a small multiple (about 10x, stated next to it) of the largest difference
 // measured over every case here (PoCL and lavapipe, box and liver, S = 1, 4, 16; stop 28): far
@@ -28,16 +28,16 @@
 #include <random>
 #include <string>
 
+#include "host/engine/make_ensemble.h"
 #include "host/ensemble/cpu_ensemble.h"
 #include "host/ensemble/device_ensemble.h"
-#include "host/ensemble/make_ensemble.h"
 #include "host/mesh/mesh_locate.h"
 #include "host/model/model.h"
 #include "host/opencl/opencl_device.h"
-#include "host/vulkan/vulkan_device.h"
 #include "host/reference/implicit_euler.h"
 #include "host/reference/reference_simulation.h"
 #include "host/scenario/scenario.h"
+#include "host/vulkan/vulkan_device.h"
 #include "requirement.h"
 
 namespace sigmafem {

@@ -24,15 +24,15 @@
 #include <sstream>
 #include <string>
 
-#include "generated_data.h"
-#include "requirement.h"
-#include "tests/filter/scenario_filter_options.h"
 #include "filter/estimation.h"
-#include "host/ensemble/make_ensemble.h"
+#include "generated_data.h"
+#include "host/engine/make_ensemble.h"
 #include "host/model/model.h"
 #include "host/opencl/opencl_device.h"
 #include "host/scenario/scenario.h"
 #include "host/vulkan/vulkan_device.h"
+#include "requirement.h"
+#include "tests/filter/scenario_filter_options.h"
 
 namespace sigmafem {
 namespace {

@@ -10,12 +10,12 @@
 
 #include "host/common/device_error.h"
 #include "host/common/input_error.h"
+#include "host/engine/make_ensemble.h"
 #include "host/ensemble/cpu_ensemble.h"
-#include "host/ensemble/make_ensemble.h"
 #include "host/model/effects.h"
 #include "host/opencl/opencl_device.h"
-#include "host/vulkan/vulkan_device.h"
 #include "host/scenario/scenario.h"
+#include "host/vulkan/vulkan_device.h"
 #include "requirement.h"
 
 namespace sigmafem {
@@ -47,7 +47,7 @@ class EffectEnsembleTest : public ::testing::Test {
 };
 
 TEST_F(EffectEnsembleTest, AnExtraLigamentIsOneMoreEstimatedLigament) {
-  auto ensemble = EffectEnsemble::make("cpu", model_, scenario_.filter->estimate, scenario_.observations.nodes,
+  auto ensemble = make_effect_ensemble("cpu", model_, scenario_.filter->estimate, scenario_.observations.nodes,
                                        kSigma, {}, effects_);
   ASSERT_EQ(ensemble->parameter_count(), 7);
   ensemble->set_parameters(theta_);
@@ -92,9 +92,9 @@ TEST_P(EffectEnsembleOnDevice, AnExtraLigamentAndACameraOffsetRunAsOnTheCpu) {
   }
   DeviceOptions options;
   options.precision = Precision::double_precision;
-  auto cpu = EffectEnsemble::make("cpu", model_, scenario_.filter->estimate, scenario_.observations.nodes, kSigma,
+  auto cpu = make_effect_ensemble("cpu", model_, scenario_.filter->estimate, scenario_.observations.nodes, kSigma,
                                   {}, effects_);
-  auto opencl = EffectEnsemble::make(GetParam(), model_, scenario_.filter->estimate, scenario_.observations.nodes,
+  auto opencl = make_effect_ensemble(GetParam(), model_, scenario_.filter->estimate, scenario_.observations.nodes,
                                      kSigma, options, effects_);
   cpu->set_parameters(theta_);
   opencl->set_parameters(theta_);
@@ -143,11 +143,11 @@ TEST_P(EffectEnsembleOnDevice, EveryPhysicsEffectPerSigmaPointRunsAsOnTheCpu) {
   }
   DeviceOptions options;
   options.precision = Precision::double_precision;
-  auto cpu = EffectEnsemble::make("cpu", model, scenario_.filter->estimate, scenario_.observations.nodes, kSigma, {},
+  auto cpu = make_effect_ensemble("cpu", model, scenario_.filter->estimate, scenario_.observations.nodes, kSigma, {},
                                   effects);
   std::unique_ptr<EffectEnsemble> device;
   try {
-    device = EffectEnsemble::make(GetParam(), model, scenario_.filter->estimate, scenario_.observations.nodes,
+    device = make_effect_ensemble(GetParam(), model, scenario_.filter->estimate, scenario_.observations.nodes,
                                   kSigma, options, effects);
   } catch (const DeviceError& e) {
     SIGMAFEM_MISSING(e.what());

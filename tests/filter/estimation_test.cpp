@@ -7,9 +7,9 @@
 #include <gtest/gtest.h>
 
 #include "generated_data.h"
+#include "host/engine/estimation_options.h"
 #include "host/ensemble/cpu_ensemble.h"
 #include "host/model/model.h"
-#include "host/scenario/estimation_options.h"
 #include "host/scenario/scenario.h"
 
 namespace sigmafem {

@@ -1,9 +1,9 @@
-// The filter a scenario describes (host/scenario/estimation_options.h) with the sigma-point
+// The filter a scenario describes (host/engine/estimation_options.h) with the sigma-point
 // set and the observation noise a test chooses. Header-only: tests compile *_test.cpp only.
 #pragma once
 
 #include "filter/estimation.h"
-#include "host/scenario/estimation_options.h"
+#include "host/engine/estimation_options.h"
 
 namespace sigmafem::test {
 

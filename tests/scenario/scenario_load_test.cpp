@@ -16,12 +16,12 @@
 #include <set>
 #include <sstream>
 
-#include "requirement.h"
-#include "temp_path.h"
 #include "host/common/input_error.h"
+#include "host/engine/estimation_options.h"
 #include "host/model/model.h"
 #include "host/scenario/scenario.h"
-#include "host/scenario/estimation_options.h"
+#include "requirement.h"
+#include "temp_path.h"
 
 namespace sigmafem {
 namespace {

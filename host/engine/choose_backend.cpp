@@ -1,4 +1,4 @@
-#include "host/ensemble/choose_backend.h"
+#include "host/engine/choose_backend.h"
 
 #include "host/opencl/opencl_device.h"
 #include "host/vulkan/vulkan_device.h"

@@ -1,4 +1,4 @@
-#include "host/ensemble/surface_cloud_estimation.h"
+#include "host/engine/surface_cloud_estimation.h"
 
 #include <algorithm>
 #include <cmath>
@@ -6,8 +6,8 @@
 #include "host/common/input_error.h"
 #include "host/common/machine_memory.h"
 #include "host/data/csv_format.h"
+#include "host/engine/make_ensemble.h"
 #include "host/ensemble/effect_ensemble.h"
-#include "host/ensemble/make_ensemble.h"
 
 namespace sigmafem {
 
@@ -48,9 +48,11 @@ SurfaceCloudEstimation make_surface_cloud_estimation(const std::string& backend,
     if (estimation.frames[k].points.cols() > 0) estimation.measured.row(static_cast<Eigen::Index>(k)).setZero();
   const PointCloudOptions options = take_outlier_gate(roukf);
   const ObservedPoints observed(surface.nodes);
-  std::unique_ptr<Ensemble> organ =
-      effects.empty() ? make_ensemble(backend, model, estimated, observed, sigma_count, device)
-                      : EffectEnsemble::make(backend, model, estimated, observed, sigma_count, device, effects);
+  std::unique_ptr<Ensemble> organ;
+  if (effects.empty())
+    organ = make_ensemble(backend, model, estimated, observed, sigma_count, device);
+  else
+    organ = make_effect_ensemble(backend, model, estimated, observed, sigma_count, device, effects);
   estimation.ensemble = std::make_unique<PointCloudObservation>(std::move(organ), surface.triangles, options);
   return estimation;
 }

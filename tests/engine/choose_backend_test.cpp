@@ -1,7 +1,7 @@
-// `--backend auto` (host/ensemble/choose_backend.h): the CPU back end without a GPU or below
+// `--backend auto` (host/engine/choose_backend.h): the CPU back end without a GPU or below
 // kGpuPairs element-sigma pairs, OpenCL's GPU before Vulkan's above; a named back end is
 // taken as it is.
-#include "host/ensemble/choose_backend.h"
+#include "host/engine/choose_backend.h"
 
 #include <gtest/gtest.h>
 

@@ -7,7 +7,7 @@
 //   error within 1.5x of the same data without the faults, the truth inside +-2 std on 90%
 //   of the scored steps;
 //   frames at 30 Hz with 3 ms jitter as good as the same frames on the step grid.
-#include "host/ensemble/surface_cloud_estimation.h"
+#include "host/engine/surface_cloud_estimation.h"
 
 #include <gtest/gtest.h>
 

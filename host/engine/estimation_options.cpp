@@ -1,4 +1,4 @@
-#include "host/scenario/estimation_options.h"
+#include "host/engine/estimation_options.h"
 
 #include <cmath>
 

@@ -1,0 +1,51 @@
+#include "host/engine/make_ensemble.h"
+
+#include "host/common/input_error.h"
+#include "host/engine/choose_backend.h"
+#include "host/ensemble/cpu_ensemble.h"
+#include "host/model/effects.h"
+#include "host/opencl/opencl_ensemble.h"
+#include "host/vulkan/vulkan_ensemble.h"
+
+namespace sigmafem {
+
+std::vector<std::string> available_backends() { return {"cpu", "opencl", "vulkan"}; }
+
+std::unique_ptr<SimulationEnsemble> make_ensemble(const std::string& backend, const Model& model,
+                                                  const std::vector<int>& estimated,
+                                                  const ObservedPoints& observed, int sigma_count,
+                                                  const DeviceOptions& options) {
+  if (backend == "auto")
+    return make_ensemble(resolve_backend(backend, model, sigma_count).backend, model, estimated,
+                         observed, sigma_count, options);
+  if (backend == "cpu")
+    return std::make_unique<CpuEnsemble>(model, estimated, observed, sigma_count, 0,
+                                         options.preconditioner);
+  if (options.preconditioner == Preconditioner::factorised)
+    throw InputError("--preconditioner factorised: only the cpu back end has it (the " + backend +
+                     " kernels precondition CG with Jacobi)");
+  if (backend == "opencl")
+    return std::make_unique<OpenClEnsemble>(model, estimated, observed, sigma_count, options);
+  if (backend == "vulkan")
+    return std::make_unique<VulkanEnsemble>(model, estimated, observed, sigma_count, options);
+  std::string names;
+  for (const std::string& name : available_backends()) names += (names.empty() ? "" : ", ") + name;
+  throw InputError("--backend " + backend + ": unknown back end (available: " + names + ")");
+}
+
+std::unique_ptr<EffectEnsemble> make_effect_ensemble(const std::string& backend, Model model,
+                                                     std::vector<int> estimated,
+                                                     const ObservedPoints& observed, int sigma_count,
+                                                     const DeviceOptions& options,
+                                                     const std::vector<std::string>& effects) {
+  for (const std::string& name : effects) {
+    const EffectDefinition* definition = find_effect(name);
+    // The stiffness is a placeholder: set_parameters gives every sigma point its own.
+    if (definition && definition->side == EffectSide::ligament)
+      estimated.push_back(add_extra_ligament(model, name, 0.0));
+  }
+  return std::make_unique<EffectEnsemble>(
+      make_ensemble(backend, model, estimated, observed, sigma_count, options), effects);
+}
+
+}  // namespace sigmafem

@@ -1,0 +1,193 @@
+#include "host/ensemble/device_buffers.h"
+
+#include <algorithm>
+#include <cmath>
+#include <stdexcept>
+#include <string>
+
+namespace sigmafem {
+namespace {
+
+// Offsets of a CSR list of `counts[n]` entries per node: offsets[n] .. offsets[n + 1].
+std::vector<int> csr_offsets(std::vector<int> counts) {
+  std::vector<int> offsets(counts.size() + 1, 0);
+  for (std::size_t n = 0; n < counts.size(); ++n) offsets[n + 1] = offsets[n] + counts[n];
+  return offsets;
+}
+
+}  // namespace
+
+std::vector<DeviceBufferSpec> device_buffer_specs(const Model& model, const ObservedPoints& observed,
+                                                  int S, std::size_t step_constant_count,
+                                                  const DeviceBufferSizes& sizes) {
+  const int nodes = model.node_count(), elements = model.element_count();
+  const int L = static_cast<int>(model.ligaments.size());
+  const std::size_t dof = 3 * static_cast<std::size_t>(nodes) * S;
+  const std::size_t per_element = static_cast<std::size_t>(elements) * S;
+
+  std::vector<int> element_nodes(4 * static_cast<std::size_t>(elements));
+  std::vector<double> element_rest(16 * static_cast<std::size_t>(elements), 0.0);
+  std::vector<int> corners_per_node(nodes, 0), ligaments_per_node(nodes, 0);
+  for (int e = 0; e < elements; ++e) {
+    const ElementRest& element = model.elements[e];
+    for (int c = 0; c < 4; ++c) {
+      element_nodes[4 * e + c] = element.nodes[c];
+      ++corners_per_node[element.nodes[c]];
+    }
+    std::copy(element.grad.begin(), element.grad.end(), element_rest.begin() + 16 * e);
+    element_rest[16 * e + 12] = element.vlambda;
+    element_rest[16 * e + 13] = element.vmu;
+  }
+  const std::vector<int> incidence_offsets = csr_offsets(corners_per_node);
+  std::vector<int> incidence(incidence_offsets[nodes]);
+  std::vector<int> fill(incidence_offsets.begin(), incidence_offsets.end() - 1);
+  for (int i = 0; i < 4 * elements; ++i) incidence[fill[element_nodes[i]]++] = i;
+
+  for (const SpringSet& ligament : model.ligaments)
+    for (int node : ligament.nodes) ++ligaments_per_node[node];
+  const std::vector<int> ligament_offsets = csr_offsets(ligaments_per_node);
+  std::vector<int> ligament_of_node(std::max(1, ligament_offsets[nodes]), 0);
+  fill.assign(ligament_offsets.begin(), ligament_offsets.end() - 1);
+  for (int l = 0; l < L; ++l)
+    for (int node : model.ligaments[l].nodes) ligament_of_node[fill[node]++] = l;
+  std::vector<double> ligament_k(static_cast<std::size_t>(std::max(1, L)) * S, 0.0);
+  for (int l = 0; l < L; ++l) {
+    const double per_node = model.ligaments[l].stiffness /
+                            static_cast<double>(model.ligaments[l].nodes.size());
+    std::fill_n(ligament_k.begin() + static_cast<std::ptrdiff_t>(l) * S, S, per_node);
+  }
+  std::vector<double> control_k(nodes, 0.0);
+  for (std::size_t j = 0; j < model.control.nodes.size(); ++j)
+    control_k[model.control.nodes[j]] += model.control.node_part(j, model.control.stiffness);
+  std::vector<double> rest_positions(3 * static_cast<std::size_t>(nodes));
+  for (int n = 0; n < nodes; ++n)
+    for (int k = 0; k < 3; ++k) rest_positions[3 * n + k] = model.rest_positions[n][k];
+  std::vector<double> initial_positions(dof);   // the rest shape for every sigma point
+  for (std::size_t row = 0; row < 3 * static_cast<std::size_t>(nodes); ++row)
+    std::fill_n(initial_positions.begin() + static_cast<std::ptrdiff_t>(row * S), S, rest_positions[row]);
+
+  const std::size_t groups = static_cast<std::size_t>(S) * sizes.cg_partitions;
+  const std::size_t sigma = static_cast<std::size_t>(S);
+  auto reals = [](DeviceBuffer id, const char* what, std::size_t count) {
+    return DeviceBufferSpec{id, what, false, std::max<std::size_t>(1, count), {}, {}};
+  };
+  auto reals_of = [](DeviceBuffer id, const char* what, std::vector<double> values) {
+    const std::size_t count = std::max<std::size_t>(1, values.size());
+    return DeviceBufferSpec{id, what, false, count, std::move(values), {}};
+  };
+  auto integers = [](DeviceBuffer id, const char* what, std::vector<int> values) {
+    const std::size_t count = values.size();
+    return DeviceBufferSpec{id, what, true, count, {}, std::move(values)};
+  };
+  using B = DeviceBuffer;
+  std::vector<DeviceBufferSpec> specs = {
+      integers(B::element_nodes, "element nodes", element_nodes),
+      reals_of(B::element_rest, "element rest state", element_rest),
+      integers(B::incidence_offsets, "node incidence", incidence_offsets),
+      integers(B::incidence, "node incidence", incidence),
+      integers(B::ligament_offsets, "ligament nodes", ligament_offsets),
+      integers(B::ligament_of_node, "ligament nodes", ligament_of_node),
+      reals_of(B::control_k, "control springs", control_k),
+      reals_of(B::mass, "mass", std::vector<double>(model.mass.data(), model.mass.data() + nodes)),
+      reals_of(B::rest_positions, "rest positions", rest_positions),
+      integers(B::observed_nodes, "observed points", corner_nodes(observed)),
+      reals_of(B::observed_weights, "observed points", corner_weights(observed)),
+      reals(B::constants, "step constants", step_constant_count),
+      reals_of(B::ligament_k, "ligament stiffness", ligament_k),
+      reals_of(B::x, "positions", initial_positions),
+      reals_of(B::v, "velocities", std::vector<double>(dof, 0.0)),
+      reals_of(B::dv, "velocity change", std::vector<double>(dof, 0.0)),
+      reals(B::rhs, "CG vectors", dof), reals(B::inverse_diagonal, "CG vectors", dof),
+      reals(B::r, "CG vectors", dof), reals(B::z, "CG vectors", dof),
+      reals(B::d, "CG vectors", dof), reals(B::q, "CG vectors", dof),
+      reals(B::frames, "element frames", 9 * per_element),
+      reals(B::element_out, "element outputs", std::max(12 * per_element, sizes.element_out)),
+      reals(B::element_diagonal, "element diagonals", 12 * per_element),
+      reals(B::observations, "observations", std::max<std::size_t>(1, observed.size()) * 3 * sigma),
+      reals(B::bb, "CG scalars", sigma), reals(B::rr, "CG scalars", sigma),
+      reals(B::rz, "CG scalars", sigma),
+      integers(B::active, "CG flags", std::vector<int>(sigma, 0)),
+      integers(B::converged, "CG flags", std::vector<int>(sigma, 0)),
+      integers(B::iterations, "CG flags", std::vector<int>(sigma, 0)),
+      integers(B::all_active, "CG flags", std::vector<int>(sigma, 1)),
+      reals(B::partial, "CG partial sums", 4 * groups),
+      integers(B::own_active, "CG flags", std::vector<int>(groups, 0)),
+      integers(B::own_iterations, "CG flags", std::vector<int>(groups, 0)),
+      reals(B::own_rz, "CG scalars", groups),
+      reals(B::recenter_scalars, "re-centring", 1 + kDeviceMaxParameters),
+      reals(B::directions, "re-centring", static_cast<std::size_t>(kDeviceMaxParameters) * sigma),
+      reals(B::weights, "re-centring", static_cast<std::size_t>(kDeviceMaxParameters) * sigma),
+  };
+  for (int i = 0; i < kDeviceBufferCount; ++i)   // the list above is in DeviceBuffer order
+    if (specs[i].id != static_cast<DeviceBuffer>(i)) throw std::logic_error("device_buffer_specs: out of order");
+  return specs;
+}
+
+const std::vector<DeviceBuffer>& kernel_buffers(DeviceKernel kernel) {
+  using B = DeviceBuffer;
+  // The node kernels' first eight: what a node row reads (kernels/shared/node_rows.h).
+#define SF_NODE_BUFFERS \
+  B::constants, B::incidence_offsets, B::incidence, B::ligament_offsets, B::ligament_of_node, \
+      B::ligament_k, B::control_k, B::mass
+  static const std::vector<std::vector<DeviceBuffer>> table = {
+      {B::element_nodes, B::element_rest, B::frames, B::x, B::v, B::constants, B::element_out,
+       B::element_diagonal},
+      {SF_NODE_BUFFERS, B::rest_positions, B::x, B::v, B::element_out, B::element_diagonal, B::rhs,
+       B::inverse_diagonal},
+      {B::element_nodes, B::element_rest, B::frames, B::d, B::active, B::element_out, B::constants},
+      {SF_NODE_BUFFERS, B::d, B::element_out, B::q},
+      {B::constants, B::bb, B::dv, B::x, B::v},
+      {B::observed_nodes, B::observed_weights, B::x, B::observations},
+      {B::recenter_scalars, B::directions, B::weights, B::x, B::v},
+  };
+#undef SF_NODE_BUFFERS
+  return table[static_cast<std::size_t>(kernel)];
+}
+
+std::vector<DeviceBuffer> with_buffer(std::vector<DeviceBuffer> buffers, DeviceBuffer from,
+                                      DeviceBuffer to) {
+  std::replace(buffers.begin(), buffers.end(), from, to);
+  return buffers;
+}
+
+int buffer_slot(DeviceKernel kernel, DeviceBuffer buffer) {
+  const std::vector<DeviceBuffer>& buffers = kernel_buffers(kernel);
+  return static_cast<int>(std::find(buffers.begin(), buffers.end(), buffer) - buffers.begin());
+}
+
+void set_ligament_stiffness(const Model& model, const std::vector<int>& estimated,
+                            const Eigen::MatrixXd& theta, int S, std::vector<double>& ligament_k) {
+  for (std::size_t j = 0; j < estimated.size(); ++j) {
+    const int l = estimated[j];
+    const double nodes = static_cast<double>(model.ligaments[l].nodes.size());
+    for (int s = 0; s < S; ++s)
+      ligament_k[static_cast<std::size_t>(l) * S + s] =
+          std::exp(theta(static_cast<Eigen::Index>(j), s)) / nodes;
+  }
+}
+
+RecenteringInputs pack_recentering(const Recentering& r, int S, const char* who) {
+  const int p = static_cast<int>(r.directions.rows());
+  if (r.directions.cols() != S || r.correction.size() != p || r.factor.rows() != p || r.factor.cols() != p)
+    throw std::invalid_argument(std::string(who) + "::recenter: sizes do not match the ensemble");
+  if (p > kDeviceMaxParameters)
+    throw std::invalid_argument(std::string(who) + "::recenter: at most " + std::to_string(kDeviceMaxParameters) +
+                                " filter parameters on a device, got " + std::to_string(p));
+  const Eigen::MatrixXd weights = r.factor * r.directions;   // W = C I
+  RecenteringInputs in;
+  in.p = static_cast<std::uint32_t>(p);
+  in.scalars.assign(1 + kDeviceMaxParameters, 0.0);
+  in.directions.resize(static_cast<std::size_t>(p) * S);
+  in.weights.resize(static_cast<std::size_t>(p) * S);
+  in.scalars[0] = r.alpha;
+  for (int j = 0; j < p; ++j) {
+    in.scalars[1 + j] = r.correction[j];
+    for (int s = 0; s < S; ++s) {
+      in.directions[static_cast<std::size_t>(j) * S + s] = r.directions(j, s);
+      in.weights[static_cast<std::size_t>(j) * S + s] = weights(j, s);
+    }
+  }
+  return in;
+}
+
+}  // namespace sigmafem

@@ -1,0 +1,97 @@
+// DeviceBuffer: every buffer of a device ensemble, one table for every back end (OpenCL,
+// Vulkan): its name, element type, size and first contents (device_buffer_specs), and which
+// buffers each kernel takes in the order of its buffer arguments (OpenCL, after the scalars)
+// and of its bindings (Vulkan: binding i is entry i). Layout, sigma index innermost: value k of
+// node n for sigma point s at [(3n + k) S + s] (kernels/opencl/ensemble_layout.h).
+// Also what the host writes into them: the ligament stiffnesses from the filter's theta and the
+// re-centring's inputs.
+#pragma once
+
+#include <Eigen/Core>
+#include <cstddef>
+#include <cstdint>
+#include <vector>
+
+#include "filter/ensemble.h"
+#include "host/mesh/observed_points.h"
+#include "host/model/model.h"
+#include "step_constants.h"
+
+namespace sigmafem {
+
+// Estimated parameters a device ensemble takes at most (kernels/shared/step_constants.h).
+constexpr int kDeviceMaxParameters = SF_MAX_PARAMETERS;
+
+enum class DeviceBuffer : int {
+  // Shared by all sigma points: the mesh and its element rest state (grad[12], vlambda, vmu,
+  // 0, 0 per element), the node incidence (CSR: corners 4 e + c of node n in element order,
+  // so the node kernels gather without atomics, the same sums every run), the ligaments on
+  // each node (CSR), the control springs and mass per node, the rest positions, the observed
+  // points' corners and weights, the step constants (kernels/shared/step_constants.h).
+  element_nodes, element_rest, incidence_offsets, incidence, ligament_offsets,
+  ligament_of_node, control_k, mass, rest_positions, observed_nodes, observed_weights,
+  constants,
+  // Per sigma point: the ligaments' stiffness per node ([l S + s], N/m), the state, CG's
+  // vectors, the element frames, the element outputs (12 per element; the CPU form of
+  // OpenCL's element_product keeps a copy of K d per chunk there instead) and diagonals,
+  // the gathered observations.
+  ligament_k, x, v, dv, rhs, inverse_diagonal, r, z, d, q, frames, element_out,
+  element_diagonal, observations,
+  // CG's per-sigma scalars and flags; all_active: S ones, for products outside CG.
+  bb, rr, rz, active, converged, iterations, all_active,
+  // CG's partitions: partial sums and each (sigma point, partition) group's own scalars.
+  partial, own_active, own_iterations, own_rz,
+  // The re-centring's inputs (pack_recentering).
+  recenter_scalars, directions, weights,
+  count
+};
+constexpr int kDeviceBufferCount = static_cast<int>(DeviceBuffer::count);
+
+// A buffer's element type, size and contents before the first step.
+struct DeviceBufferSpec {
+  DeviceBuffer id = DeviceBuffer::count;
+  const char* what = "";          // for "allocating <what>" errors
+  bool integer = false;           // int32 (indices, flags) or a device real
+  std::size_t count = 0;          // elements (at least 1)
+  std::vector<double> reals;      // first contents; empty: none (written before it is read)
+  std::vector<int> integers;      // first contents of an integer buffer (always given)
+};
+
+// What differs between the back ends' buffers.
+struct DeviceBufferSizes {
+  std::size_t element_out = 0;    // at least 12 per element and sigma point
+  int cg_partitions = 1;          // CG work-groups per sigma point
+};
+
+// Every buffer of an ensemble of `model` with S sigma points, in DeviceBuffer order.
+std::vector<DeviceBufferSpec> device_buffer_specs(const Model& model, const ObservedPoints& observed,
+                                                  int S, std::size_t step_constant_count,
+                                                  const DeviceBufferSizes& sizes);
+
+// The kernels that both back ends have, and the buffers each takes, in argument/binding order.
+enum class DeviceKernel { element_rhs, node_rhs, element_product, node_product, state_update,
+                          observation_gather, recenter };
+const std::vector<DeviceBuffer>& kernel_buffers(DeviceKernel kernel);
+// `buffers` with `from` replaced by `to` (a kernel run on other inputs: element_product on dv).
+std::vector<DeviceBuffer> with_buffer(std::vector<DeviceBuffer> buffers, DeviceBuffer from,
+                                      DeviceBuffer to);
+// The index of `buffer` in kernel's list (its argument after the scalars, its binding).
+int buffer_slot(DeviceKernel kernel, DeviceBuffer buffer);
+
+// Writes exp(theta(j, s)) / (nodes of ligament estimated[j]) into ligament_k (p x S theta).
+void set_ligament_stiffness(const Model& model, const std::vector<int>& estimated,
+                            const Eigen::MatrixXd& theta, int sigma_count,
+                            std::vector<double>& ligament_k);
+
+// The re-centring inputs, packed as the recenter kernels read them: scalars[1 + max p]
+// (alpha, the correction), directions and weights W = C I, each [j S + s]. p is the filter's
+// parameter count, which may exceed the ensemble's own (EffectEnsemble adds effect
+// parameters): re-sampling the states does not depend on what the parameters are. Throws
+// std::invalid_argument when the sizes disagree or p exceeds kDeviceMaxParameters.
+struct RecenteringInputs {
+  std::uint32_t p = 0;
+  std::vector<double> scalars, directions, weights;
+};
+RecenteringInputs pack_recentering(const Recentering& r, int sigma_count, const char* who);
+
+}  // namespace sigmafem

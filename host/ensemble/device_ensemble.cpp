@@ -1,0 +1,82 @@
+#include "host/ensemble/device_ensemble.h"
+
+#include <stdexcept>
+
+#include "host/common/device_error.h"
+#include "host/ensemble/device_limits.h"
+#include "host/ensemble/device_readout.h"
+
+namespace sigmafem {
+
+DeviceEnsemble::DeviceEnsemble(const Model& model, std::vector<int> estimated,
+                               ObservedPoints observed, int sigma_count, Precision precision,
+                               const char* backend, const char* who)
+    : model_(model),
+      estimated_(std::move(estimated)),
+      observed_(std::move(observed)),
+      S_(sigma_count),
+      nodes_(model.node_count()),
+      elements_(model.element_count()),
+      precision_(precision),
+      tolerance_(device_cg_tolerance(model, precision)),
+      step_constants_(model, sigma_count, tolerance_),
+      backend_(backend),
+      who_(who) {
+  check_ensemble_arguments(model, estimated_, observed_, S_, who);
+}
+
+void DeviceEnsemble::check_device_memory(std::size_t real_size, const std::string& name,
+                                         std::size_t memory, std::size_t largest_buffer) const {
+  const EnsembleMemory need = ensemble_memory(nodes_, elements_, S_, real_size);
+  if (need.largest > largest_buffer || need.total > memory)
+    throw DeviceError(out_of_device_memory_message(need, elements_, S_, name, memory, largest_buffer));
+}
+
+std::vector<DeviceBufferSpec> DeviceEnsemble::buffer_specs(const DeviceBufferSizes& sizes) {
+  std::vector<DeviceBufferSpec> specs = device_buffer_specs(model_, observed_, S_, step_constants_.size(), sizes);
+  ligament_k_ = specs[static_cast<int>(DeviceBuffer::ligament_k)].reals;
+  return specs;
+}
+
+void DeviceEnsemble::set_parameters(const Eigen::MatrixXd& theta) {
+  check_parameter_matrix(theta, parameter_count(), sigma_count(), who_);
+  set_ligament_stiffness(model_, estimated_, theta, S_, ligament_k_);
+  write_ligament_stiffness();
+}
+
+void DeviceEnsemble::set_physics_effects(const std::vector<PhysicsEffects>& effects) {
+  step_constants_.set_physics_effects(effects, who_);
+}
+
+std::vector<double> DeviceEnsemble::column_of(DeviceBuffer buffer, std::size_t rows, int s) const {
+  return sigma_column(read_reals(buffer, rows * S_), rows, S_, s, who_);
+}
+
+Eigen::VectorXd DeviceEnsemble::positions(int s) const {
+  const std::vector<double> column = column_of(DeviceBuffer::x, 3 * static_cast<std::size_t>(nodes_), s);
+  return Eigen::Map<const Eigen::VectorXd>(column.data(), static_cast<Eigen::Index>(column.size()));
+}
+
+Eigen::VectorXd DeviceEnsemble::velocities(int s) const {
+  const std::vector<double> column = column_of(DeviceBuffer::v, 3 * static_cast<std::size_t>(nodes_), s);
+  return Eigen::Map<const Eigen::VectorXd>(column.data(), static_cast<Eigen::Index>(column.size()));
+}
+
+std::vector<double> DeviceEnsemble::frames(int s) const {
+  return column_of(DeviceBuffer::frames, 9 * static_cast<std::size_t>(elements_), s);
+}
+
+Eigen::MatrixXd DeviceEnsemble::system_product(const Eigen::MatrixXd& d) {
+  const std::size_t rows = 3 * static_cast<std::size_t>(nodes_);
+  if (static_cast<std::size_t>(d.rows()) != rows || d.cols() != S_)
+    throw std::invalid_argument(std::string(who_) + "::system_product: expected 3N x S");
+  write_reals(DeviceBuffer::d, to_sigma_rows(d));
+  run_system_product();
+  return from_sigma_rows(read_reals(DeviceBuffer::q, rows * S_), rows, S_);
+}
+
+std::string DeviceEnsemble::description() const {
+  return device_ensemble_description(backend_, precision_, device_name());
+}
+
+}  // namespace sigmafem

@@ -1,0 +1,63 @@
+#include "host/ensemble/device_limits.h"
+
+#include <algorithm>
+#include <stdexcept>
+
+#include "host/common/input_error.h"
+#include "host/ensemble/device_buffers.h"
+
+namespace sigmafem {
+
+double device_cg_tolerance(const Model& model, Precision precision) {
+  return precision == Precision::single ? std::max(model.solver.cg_tolerance, kSingleCgTolerance)
+                                        : model.solver.cg_tolerance;
+}
+
+void check_ensemble_arguments(const Model& model, const std::vector<int>& estimated,
+                              const ObservedPoints& observed, int S, const char* who) {
+  const std::string name(who);
+  if (S < 1) throw std::invalid_argument(name + ": need at least one sigma point");
+  if (static_cast<int>(estimated.size()) > kDeviceMaxParameters)
+    throw std::invalid_argument(name + ": at most " + std::to_string(kDeviceMaxParameters) +
+                                " estimated parameters");
+  for (int l : estimated)
+    if (l < 0 || l >= static_cast<int>(model.ligaments.size()))
+      throw std::invalid_argument(name + ": no ligament " + std::to_string(l));
+  check_observed_points(observed, model.node_count(), who);
+  // The kernels give every node of a ligament the same part of its stiffness (one number per
+  // ligament and sigma point); the control's parts are per node and need no check.
+  for (const SpringSet& ligament : model.ligaments)
+    if (!ligament.shares.empty())
+      throw InputError(name + ": ligament " + ligament.name +
+                       " gives its nodes unequal parts of its stiffness (generate --truth-refine spreads each "
+                       "spring over the refined mesh), which the device back ends do not hold: use --backend cpu");
+}
+
+int cg_partitions(int nodes, int forced) {
+  if (forced > 0) return forced;
+  return std::clamp(3 * nodes / kPartitionRows, 1, kMostPartitions);
+}
+
+EnsembleMemory ensemble_memory(int nodes, int elements, int S, std::size_t real_size) {
+  // Per dof and sigma: x, v, dv, rhs, the Jacobi diagonal, r, z, d, q; per element and sigma:
+  // the frame (9), the element outputs (12) and diagonals (12).
+  const std::size_t dof = 3 * static_cast<std::size_t>(nodes) * S;
+  const std::size_t per_element = static_cast<std::size_t>(elements) * S;
+  EnsembleMemory need;
+  need.largest = 12 * per_element * real_size;
+  need.total = (9 * dof + 33 * per_element) * real_size;
+  return need;
+}
+
+std::string out_of_device_memory_message(const EnsembleMemory& need, int elements, int S,
+                                         const std::string& device,
+                                         std::size_t device_memory, std::size_t largest_buffer) {
+  return "out of device memory: " + std::to_string(S) + " sigma points on " +
+         std::to_string(elements) + " tetrahedra need about " + std::to_string(need.total >> 20) +
+         " MiB (largest buffer " + std::to_string(need.largest >> 20) + " MiB); " + device +
+         " has " + std::to_string(device_memory >> 20) + " MiB (largest buffer " +
+         std::to_string(largest_buffer >> 20) +
+         " MiB). Use fewer sigma points, a coarser mesh or another device";
+}
+
+}  // namespace sigmafem

@@ -1,0 +1,48 @@
+// What a device ensemble may be asked and what it needs: its arguments checked, the CG
+// tolerance it solves to, CG's work-groups per sigma point, and its device memory, with the
+// message when the device has too little.
+#pragma once
+
+#include <cstddef>
+#include <string>
+#include <vector>
+
+#include "host/common/device_options.h"
+#include "host/mesh/observed_points.h"
+#include "host/model/model.h"
+
+namespace sigmafem {
+
+// Checks an ensemble's arguments: std::invalid_argument naming `who`.
+void check_ensemble_arguments(const Model& model, const std::vector<int>& estimated,
+                              const ObservedPoints& observed, int sigma_count, const char* who);
+
+// The CG tolerance floor of a float32 device ensemble: about ten float32 epsilons (float32
+// cannot reach the scenario's 1e-10).
+constexpr double kSingleCgTolerance = 1e-6;
+
+// The CG tolerance a device ensemble solves to: the scenario's, raised to kSingleCgTolerance
+// in single precision.
+double device_cg_tolerance(const Model& model, Precision precision);
+
+// The CG kernels' work-groups per sigma point on a GPU (kernels/opencl/conjugate_gradient.cl's
+// SF_CG_PARTITIONS, specialization constant 1 of kernels/vulkan/conjugate_gradient.comp): one
+// below 2 kPartitionRows rows (3 per node), then one per kPartitionRows rows, at most
+// kMostPartitions. `forced` > 0 (DeviceOptions::cg_partitions) is taken as it is.
+constexpr int kPartitionRows = 512;
+constexpr int kMostPartitions = 64;
+int cg_partitions(int nodes, int forced);
+
+// Device memory of an ensemble, in bytes, for `real_size`-byte reals.
+struct EnsembleMemory {
+  std::size_t total = 0;     // about: all buffers
+  std::size_t largest = 0;   // the largest single buffer (12 per element and sigma point)
+};
+EnsembleMemory ensemble_memory(int nodes, int elements, int sigma_count, std::size_t real_size);
+
+// The "out of device memory" message: what the ensemble needs and what `device` has.
+std::string out_of_device_memory_message(const EnsembleMemory& need, int elements,
+                                         int sigma_count, const std::string& device,
+                                         std::size_t device_memory, std::size_t largest_buffer);
+
+}  // namespace sigmafem
