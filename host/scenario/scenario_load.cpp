@@ -22,6 +22,7 @@
 #include "host/common/physical_limits.h"
 #include "host/mesh/mesh_locate.h"
 #include "host/mesh/text_cursor.h"
+#include "host/scenario/checked_json.h"
 #include "host/scenario/scenario.h"
 #include "host/scenario/surface_regions.h"
 
@@ -29,7 +30,14 @@ namespace sigmafem {
 
 namespace {
 
-using nlohmann::json;
+using checked_json::Checker;
+using checked_json::child;
+using checked_json::describe;
+using checked_json::element;
+using checked_json::in_quotes;
+using checked_json::join;
+using checked_json::json;
+using checked_json::suggestion;
 namespace fs = std::filesystem;
 
 constexpr const char* kFormat = "sigmafem-scenario/1";
@@ -37,261 +45,6 @@ constexpr const char* kFormat = "sigmafem-scenario/1";
 // mesh.refine: each level multiplies the tetrahedra by 8, so 3 levels (x512) already turn a
 // 10k-element mesh into millions; beyond that a finer mesh file is the better tool.
 constexpr int kMaxMeshRefine = 3;
-
-// ---------------------------------------------------------------------------------------
-// Text helpers for messages.
-
-std::string in_quotes(const std::string& s) {
-  return "\"" + s + "\"";
-}
-
-std::string join(const std::vector<std::string>& items) {
-  std::string out;
-  for (const std::string& item : items) out += (out.empty() ? "" : ", ") + item;
-  return out;
-}
-
-// What a JSON value is, for "expected X, found Y".
-std::string describe(const json& value) {
-  constexpr size_t kMaxShown = 40;
-  switch (value.type()) {
-    case json::value_t::null:
-      return "null";
-    case json::value_t::boolean:
-      return value.dump() + " (a boolean)";
-    case json::value_t::string: {
-      std::string text = value.dump();
-      if (text.size() > kMaxShown) text = text.substr(0, kMaxShown) + "...\"";
-      return text + " (a string)";
-    }
-    case json::value_t::array:
-      return "an array of " + std::to_string(value.size()) + " elements";
-    case json::value_t::object:
-      return "an object";
-    default:
-      return value.dump();  // the numbers
-  }
-}
-
-// Levenshtein distance, to suggest the field or ligament a typo meant.
-size_t edit_distance(const std::string& a, const std::string& b) {
-  std::vector<size_t> row(b.size() + 1);
-  for (size_t j = 0; j <= b.size(); ++j) row[j] = j;
-  for (size_t i = 1; i <= a.size(); ++i) {
-    size_t diagonal = row[0];
-    row[0] = i;
-    for (size_t j = 1; j <= b.size(); ++j) {
-      const size_t above = row[j];
-      row[j] = std::min({row[j] + 1, row[j - 1] + 1, diagonal + (a[i - 1] == b[j - 1] ? 0 : 1)});
-      diagonal = above;
-    }
-  }
-  return row[b.size()];
-}
-
-// " (did you mean "x"?)" when one candidate is within two edits, else "".
-std::string suggestion(const std::string& word, const std::vector<std::string>& candidates) {
-  std::string best;
-  size_t best_distance = 3;
-  for (const std::string& candidate : candidates) {
-    const size_t d = edit_distance(word, candidate);
-    if (d < best_distance && d < candidate.size()) {
-      best = candidate;
-      best_distance = d;
-    }
-  }
-  return best.empty() ? "" : " (did you mean " + in_quotes(best) + "?)";
-}
-
-std::string child(const std::string& path, const std::string& key) {
-  return path.empty() ? key : path + "." + key;
-}
-
-std::string element(const std::string& path, size_t index) {
-  return path + "[" + std::to_string(index) + "]";
-}
-
-// ---------------------------------------------------------------------------------------
-// Reading the file.
-
-// nlohmann keeps the last of two equal keys without a word; in a hand-written scenario a
-// repeated key is a mistake (an edit made in one place and not the other), so the parser
-// callback tracks where it is and reports the repeated key by its field path.
-class DuplicateKeyCheck {
- public:
-  // Returns the path of a key that repeats, or "" if the event is fine.
-  std::string on_event(json::parse_event_t event, const json& parsed) {
-    switch (event) {
-      case json::parse_event_t::object_start:
-        frames_.push_back({true, {}, {}, 0});
-        break;
-      case json::parse_event_t::array_start:
-        frames_.push_back({false, {}, {}, 0});
-        break;
-      case json::parse_event_t::key: {
-        Frame& top = frames_.back();
-        top.key = parsed.get<std::string>();
-        if (!top.keys.insert(top.key).second) return path();
-        break;
-      }
-      case json::parse_event_t::value:
-        next_element();
-        break;
-      case json::parse_event_t::object_end:
-      case json::parse_event_t::array_end:
-        frames_.pop_back();
-        next_element();
-        break;
-    }
-    return "";
-  }
-
- private:
-  struct Frame {
-    bool is_object;
-    std::set<std::string> keys;  // objects: keys seen so far
-    std::string key;             // objects: the key being read
-    size_t index;                // arrays: index of the element being read
-  };
-
-  void next_element() {
-    if (!frames_.empty() && !frames_.back().is_object) ++frames_.back().index;
-  }
-
-  std::string path() const {
-    std::string out;
-    for (const Frame& frame : frames_) {
-      out = frame.is_object ? child(out, frame.key) : element(out, frame.index);
-    }
-    return out;
-  }
-
-  std::vector<Frame> frames_;
-};
-
-// nlohmann reports a byte offset (1-based, the last character it read); people count lines.
-std::string line_and_column(const std::string& text, size_t byte) {
-  const size_t end = std::min(byte > 0 ? byte - 1 : 0, text.size());
-  size_t line = 1;
-  size_t line_start = 0;
-  for (size_t i = 0; i < end; ++i) {
-    if (text[i] == '\n') {
-      ++line;
-      line_start = i + 1;
-    }
-  }
-  return "line " + std::to_string(line) + ", column " + std::to_string(end - line_start + 1);
-}
-
-// nlohmann's what() is "[json.exception.parse_error.101] parse error at line 3, column 5:
-// syntax error while parsing ..."; keep the part after the location.
-std::string parse_problem(const std::string& what) {
-  const size_t at = what.find("parse error");
-  const size_t colon = at == std::string::npos ? at : what.find(": ", at);
-  return colon == std::string::npos ? what : what.substr(colon + 2);
-}
-
-// ---------------------------------------------------------------------------------------
-// Field access with checks. All of them throw with the field's path.
-
-class Checker {
- public:
-  explicit Checker(std::string file) : file_(std::move(file)) {}
-
-  [[noreturn]] void fail(const std::string& path, const std::string& what) const {
-    throw InputError("scenario " + file_ + ": " + path + ": " + what);
-  }
-
-  // A problem with the file as a whole, before any field can be named.
-  [[noreturn]] void fail_file(const std::string& what) const {
-    throw InputError("scenario " + file_ + ": " + what);
-  }
-
-  void require(bool ok, const std::string& path, const std::string& what) const {
-    if (!ok) fail(path, what);
-  }
-
-  // `value` must be an object with only `allowed` keys and every `required` one. The root
-  // object's path is "", and its unknown or missing fields are named alone ("meshh").
-  void check_object(const json& value, const std::string& path,
-                    const std::vector<std::string>& allowed,
-                    const std::vector<std::string>& required) const {
-    require(value.is_object(), path.empty() ? "(top level)" : path,
-            "expected an object {...}, found " + describe(value));
-    for (const auto& item : value.items()) {
-      if (std::find(allowed.begin(), allowed.end(), item.key()) == allowed.end()) {
-        fail(child(path, item.key()), "unknown field" + suggestion(item.key(), allowed) +
-                                          "; allowed here: " + join(allowed));
-      }
-    }
-    for (const std::string& key : required) {
-      require(value.contains(key), child(path, key), "missing required field");
-    }
-  }
-
-  double number(const json& value, const std::string& path) const {
-    require(value.is_number(), path, "expected a number, found " + describe(value));
-    const double x = value.get<double>();
-    // A literal such as 1e999 parses to infinity; no scenario quantity may be infinite.
-    require(std::isfinite(x), path, "expected a finite number, found " + value.dump());
-    require(std::fabs(x) <= kMaxScenarioMagnitude, path,
-            value.dump() + " is beyond +-" + message_number(kMaxScenarioMagnitude) +
-                ", more than any quantity of a scenario in SI units (a unit slip?)");
-    return x;
-  }
-
-  // Integers may be written 1500 or 1.5e3, but not 1500.5.
-  int integer(const json& value, const std::string& path) const {
-    const std::string found = "expected an integer, found " + describe(value);
-    require(value.is_number(), path, found);
-    const double x = value.is_number_unsigned()  ? static_cast<double>(value.get<std::uint64_t>())
-                     : value.is_number_integer() ? static_cast<double>(value.get<std::int64_t>())
-                                                 : value.get<double>();
-    require(std::isfinite(x) && x == std::floor(x), path, found);
-    require(x >= INT_MIN && x <= INT_MAX, path, "integer " + value.dump() + " is out of range");
-    return static_cast<int>(x);
-  }
-
-  std::string string(const json& value, const std::string& path) const {
-    require(value.is_string(), path, "expected a string \"...\", found " + describe(value));
-    return value.get<std::string>();
-  }
-
-  Eigen::Vector3d vector3(const json& value, const std::string& path) const {
-    require(value.is_array() && value.size() == 3, path,
-            "expected an array of 3 numbers [x, y, z], found " + describe(value));
-    Eigen::Vector3d v;
-    for (size_t k = 0; k < 3; ++k)
-      v[static_cast<Eigen::Index>(k)] = number(value[k], element(path, k));
-    return v;
-  }
-
-  const json& array(const json& value, const std::string& path) const {
-    require(value.is_array(), path, "expected an array [...], found " + describe(value));
-    return value;
-  }
-
-  // Optional members of an already checked object: the fallback when absent.
-  double number_or(const json& object, const std::string& path, const std::string& key,
-                   double fallback) const {
-    return object.contains(key) ? number(object.at(key), child(path, key)) : fallback;
-  }
-  int integer_or(const json& object, const std::string& path, const std::string& key,
-                 int fallback) const {
-    return object.contains(key) ? integer(object.at(key), child(path, key)) : fallback;
-  }
-
-  // Range checks: the message shows the rule and the value found.
-  void positive(double x, const std::string& path) const {
-    require(x > 0.0, path, "must be > 0, found " + message_number(x));
-  }
-  void non_negative(double x, const std::string& path) const {
-    require(x >= 0.0, path, "must be >= 0, found " + message_number(x));
-  }
-
- private:
-  std::string file_;
-};
 
 // Which nodes some tetrahedron uses. The mesh keeps the others (file indices stay valid), but
 // such a node is no part of the body: it never moves, so it can be no ligament, grip or
@@ -430,30 +183,6 @@ int ligament_by_name(const Checker& c, const std::vector<Ligament>& ligaments, c
                    "; ligaments: " + (names.empty() ? "(none)" : join(names)));
 }
 
-
-json parse_json(const Checker& c, const std::string& text) {
-  DuplicateKeyCheck duplicates;
-  const json::parser_callback_t callback = [&](int /*depth*/, json::parse_event_t event,
-                                               json& parsed) {
-    const std::string repeated = duplicates.on_event(event, parsed);
-    if (!repeated.empty()) c.fail(repeated, "duplicate key; each field may appear once");
-    return true;
-  };
-  try {
-    return json::parse(text, callback);
-  } catch (const json::parse_error& e) {
-    c.fail(line_and_column(text, e.byte), "invalid JSON: " + parse_problem(e.what()));
-  } catch (const json::out_of_range& e) {
-    // A literal beyond double range (1e400): nlohmann names the literal but not where it is.
-    const std::string what = e.what();
-    const size_t open = what.find('\''), close = what.rfind('\'');
-    const std::string literal = open < close ? what.substr(open + 1, close - open - 1) : "";
-    const size_t at = literal.empty() ? std::string::npos : text.find(literal);
-    c.fail(at == std::string::npos ? "(a number)" : line_and_column(text, at + 1),
-           "number " + (literal.empty() ? std::string("literal") : literal) +
-               " is beyond the range of a double (about 1.8e308)");
-  }
-}
 
 // Paths in a scenario are relative to its folder, so a scenario and its files move together.
 std::string resolve(const std::string& scenario_path, const std::string& file) {
@@ -925,7 +654,7 @@ void read_output(const Checker& c, const json& root, Scenario& s) {
 
 Scenario load_scenario(const std::string& path) {
   const Checker c(path);
-  const json root = parse_json(c, read_input_file(path, "scenario " + path, kMaxJsonBytes));
+  const json root = c.parse(read_input_file(path, "scenario " + path, kMaxJsonBytes));
   c.require(root.is_object(), "(top level)",
             "expected a JSON object {...}, found " + describe(root));
 

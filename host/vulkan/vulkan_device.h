@@ -1,8 +1,8 @@
-// The Vulkan devices of this machine and one of them made ready for compute: the loader
-// opened at run time (a machine without libvulkan still runs the other back ends and gets a
-// clear message here), an instance without surface or window, device discovery (`sigmafem
-// devices`), a compute queue, storage buffers, compute pipelines from the SPIR-V embedded at
-// build time (host/vulkan/vulkan_shaders.h), one reusable command buffer and a fence.
+// The Vulkan devices of this machine and one of them made ready for compute. Discovery
+// (`sigmafem devices`), the loader opened at run time and the instances are
+// host/vulkan/vulkan_instance.cpp's; VulkanDevice (vulkan_device.cpp) holds a compute queue,
+// storage buffers, compute pipelines from the SPIR-V embedded at build time
+// (host/vulkan/vulkan_shaders.h), one reusable command buffer and a fence.
 //
 // Validation: with SIGMAFEM_VULKAN_VALIDATION=1 and VK_LAYER_KHRONOS_validation installed,
 // the layer is switched on (with synchronization validation) and every message it sends is
@@ -41,7 +41,7 @@ int vulkan_validation_message_count();
 // Whether SIGMAFEM_VULKAN_VALIDATION=1 asks for the layer and the layer is installed.
 bool vulkan_validation_available();
 
-struct VulkanApi;  // the loader's function table (vulkan_device.cpp)
+struct VulkanApi;  // the loader's function table (vulkan_instance.h)
 
 // A storage buffer in device memory. Owned by the VulkanDevice that made it.
 struct VulkanBuffer {
