@@ -2,12 +2,12 @@
 
 #include <algorithm>
 #include <cmath>
-#include <sstream>
 
 #include "filter/path_consistency.h"
 #include "filter/timed_observation.h"
 #include "host/common/input_error.h"
 #include "host/common/interruption.h"
+#include "host/diagnosis/diagnosis_conclusion.h"
 #include "host/engine/estimation_options.h"
 #include "host/engine/make_ensemble.h"
 #include "host/engine/surface_cloud_estimation.h"
@@ -15,42 +15,6 @@
 #include "host/model/model.h"
 
 namespace sigmafem {
-namespace {
-
-constexpr double kLog2Pi = 1.8378770664093453;
-
-std::string format(double x, int precision = 3) {
-  std::ostringstream out;
-  out.precision(precision);
-  out << x;
-  return out.str();
-}
-
-// A share as a percentage: one decimal from 1% up (99.9%, not 1e+02%), two digits below.
-std::string percent(double share) {
-  const double p = 100.0 * share;
-  std::ostringstream out;
-  if (std::abs(p) >= 1.0) {
-    out.setf(std::ios::fixed);
-    out.precision(1);
-  } else {
-    out.precision(2);
-  }
-  out << p << '%';
-  return out.str();
-}
-
-std::string describe_estimate(const EffectEstimate& e) {
-  std::ostringstream out;
-  out << e.name << " = ";
-  for (std::size_t j = 0; j < e.value.size(); ++j)
-    out << (j ? ", " : "") << format(e.value[j]) << " +- " << format(e.std[j], 2);
-  if (!e.units.empty() && !e.units[0].empty()) out << ' ' << e.units[0];
-  return out.str();
-}
-
-}  // namespace
-
 std::vector<std::string> candidate_library(const Scenario& scenario, const std::vector<std::string>& names) {
   std::vector<std::string> asked = names;
   if (asked.empty())
@@ -97,19 +61,17 @@ RefitStart refit_start(const ModelFit& first) {
   return start;
 }
 
-ModelFit fit_model(const Scenario& scenario, const ObservationTable& data,
-                   const std::optional<TruthTable>& truth, const std::vector<std::string>& effects,
-                   const DiagnoseOptions& options, const Eigen::VectorXd& start,
-                   const Eigen::VectorXd& start_std) {
-  if (!scenario.filter)
-    throw InputError("scenario " + scenario.path + ": filter: missing; diagnose needs a filter block");
-  const FilterSpec& spec = *scenario.filter;
-  ModelFit fit;
-  fit.effects = effects;
-  for (int l : spec.estimate) fit.ligaments.push_back(scenario.ligaments[static_cast<std::size_t>(l)].name);
+namespace {
 
-  // The prior: the scenario's for the stiffnesses; N(0, 1) in the coordinates of every
-  // effect parameter (EffectEnsemble), without drift: an effect is a constant.
+constexpr double kLog2Pi = 1.8378770664093453;
+
+// The estimation options of a fit: the scenario's prior for the stiffnesses; N(0, 1) in the
+// coordinates of every effect parameter (EffectEnsemble), without drift: an effect is a
+// constant. A refit starts at `start` (with at most the prior's std).
+EstimationOptions fit_options(const Scenario& scenario, const std::vector<std::string>& effects,
+                              const DiagnoseOptions& options, const Eigen::VectorXd& start,
+                              const Eigen::VectorXd& start_std, ModelFit& fit) {
+  const FilterSpec& spec = *scenario.filter;
   EstimationOptions estimation = estimation_options(scenario);
   const int p0 = static_cast<int>(spec.estimate.size());
   int p = p0;
@@ -136,9 +98,19 @@ ModelFit fit_model(const Scenario& scenario, const ObservationTable& data,
   }
   estimation.stiffness_count = p0;
   fit.parameter_count = p;
+  return estimation;
+}
 
+// Runs the filter of the fit's model over the data; returns the tracked points' mean
+// positions (the residual's lever arms; empty for a surface cloud).
+Eigen::MatrixX3d run_fit(const Scenario& scenario, const ObservationTable& data,
+                         const std::vector<std::string>& effects, const DiagnoseOptions& options,
+                         EstimationOptions estimation, ModelFit& fit) {
+  const FilterSpec& spec = *scenario.filter;
+  RoukfOptions& roukf = estimation.roukf;
+  const int p = fit.parameter_count;
   const int sigma_count = sigma_point_count(roukf.sigma_points, p);
-  Eigen::MatrixX3d positions;   // the tracked points' mean positions: the residual's lever arms
+  Eigen::MatrixX3d positions;
   const Model model = make_model(scenario);
   // A camera offset the scenario declares: the positions are the data minus the offset.
   const Eigen::Vector3d offset = camera_offset(scenario.effects);
@@ -163,6 +135,13 @@ ModelFit fit_model(const Scenario& scenario, const ObservationTable& data,
                              [&](Eigen::Index row) { ensemble.set_row(row); });
     positions = mean_observed_positions(points);
   }
+  return positions;
+}
+
+// The fit's residual tests (a filter that stopped early fails one more), log-likelihood per
+// step and innovation RMS. Returns the residual tests' burn-in steps.
+int score_fit(const ObservationTable& data, const DiagnoseOptions& options,
+               const Eigen::MatrixX3d& positions, ModelFit& fit) {
   // A cloud's rows are surface triangles, not points with lever arms: its residual is judged
   // by the step means, with no spatial or rigid pattern (as `estimate` does).
   const InnovationSeries series = innovation_series(fit.run);
@@ -200,8 +179,13 @@ ModelFit fit_model(const Scenario& scenario, const ObservationTable& data,
       if (!std::isnan(z)) sum += z * z, ++count;
     }
   fit.innovation_rms = count > 0 ? std::sqrt(sum / static_cast<double>(count)) : NAN;
-  if (fit.run.steps.empty()) return fit;
+  return residual.burn_in_steps;
+}
 
+// The effects' estimates at the last step, each with its first-order std widened where its
+// path moved more than its covariance allows.
+void read_effect_estimates(const std::vector<std::string>& effects, int burn_in_steps, ModelFit& fit) {
+  const int p0 = static_cast<int>(fit.ligaments.size());
   const EstimationStep& last = fit.run.steps.back();
   fit.stiffness = last.stiffness.head(p0);
   fit.stiffness_std = last.stiffness_std.head(p0);
@@ -222,38 +206,61 @@ ModelFit fit_model(const Scenario& scenario, const ObservationTable& data,
     // The stated std: the first-order one, widened where the estimate's path moved more than
     // its covariance allows (after the residual tests' burn-in, the sigma points' spread).
     for (int j = 0; j < k; ++j) {
-      const PathConsistency path = path_consistency(fit.run.steps, row + j, residual.burn_in_steps);
+      const PathConsistency path = path_consistency(fit.run.steps, row + j, burn_in_steps);
       estimate.path_ratio.push_back(path.ratio);
       estimate.std.push_back(estimate.first_order_std[static_cast<std::size_t>(j)] * std::max(1.0, path.ratio));
     }
     fit.estimates.push_back(estimate);
     row += k;
   }
-  if (truth) {
-    const std::size_t n = fit.run.steps.size();
-    const std::size_t first = n - std::max<std::size_t>(1, n / 5);
-    double absolute = 0.0, truth_sum = 0.0;
-    int terms = 0;
-    bool ok = true;
-    for (std::size_t k = first; k < n && ok; ++k) {
-      const EstimationStep& step = fit.run.steps[k];
-      for (int j = 0; j < p0; ++j) {
-        const int column = truth->column(fit.ligaments[static_cast<std::size_t>(j)]);
-        if (column < 0 || step.step >= truth->stiffness.rows()) {
-          ok = false;
-          break;
-        }
-        const double t = truth->stiffness(step.step, column);
-        absolute += std::abs(step.stiffness[j] - t);
-        truth_sum += t;
-        ++terms;
+}
+
+// The stiffness error against the truth: mean |error| over the last 20% of the steps, and over
+// the sum of the true stiffnesses.
+void compare_with_truth(const TruthTable& truth, ModelFit& fit) {
+  const int p0 = static_cast<int>(fit.ligaments.size());
+  const std::size_t n = fit.run.steps.size();
+  const std::size_t first = n - std::max<std::size_t>(1, n / 5);
+  double absolute = 0.0, truth_sum = 0.0;
+  int terms = 0;
+  bool ok = true;
+  for (std::size_t k = first; k < n && ok; ++k) {
+    const EstimationStep& step = fit.run.steps[k];
+    for (int j = 0; j < p0; ++j) {
+      const int column = truth.column(fit.ligaments[static_cast<std::size_t>(j)]);
+      if (column < 0 || step.step >= truth.stiffness.rows()) {
+        ok = false;
+        break;
       }
-    }
-    if (ok && terms > 0) {
-      fit.stiffness_error = absolute / terms;
-      if (truth_sum > 0.0) fit.stiffness_relative_error = absolute / truth_sum;
+      const double t = truth.stiffness(step.step, column);
+      absolute += std::abs(step.stiffness[j] - t);
+      truth_sum += t;
+      ++terms;
     }
   }
+  if (ok && terms > 0) {
+    fit.stiffness_error = absolute / terms;
+    if (truth_sum > 0.0) fit.stiffness_relative_error = absolute / truth_sum;
+  }
+}
+
+}  // namespace
+
+ModelFit fit_model(const Scenario& scenario, const ObservationTable& data,
+                   const std::optional<TruthTable>& truth, const std::vector<std::string>& effects,
+                   const DiagnoseOptions& options, const Eigen::VectorXd& start,
+                   const Eigen::VectorXd& start_std) {
+  if (!scenario.filter)
+    throw InputError("scenario " + scenario.path + ": filter: missing; diagnose needs a filter block");
+  ModelFit fit;
+  fit.effects = effects;
+  for (int l : scenario.filter->estimate) fit.ligaments.push_back(scenario.ligaments[static_cast<std::size_t>(l)].name);
+  const EstimationOptions estimation = fit_options(scenario, effects, options, start, start_std, fit);
+  const Eigen::MatrixX3d positions = run_fit(scenario, data, effects, options, estimation, fit);
+  const int burn_in_steps = score_fit(data, options, positions, fit);
+  if (fit.run.steps.empty()) return fit;
+  read_effect_estimates(effects, burn_in_steps, fit);
+  if (truth) compare_with_truth(*truth, fit);
   return fit;
 }
 
@@ -297,9 +304,9 @@ Diagnosis diagnose(const Scenario& scenario, const ObservationTable& data,
     if (!options.log) return;
     std::string name = "declared model";
     for (const std::string& e : fit.effects) name += " + " + e;
-    *options.log << "  " << name << ": log-likelihood " << format(fit.log_likelihood, 8) << ", residual "
+    *options.log << "  " << name << ": log-likelihood " << significant_digits(fit.log_likelihood, 8) << ", residual "
                  << to_string(fit.residual.verdict.consistency) << ", innovation RMS "
-                 << format(1e3 * fit.innovation_rms) << " mm"
+                 << significant_digits(1e3 * fit.innovation_rms) << " mm"
                  << (fit.run.complete ? "" : " (stopped: " + fit.run.stop_reason + ")") << '\n';
   };
 
@@ -395,38 +402,21 @@ Diagnosis diagnose(const Scenario& scenario, const ObservationTable& data,
   for (int f : d.path) path_fits.push_back(&d.fits[static_cast<std::size_t>(f)]);
   d.misfit = misfit_shares(path_fits);
   const ModelFit& after = d.after();
-  std::ostringstream text;
   if (d.path.size() == 1 && after.residual.verdict.consistency == Consistency::consistent) {
     d.outcome = DiagnosisOutcome::consistent;
-    text << "The declared model explains the data: the residual is consistent, nothing was added.";
   } else if (after.residual.verdict.consistency == Consistency::consistent) {
     d.outcome = DiagnosisOutcome::explained;
-    text << "The declared model left an inconsistent residual; adding ";
-    for (std::size_t j = 0; j < after.estimates.size(); ++j) {
-      const EffectEstimate& e = after.estimates[j];
-      text << (j ? ", then " : "") << describe_estimate(e);
-      EffectValue value{e.name, e.value};
-      d.discovered.push_back(value);
-    }
-    text << " makes it consistent.";
-    // Another candidate that also made the residual consistent is an alternative the data
-    // cannot rule out (e.g. a scale of Young's modulus and a gravity along the known one,
-    // when that gravity is the only known force): say so rather than hide it.
-    for (const DiagnosisRound& r : d.rounds)
-      for (const CandidateScore& c : r.candidates)
-        if (!r.chosen.empty() && c.effect != r.chosen && c.complete && c.verdict == Consistency::consistent)
-          text << " Also consistent instead of " << r.chosen << ": " << describe_estimate(c.estimate)
-               << " (score " << format(c.score, 6) << "): the data may not tell the two apart.";
+    for (const EffectEstimate& e : after.estimates) d.discovered.push_back({e.name, e.value});
   } else if (after.residual.verdict.consistency == Consistency::too_few_steps) {
     d.outcome = DiagnosisOutcome::unexplained;
-    text << "Too few filter steps to judge the residual: nothing was tested or added.";
   } else {
     d.claims = check_claims(path_fits, d.misfit, runners_up(d.rounds), options.claims);
     const int claimed = static_cast<int>(
         std::count_if(d.claims.begin(), d.claims.end(), [](const ClaimCheck& c) { return c.claimed; }));
+    d.outcome = claimed > 0 ? DiagnosisOutcome::partly_explained : DiagnosisOutcome::unexplained;
     if (claimed > 0) {
-      d.outcome = DiagnosisOutcome::partly_explained;
       d.after_position = claimed;
+      // The claimed estimates, their std widened by how far they moved in the later fits.
       ModelFit& fit = d.fits[static_cast<std::size_t>(d.path[static_cast<std::size_t>(claimed)])];
       for (std::size_t j = 0; j < fit.estimates.size(); ++j) {
         std::vector<EffectEstimate> later;
@@ -434,59 +424,11 @@ Diagnosis diagnose(const Scenario& scenario, const ObservationTable& data,
           later.push_back(d.fits[static_cast<std::size_t>(d.path[m])].estimates[j]);
         fit.estimates[j] = widened(fit.estimates[j], later);
       }
-      text << "The residual stays inconsistent, but ";
-      for (int j = 0; j < claimed; ++j) {
-        const EffectEstimate& e = fit.estimates[static_cast<std::size_t>(j)];
-        text << (j ? ", then " : "") << describe_estimate(e) << " (" << percent(d.misfit.removed[static_cast<std::size_t>(j)])
-             << " of the declared model's misfit)";
-        d.discovered.push_back({e.name, e.value});
-      }
-      const double left = fit.residual.nis.mean - fit.residual.nis.mean_dof;
-      text << " account" << (claimed == 1 ? "s" : "") << " for most of it; "
-           << percent(left / d.misfit.declared_excess)
-           << " remains, a model error outside the library (a geometry finer than the mesh, or an effect the "
-              "library lacks). The stated std"
-           << (static_cast<std::size_t>(claimed) + 1 < d.path.size()
-                   ? " includes how far the estimate moved in the later fits, but"
-                   : "")
-           << " cannot include the bias such an error gives every fit alike: the value is the effect that "
-              "best mimics the data in this model (on truths from a finer mesh, 2-31% off).";
-      if (static_cast<std::size_t>(claimed) < d.claims.size()) {
-        const ClaimCheck& next = d.claims[static_cast<std::size_t>(claimed)];
-        text << " Not claimed: " << next.effect << " (" << next.reason << ")";
-        for (std::size_t j = static_cast<std::size_t>(claimed) + 1; j < d.misfit.effects.size(); ++j)
-          text << ", " << d.misfit.effects[j];
-        text << '.';
-      }
-    } else {
-      d.outcome = DiagnosisOutcome::unexplained;
-      text << "The residual stays unexplained: ";
-      if (d.path.size() == 1) {
-        text << "no candidate effect (" << (library.empty() ? "none" : "");
-        for (std::size_t j = 0; j < library.size(); ++j) text << (j ? ", " : "") << library[j];
-        text << ") raised the likelihood by more than its penalty.";
-      } else {
-        text << "the effects tried (";
-        for (std::size_t j = 0; j < after.estimates.size(); ++j)
-          text << (j ? ", " : "") << describe_estimate(after.estimates[j]);
-        text << ") raise the likelihood but leave the residual inconsistent, so none is claimed";
-        if (!d.claims.empty()) text << " (" << d.claims[0].effect << ": " << d.claims[0].reason << ")";
-        if (std::isfinite(d.misfit.remaining)) {
-          text << "; of the declared model's misfit (mean NIS " << format(d.before().residual.nis.mean, 4)
-               << " against " << format(d.before().residual.nis.mean_dof, 3) << " observed rows) ";
-          for (std::size_t j = 0; j < d.misfit.removed.size(); ++j)
-            text << (j ? ", then " : "") << d.misfit.effects[j] << " accounted for " << percent(d.misfit.removed[j]);
-          text << ", and " << percent(d.misfit.remaining) << " remains";
-        }
-        text << ": the data hold an effect outside the library (or more than one).";
-      }
+      for (int j = 0; j < claimed; ++j)
+        d.discovered.push_back({fit.estimates[static_cast<std::size_t>(j)].name, fit.estimates[static_cast<std::size_t>(j)].value});
     }
-    text << " Failed tests: ";
-    const std::vector<std::string> failed = d.after().residual.verdict.failed();
-    for (std::size_t j = 0; j < failed.size(); ++j) text << (j ? ", " : "") << failed[j];
-    text << '.';
   }
-  d.conclusion = text.str();
+  d.conclusion = diagnosis_conclusion(d, library);
   return d;
 }
 
