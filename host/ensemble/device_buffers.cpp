@@ -4,6 +4,9 @@
 #include <cmath>
 #include <stdexcept>
 #include <string>
+#include <utility>
+
+#include "device_layout.h"
 
 namespace sigmafem {
 namespace {
@@ -13,6 +16,15 @@ std::vector<int> csr_offsets(std::vector<int> counts) {
   std::vector<int> offsets(counts.size() + 1, 0);
   for (std::size_t n = 0; n < counts.size(); ++n) offsets[n + 1] = offsets[n] + counts[n];
   return offsets;
+}
+
+// A kernel's buffers from (slot, buffer) pairs (device_layout.h); every slot given once.
+std::vector<DeviceBuffer> by_slot(std::initializer_list<std::pair<int, DeviceBuffer>> slots) {
+  std::vector<DeviceBuffer> buffers(slots.size(), DeviceBuffer::count);
+  for (const auto& [slot, id] : slots) buffers.at(static_cast<std::size_t>(slot)) = id;
+  if (std::count(buffers.begin(), buffers.end(), DeviceBuffer::count) > 0)
+    throw std::logic_error("kernel_buffers: a slot given twice");
+  return buffers;
 }
 
 }  // namespace
@@ -125,22 +137,50 @@ std::vector<DeviceBufferSpec> device_buffer_specs(const Model& model, const Obse
 
 const std::vector<DeviceBuffer>& kernel_buffers(DeviceKernel kernel) {
   using B = DeviceBuffer;
-  // The node kernels' first eight: what a node row reads (kernels/shared/node_rows.h).
-#define SF_NODE_BUFFERS \
-  B::constants, B::incidence_offsets, B::incidence, B::ligament_offsets, B::ligament_of_node, \
-      B::ligament_k, B::control_k, B::mass
+  // The buffers a node row reads (node_rows.h): the node kernels' first slots.
+#define SF_NODE_ROW_SLOTS {SF_NODE_CONSTANTS, B::constants}, \
+    {SF_NODE_INCIDENCE_OFFSETS, B::incidence_offsets}, {SF_NODE_INCIDENCE, B::incidence}, \
+    {SF_NODE_LIGAMENT_OFFSETS, B::ligament_offsets}, \
+    {SF_NODE_LIGAMENT_OF_NODE, B::ligament_of_node}, {SF_NODE_LIGAMENT_K, B::ligament_k}, \
+    {SF_NODE_CONTROL_K, B::control_k}, {SF_NODE_MASS, B::mass}
   static const std::vector<std::vector<DeviceBuffer>> table = {
-      {B::element_nodes, B::element_rest, B::frames, B::x, B::v, B::constants, B::element_out,
-       B::element_diagonal},
-      {SF_NODE_BUFFERS, B::rest_positions, B::x, B::v, B::element_out, B::element_diagonal, B::rhs,
-       B::inverse_diagonal},
-      {B::element_nodes, B::element_rest, B::frames, B::d, B::active, B::element_out, B::constants},
-      {SF_NODE_BUFFERS, B::d, B::element_out, B::q},
-      {B::constants, B::bb, B::dv, B::x, B::v},
-      {B::observed_nodes, B::observed_weights, B::x, B::observations},
-      {B::recenter_scalars, B::directions, B::weights, B::x, B::v},
+      // element_rhs
+      by_slot({{SF_ELEMENT_RHS_ELEMENT_NODES, B::element_nodes},
+               {SF_ELEMENT_RHS_ELEMENT_REST, B::element_rest}, {SF_ELEMENT_RHS_FRAMES, B::frames},
+               {SF_ELEMENT_RHS_X, B::x}, {SF_ELEMENT_RHS_V, B::v},
+               {SF_ELEMENT_RHS_CONSTANTS, B::constants},
+               {SF_ELEMENT_RHS_ELEMENT_OUT, B::element_out},
+               {SF_ELEMENT_RHS_ELEMENT_DIAGONAL, B::element_diagonal}}),
+      // node_rhs
+      by_slot({SF_NODE_ROW_SLOTS, {SF_NODE_RHS_REST_POSITIONS, B::rest_positions},
+               {SF_NODE_RHS_X, B::x}, {SF_NODE_RHS_V, B::v},
+               {SF_NODE_RHS_ELEMENT_OUT, B::element_out},
+               {SF_NODE_RHS_ELEMENT_DIAGONAL, B::element_diagonal}, {SF_NODE_RHS_RHS, B::rhs},
+               {SF_NODE_RHS_INVERSE_DIAGONAL, B::inverse_diagonal}}),
+      // element_product
+      by_slot({{SF_ELEMENT_PRODUCT_ELEMENT_NODES, B::element_nodes},
+               {SF_ELEMENT_PRODUCT_ELEMENT_REST, B::element_rest},
+               {SF_ELEMENT_PRODUCT_FRAMES, B::frames}, {SF_ELEMENT_PRODUCT_D, B::d},
+               {SF_ELEMENT_PRODUCT_ACTIVE, B::active},
+               {SF_ELEMENT_PRODUCT_ELEMENT_OUT, B::element_out},
+               {SF_ELEMENT_PRODUCT_CONSTANTS, B::constants}}),
+      // node_product
+      by_slot({SF_NODE_ROW_SLOTS, {SF_NODE_PRODUCT_D, B::d},
+               {SF_NODE_PRODUCT_ELEMENT_OUT, B::element_out}, {SF_NODE_PRODUCT_Q, B::q}}),
+      // state_update
+      by_slot({{SF_STATE_UPDATE_CONSTANTS, B::constants}, {SF_STATE_UPDATE_BB, B::bb},
+               {SF_STATE_UPDATE_DV, B::dv}, {SF_STATE_UPDATE_X, B::x}, {SF_STATE_UPDATE_V, B::v}}),
+      // observation_gather
+      by_slot({{SF_OBSERVATION_GATHER_OBSERVED_NODES, B::observed_nodes},
+               {SF_OBSERVATION_GATHER_OBSERVED_WEIGHTS, B::observed_weights},
+               {SF_OBSERVATION_GATHER_X, B::x},
+               {SF_OBSERVATION_GATHER_OBSERVATIONS, B::observations}}),
+      // recenter
+      by_slot({{SF_RECENTER_RECENTER_SCALARS, B::recenter_scalars},
+               {SF_RECENTER_DIRECTIONS, B::directions}, {SF_RECENTER_WEIGHTS, B::weights},
+               {SF_RECENTER_X, B::x}, {SF_RECENTER_V, B::v}}),
   };
-#undef SF_NODE_BUFFERS
+#undef SF_NODE_ROW_SLOTS
   return table[static_cast<std::size_t>(kernel)];
 }
 
@@ -155,8 +195,8 @@ int buffer_slot(DeviceKernel kernel, DeviceBuffer buffer) {
   return static_cast<int>(std::find(buffers.begin(), buffers.end(), buffer) - buffers.begin());
 }
 
-void set_ligament_stiffness(const Model& model, const std::vector<int>& estimated,
-                            const Eigen::MatrixXd& theta, int S, std::vector<double>& ligament_k) {
+void ligament_k_from_theta(const Model& model, const std::vector<int>& estimated,
+                           const Eigen::MatrixXd& theta, int S, std::vector<double>& ligament_k) {
   for (std::size_t j = 0; j < estimated.size(); ++j) {
     const int l = estimated[j];
     const double nodes = static_cast<double>(model.ligaments[l].nodes.size());

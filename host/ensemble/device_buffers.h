@@ -79,9 +79,9 @@ std::vector<DeviceBuffer> with_buffer(std::vector<DeviceBuffer> buffers, DeviceB
 int buffer_slot(DeviceKernel kernel, DeviceBuffer buffer);
 
 // Writes exp(theta(j, s)) / (nodes of ligament estimated[j]) into ligament_k (p x S theta).
-void set_ligament_stiffness(const Model& model, const std::vector<int>& estimated,
-                            const Eigen::MatrixXd& theta, int sigma_count,
-                            std::vector<double>& ligament_k);
+void ligament_k_from_theta(const Model& model, const std::vector<int>& estimated,
+                           const Eigen::MatrixXd& theta, int sigma_count,
+                           std::vector<double>& ligament_k);
 
 // The re-centring inputs, packed as the recenter kernels read them: scalars[1 + max p]
 // (alpha, the correction), directions and weights W = C I, each [j S + s]. p is the filter's

@@ -40,8 +40,8 @@ std::vector<DeviceBufferSpec> DeviceEnsemble::buffer_specs(const DeviceBufferSiz
 
 void DeviceEnsemble::set_parameters(const Eigen::MatrixXd& theta) {
   check_parameter_matrix(theta, parameter_count(), sigma_count(), who_);
-  set_ligament_stiffness(model_, estimated_, theta, S_, ligament_k_);
-  write_ligament_stiffness();
+  ligament_k_from_theta(model_, estimated_, theta, S_, ligament_k_);
+  upload_ligament_k();
 }
 
 void DeviceEnsemble::set_physics_effects(const std::vector<PhysicsEffects>& effects) {

@@ -63,7 +63,7 @@ class DeviceEnsemble : public SimulationEnsemble {
   // the next step; the device's name; A d of the `d` buffer into `q` (system_product).
   virtual std::vector<double> read_reals(DeviceBuffer buffer, std::size_t count) const = 0;
   virtual void write_reals(DeviceBuffer buffer, const std::vector<double>& values) = 0;
-  virtual void write_ligament_stiffness() = 0;
+  virtual void upload_ligament_k() = 0;
   virtual std::string device_name() const = 0;
   virtual void run_system_product() = 0;
 

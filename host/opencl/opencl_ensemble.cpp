@@ -5,12 +5,11 @@
 #include <string>
 
 #include "host/ensemble/device_readout.h"
+#include "device_layout.h"
 #include "host/ensemble/device_limits.h"
 
 namespace sigmafem {
 namespace {
-
-constexpr std::size_t kGroup = 64;        // work-group size of the element and node kernels
 
 std::size_t round_up(std::size_t n, std::size_t multiple) {
   return (n + multiple - 1) / multiple * multiple;
@@ -171,10 +170,10 @@ std::vector<double> OpenClEnsemble::read_reals(DeviceBuffer id, std::size_t coun
   return from_device_reals(bytes.data(), count, device_.precision());
 }
 
-void OpenClEnsemble::write_ligament_stiffness() { write_reals(DeviceBuffer::ligament_k, ligament_k_); }
+void OpenClEnsemble::upload_ligament_k() { write_reals(DeviceBuffer::ligament_k, ligament_k_); }
 
 void OpenClEnsemble::run(cl::Kernel& kernel, std::size_t items, std::size_t local) const {
-  const std::size_t group = local > 0 ? local : kGroup;
+  const std::size_t group = local > 0 ? local : SF_ITEMS_PER_GROUP;
   cl::Event event;
   device_.queue().enqueueNDRangeKernel(kernel, cl::NullRange, cl::NDRange(round_up(items, group)),
                                        cl::NDRange(group), nullptr, &event);

@@ -38,7 +38,7 @@ class OpenClEnsemble : public DeviceEnsemble {
  private:
   std::vector<double> read_reals(DeviceBuffer buffer, std::size_t count) const override;
   void write_reals(DeviceBuffer buffer, const std::vector<double>& values) override;
-  void write_ligament_stiffness() override;
+  void upload_ligament_k() override;
   std::string device_name() const override { return device_.info().name; }
   void run_system_product() override;
   const cl::Buffer& buffer(DeviceBuffer id) const { return buffers_[static_cast<int>(id)]; }

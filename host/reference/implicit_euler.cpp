@@ -3,10 +3,10 @@
 namespace sigmafem {
 
 ImplicitEulerSystem::ImplicitEulerSystem(const Model& model, const std::vector<Frame>& frames,
-                                         const Eigen::VectorXd& spring_stiffness)
+                                         const Eigen::VectorXd& node_springs)
     : model_(model),
       frames_(frames),
-      spring_stiffness_(spring_stiffness),
+      node_springs_(node_springs),
       mass_factor_(1.0 + model.dt * model.damping.rayleigh_mass),
       stiffness_factor_(model.dt * (model.dt + model.damping.rayleigh_stiffness)) {
   const int n = model.node_count();
@@ -17,9 +17,9 @@ ImplicitEulerSystem::ImplicitEulerSystem(const Model& model, const std::vector<F
     // has no mass and, without a spring, no stiffness: its rows of A would be zero. A unit
     // placeholder mass makes them the identity; with no force on the node, dv = 0 and it
     // stays where it is. Its real mass (zero) still counts everywhere else.
-    const bool isolated = model.mass[i] == 0.0 && spring_stiffness_[i] == 0.0;
+    const bool isolated = model.mass[i] == 0.0 && node_springs_[i] == 0.0;
     dof_mass_.segment<3>(3 * i).setConstant(isolated ? 1.0 : model.mass[i]);
-    dof_spring_.segment<3>(3 * i).setConstant(spring_stiffness_[i]);
+    dof_spring_.segment<3>(3 * i).setConstant(node_springs_[i]);
   }
 }
 

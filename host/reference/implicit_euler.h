@@ -17,10 +17,10 @@ namespace sigmafem {
 
 class ImplicitEulerSystem {
  public:
-  // `frames` are the element frames at x_n; `spring_stiffness` is the per-node spring
+  // `frames` are the element frames at x_n; `node_springs` is the per-node spring
   // stiffness (N/m, isotropic). Both are referenced, not copied: keep them alive.
   ImplicitEulerSystem(const Model& model, const std::vector<Frame>& frames,
-                      const Eigen::VectorXd& spring_stiffness);
+                      const Eigen::VectorXd& node_springs);
 
   // y = K d (tangent stiffness, springs included).
   void stiffness_product(const Eigen::VectorXd& d, Eigen::VectorXd& y) const;
@@ -41,7 +41,7 @@ class ImplicitEulerSystem {
  private:
   const Model& model_;
   const std::vector<Frame>& frames_;
-  const Eigen::VectorXd& spring_stiffness_;
+  const Eigen::VectorXd& node_springs_;
   Eigen::VectorXd dof_mass_;          // lumped mass repeated on the three axes
   Eigen::VectorXd dof_spring_;        // spring stiffness repeated on the three axes
   double mass_factor_;                // 1 + h b

@@ -61,7 +61,7 @@ void ReferenceSimulation::set_state(const Eigen::VectorXd& positions,
   v_ = velocities;
 }
 
-Eigen::VectorXd ReferenceSimulation::spring_stiffness() const {
+Eigen::VectorXd ReferenceSimulation::node_springs() const {
   Eigen::VectorXd k = Eigen::VectorXd::Zero(model_.node_count());
   for (std::size_t l = 0; l < model_.ligaments.size(); ++l) {
     const SpringSet& ligament = model_.ligaments[l];
@@ -107,7 +107,7 @@ CgResult ReferenceSimulation::step(const Eigen::Vector3d& so_position) {
   so_history_.push(so_position);
   const Eigen::Vector3d so_target = so_history_.lagged(model_.so_lag);
   element_frames(model_, x_, frames_);
-  const Eigen::VectorXd springs = spring_stiffness();
+  const Eigen::VectorXd springs = node_springs();
   const ImplicitEulerSystem system(model_, frames_, springs);
   const Eigen::VectorXd b = system.right_hand_side(forces(x_, frames_, so_target), v_);
 
@@ -146,7 +146,7 @@ CgResult ReferenceSimulation::step(const Eigen::Vector3d& so_position) {
 Eigen::SparseMatrix<double> ReferenceSimulation::system_matrix() const {
   std::vector<Frame> frames;
   element_frames(model_, x_, frames);
-  return ImplicitEulerSystem(model_, frames, spring_stiffness()).assemble();
+  return ImplicitEulerSystem(model_, frames, node_springs()).assemble();
 }
 
 double ReferenceSimulation::kinetic_energy() const {

@@ -65,7 +65,7 @@ class ReferenceSimulation {
   // The spring stiffness on each node (ligaments and control), N/m: the linear law's. With
   // a nonlinear ligament law the implicit step takes the law's linear part implicitly and the
   // rest, k u |u|^2/d0^2, explicitly in the forces (as the device kernels do).
-  Eigen::VectorXd spring_stiffness() const;
+  Eigen::VectorXd node_springs() const;
   // All forces at positions x with the SO at so_position, for the frames of x.
   Eigen::VectorXd forces(const Eigen::VectorXd& x, const std::vector<Frame>& frames,
                          const Eigen::Vector3d& so_position) const;

@@ -6,15 +6,14 @@
 #include <string>
 
 #include "host/ensemble/device_readout.h"
+#include "device_layout.h"
 #include "host/ensemble/device_limits.h"
 
 namespace sigmafem {
 namespace {
 
-constexpr std::size_t kItemsPerGroup = 64;   // SF_ITEMS_PER_GROUP in kernels/vulkan/ensemble_layout.h
-
 std::uint32_t groups_for(std::size_t items) {
-  return static_cast<std::uint32_t>((items + kItemsPerGroup - 1) / kItemsPerGroup);
+  return static_cast<std::uint32_t>((items + SF_ITEMS_PER_GROUP - 1) / SF_ITEMS_PER_GROUP);
 }
 
 }  // namespace
@@ -70,7 +69,7 @@ VulkanEnsemble::VulkanEnsemble(const Model& model, std::vector<int> estimated,
   // (the node rows' buffers first: cg_start does the warm start's gather), the iteration's
   // four another.
   std::vector<DeviceBuffer> start = kernel_buffers(DeviceKernel::node_product);
-  start.resize(8);
+  start.resize(SF_NODE_MASS + 1);
   start.insert(start.end(), {B::element_out, B::rhs, B::inverse_diagonal, B::dv, B::r, B::z, B::d,
                              B::bb, B::rr, B::rz, B::active, B::converged, B::iterations,
                              B::partial, B::own_active, B::own_iterations, B::own_rz});
@@ -132,7 +131,7 @@ std::vector<double> VulkanEnsemble::read_reals(DeviceBuffer id, std::size_t coun
   return from_device_reals(bytes.data(), count, device_.precision());
 }
 
-void VulkanEnsemble::write_ligament_stiffness() {
+void VulkanEnsemble::upload_ligament_k() {
   pending_ligament_k_ = to_device_reals(ligament_k_, device_.precision());
 }
 
@@ -167,6 +166,8 @@ void VulkanEnsemble::flush_pending() const {
 void VulkanEnsemble::dispatch_items(VkCommandBuffer cmd, const VulkanKernel& kernel,
                                     VkDescriptorSet set, std::size_t items,
                                     std::uint32_t count) const {
+  static_assert(sizeof(PushConstants) == VulkanDevice::kPushConstantBytes,
+                "SF_PUSH_CONSTANTS: the shaders' 16 bytes of push constants");
   PushConstants push;
   push.S = static_cast<std::uint32_t>(S_);
   push.count = count;

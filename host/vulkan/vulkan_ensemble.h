@@ -20,6 +20,7 @@
 #include <Eigen/Core>
 #include <vector>
 
+#include "device_layout.h"
 #include "host/ensemble/device_ensemble.h"
 #include "host/model/model.h"
 #include "host/vulkan/vulkan_device.h"
@@ -42,16 +43,17 @@ class VulkanEnsemble : public DeviceEnsemble {
   int last_step_waits() const { return last_step_waits_; }
 
  private:
-  // The scalar arguments of every shader (SfPush in kernels/vulkan/ensemble_layout.h).
+  // The scalar arguments of every shader (SF_PUSH_CONSTANTS, kernels/shared/device_layout.h).
+#define SF_HOST_UINT(name) std::uint32_t name = 0;
+#define SF_HOST_INT(name) std::int32_t name = 0;
   struct PushConstants {
-    std::uint32_t S = 0;
-    std::uint32_t count = 0;
-    std::int32_t max_iterations = 0;
-    std::uint32_t p = 0;
+    SF_PUSH_CONSTANTS(SF_HOST_UINT, SF_HOST_INT)
   };
+#undef SF_HOST_UINT
+#undef SF_HOST_INT
   std::vector<double> read_reals(DeviceBuffer buffer, std::size_t count) const override;
   void write_reals(DeviceBuffer buffer, const std::vector<double>& values) override;
-  void write_ligament_stiffness() override;
+  void upload_ligament_k() override;
   std::string device_name() const override { return device_.info().name; }
   void run_system_product() override;
   const VulkanBuffer& buffer(DeviceBuffer id) const { return buffers_[static_cast<int>(id)]; }

@@ -18,14 +18,14 @@ __kernel void element_product(uint S, uint element_count, uint node_count,
                               __global const int* restrict nodes,
                               __global const real* restrict rest, __global const real* restrict frames,
                               __global const real* restrict d, __global const uint* restrict active,
-                              __global real* restrict out, __global const real* restrict c) {
+                              __global real* restrict element_out, __global const real* restrict c) {
 #if SF_ELEMENT_CHUNKS > 0
   uint chunk = (uint)get_global_id(0);
   if (chunk >= SF_ELEMENT_CHUNKS) return;
   sf_element_chunk_products((uint)((ulong)element_count * chunk / SF_ELEMENT_CHUNKS),
                             (uint)((ulong)element_count * (chunk + 1) / SF_ELEMENT_CHUNKS), S,
                             node_count, nodes, rest, frames, c, d,
-                            out + chunk * ((size_t)3 * node_count * S));
+                            element_out + chunk * ((size_t)3 * node_count * S));
 #else
   uint e;
   uint first;
@@ -49,7 +49,7 @@ __kernel void element_product(uint S, uint element_count, uint node_count,
     sf_load_frame(frames, e, s, S, frame);
     sf_gather_corners(d, corner_nodes, s, S, corner);
     sf_element_product(frame, grad, vlambda, vmu, corner, product);
-    sf_store_corners(out, e, s, S, product);
+    sf_store_corners(element_out, e, s, S, product);
   }
 #endif
 }

@@ -14,8 +14,8 @@
 __kernel void element_rhs(uint S, uint element_count, __global const int* restrict nodes,
                           __global const real* restrict rest, __global real* restrict frames,
                           __global const real* restrict x, __global const real* restrict v,
-                          __global const real* restrict c, __global real* restrict rhs_out,
-                          __global real* restrict diagonal_out) {
+                          __global const real* restrict c, __global real* restrict element_out,
+                          __global real* restrict element_diagonal) {
   uint e;
   uint first;
   if (!sf_block_item(get_global_id(0), S, element_count, &e, &first)) return;
@@ -42,8 +42,8 @@ __kernel void element_rhs(uint S, uint element_count, __global const int* restri
     sf_element_product(frame, grad, vlambda, vmu, corner, product);
     SF_UNROLL
     for (int i = 0; i < 12; ++i) force[i] -= SF_SIGMA_CONSTANT(c, SF_VELOCITY_FACTOR, s, S) * product[i];
-    sf_store_corners(rhs_out, e, s, S, force);
+    sf_store_corners(element_out, e, s, S, force);
     sf_element_diagonal(frame, grad, vlambda, vmu, product);
-    sf_store_corners(diagonal_out, e, s, S, product);
+    sf_store_corners(element_diagonal, e, s, S, product);
   }
 }

@@ -1,10 +1,6 @@
-/* ensemble_layout.h: how the OpenCL ensemble lays out its arrays (ARCHITECTURE.md, "The
- * ensemble on a device"). Every per-sigma array has the sigma index innermost, so that
- * neighbouring work-items (neighbouring sigma points) read neighbouring addresses:
- *   per-dof     x[(3 * node + axis) * S + s]
- *   per-element frames[(9 * e + i) * S + s],  corner outputs [(12 * e + i) * S + s]
- * Shared data (rest shape, element rest state, mass) is stored once for all sigma points.
- * Work-items of the element and node kernels are flattened: gid = item * S + s. */
+/* ensemble_layout.h: what every OpenCL kernel includes: the layout every back end shares
+ * (kernels/shared/device_layout.h; a kernel's buffer arguments follow its slots there, after
+ * its scalars) and the index helpers over its buffers. */
 #ifndef SIGMAFEM_ENSEMBLE_LAYOUT_H
 #define SIGMAFEM_ENSEMBLE_LAYOUT_H
 
@@ -13,6 +9,7 @@
 #  define SF_REAL double
 #endif
 
+#include "device_layout.h"
 #include "element.h"
 
 typedef SF_REAL real;
@@ -42,9 +39,6 @@ static inline int sf_block_item(size_t gid, uint S, uint count, uint* item, uint
   *first = (uint)(gid % blocks) * SF_SIGMA_BLOCK;
   return 1;
 }
-
-/* The element rest state, 16 numbers per element: grad[12], vlambda, vmu, two unused. */
-#define SF_REST_STRIDE 16
 
 /* Loads the 15 rest numbers of element e (element.h's grad, vlambda, vmu). */
 static inline void sf_load_rest(__global const real* restrict rest, uint e, real grad[12],

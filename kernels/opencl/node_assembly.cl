@@ -13,7 +13,7 @@ __kernel void node_rhs(uint S, uint node_count, __global const real* c,
                        __global const real* ligament_k, __global const real* control_k,
                        __global const real* mass, __global const real* rest_positions,
                        __global const real* x, __global const real* v,
-                       __global const real* element_rhs_out, __global const real* element_diagonal,
+                       __global const real* element_out, __global const real* element_diagonal,
                        __global real* rhs, __global real* inverse_diagonal) {
   size_t gid = get_global_id(0);
   if (gid >= (size_t)node_count * S) return;
@@ -26,7 +26,7 @@ __kernel void node_rhs(uint S, uint node_count, __global const real* c,
   SF_LOAD_NODE_CONSTANTS(c, s, S, at)
   real f_elements[3];
   real diagonal[3];
-  SF_CORNER_SUMS(element_rhs_out, incidence_offsets, incidence, n, s, S, f_elements)
+  SF_CORNER_SUMS(element_out, incidence_offsets, incidence, n, s, S, f_elements)
   SF_CORNER_SUMS(element_diagonal, incidence_offsets, incidence, n, s, S, diagonal)
   real u[3];
   for (int k = 0; k < 3; ++k) u[k] = x[((size_t)3 * n + k) * S + s] - rest_positions[3 * n + k];

@@ -8,13 +8,13 @@
 #include "ensemble_layout.h"
 
 layout(local_size_x = SF_ITEMS_PER_GROUP) in;
-layout(std430, binding = 0) restrict readonly buffer Nodes { int nodes[]; };
-layout(std430, binding = 1) restrict readonly buffer Rest { real rest[]; };
-layout(std430, binding = 2) restrict readonly buffer Frames { real frames[]; };
-layout(std430, binding = 3) restrict readonly buffer D { real d[]; };
-layout(std430, binding = 4) restrict readonly buffer Active { uint active_flags[]; };
-layout(std430, binding = 5) restrict writeonly buffer Out { real out_values[]; };
-layout(std430, binding = 6) restrict readonly buffer C { real c[]; };
+layout(std430, binding = SF_ELEMENT_PRODUCT_ELEMENT_NODES) restrict readonly buffer Nodes { int nodes[]; };
+layout(std430, binding = SF_ELEMENT_PRODUCT_ELEMENT_REST) restrict readonly buffer Rest { real rest[]; };
+layout(std430, binding = SF_ELEMENT_PRODUCT_FRAMES) restrict readonly buffer Frames { real frames[]; };
+layout(std430, binding = SF_ELEMENT_PRODUCT_D) restrict readonly buffer D { real d[]; };
+layout(std430, binding = SF_ELEMENT_PRODUCT_ACTIVE) restrict readonly buffer Active { uint active_flags[]; };
+layout(std430, binding = SF_ELEMENT_PRODUCT_ELEMENT_OUT) restrict writeonly buffer ElementOut { real element_out[]; };
+layout(std430, binding = SF_ELEMENT_PRODUCT_CONSTANTS) restrict readonly buffer C { real c[]; };
 
 void main() {
   uint S = sf_push.S;
@@ -35,5 +35,5 @@ void main() {
   for (uint i = 0u; i < 9u; ++i) frame[i] = frames[(9u * e + i) * S + s];
   SF_GATHER_CORNERS(d, corner_nodes, s, S, corner)
   sf_element_product(frame, grad, vlambda, vmu, corner, product);
-  SF_STORE_CORNERS(out_values, e, s, S, product)
+  SF_STORE_CORNERS(element_out, e, s, S, product)
 }

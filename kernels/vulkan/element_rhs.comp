@@ -10,14 +10,14 @@
 #include "ensemble_layout.h"
 
 layout(local_size_x = SF_ITEMS_PER_GROUP) in;
-layout(std430, binding = 0) restrict readonly buffer Nodes { int nodes[]; };
-layout(std430, binding = 1) restrict readonly buffer Rest { real rest[]; };
-layout(std430, binding = 2) restrict writeonly buffer Frames { real frames[]; };
-layout(std430, binding = 3) restrict readonly buffer X { real x[]; };
-layout(std430, binding = 4) restrict readonly buffer V { real v[]; };
-layout(std430, binding = 5) restrict readonly buffer C { real c[]; };
-layout(std430, binding = 6) restrict writeonly buffer RhsOut { real rhs_out[]; };
-layout(std430, binding = 7) restrict writeonly buffer DiagonalOut { real diagonal_out[]; };
+layout(std430, binding = SF_ELEMENT_RHS_ELEMENT_NODES) restrict readonly buffer Nodes { int nodes[]; };
+layout(std430, binding = SF_ELEMENT_RHS_ELEMENT_REST) restrict readonly buffer Rest { real rest[]; };
+layout(std430, binding = SF_ELEMENT_RHS_FRAMES) restrict writeonly buffer Frames { real frames[]; };
+layout(std430, binding = SF_ELEMENT_RHS_X) restrict readonly buffer X { real x[]; };
+layout(std430, binding = SF_ELEMENT_RHS_V) restrict readonly buffer V { real v[]; };
+layout(std430, binding = SF_ELEMENT_RHS_CONSTANTS) restrict readonly buffer C { real c[]; };
+layout(std430, binding = SF_ELEMENT_RHS_ELEMENT_OUT) restrict writeonly buffer ElementOut { real element_out[]; };
+layout(std430, binding = SF_ELEMENT_RHS_ELEMENT_DIAGONAL) restrict writeonly buffer ElementDiagonal { real element_diagonal[]; };
 
 void main() {
   uint S = sf_push.S;
@@ -42,7 +42,7 @@ void main() {
   SF_GATHER_CORNERS(v, corner_nodes, s, S, corner)
   sf_element_product(frame, grad, vlambda, vmu, corner, product);
   for (uint i = 0u; i < 12u; ++i) force[i] -= SF_SIGMA_CONSTANT(c, SF_VELOCITY_FACTOR, s, S) * product[i];
-  SF_STORE_CORNERS(rhs_out, e, s, S, force)
+  SF_STORE_CORNERS(element_out, e, s, S, force)
   sf_element_diagonal(frame, grad, vlambda, vmu, product);
-  SF_STORE_CORNERS(diagonal_out, e, s, S, product)
+  SF_STORE_CORNERS(element_diagonal, e, s, S, product)
 }

@@ -1,16 +1,7 @@
-/* ensemble_layout.h: how the Vulkan ensemble lays out its arrays: the same layout as the
- * OpenCL ensemble (kernels/opencl/ensemble_layout.h, ARCHITECTURE.md "The ensemble on a
- * device"), sigma index innermost:
- *   per-dof     x[(3 * node + axis) * S + s]
- *   per-element frames[(9 * e + i) * S + s],  corner outputs [(12 * e + i) * S + s]
- * Shared data (rest shape, element rest state, mass) is stored once for all sigma points.
- * Work-items of the element and node kernels: gid = item * S + s (one (item, sigma) pair per
- * invocation; llvmpipe runs 8 invocations in one SIMD register, a GPU a warp).
- *
- * Buffers are std430 storage buffers in descriptor set 0; a shader's binding numbers follow
- * the order of the buffer arguments of the OpenCL kernel of the same name. The scalar
- * arguments (S, the item count, the CG cap, p) are push constants (SfPush, the same 16
- * bytes for every shader: host/vulkan/vulkan_ensemble.cpp, struct PushConstants).
+/* ensemble_layout.h: what every Vulkan shader includes: the layout, slots and push constants
+ * every back end shares (kernels/shared/device_layout.h) in GLSL's terms, and the index
+ * helpers over its buffers. Buffers are std430 storage buffers in descriptor set 0, bound at
+ * device_layout.h's slots (the CG shaders' bindings are their own: conjugate_gradient.comp).
  * Indices are 32-bit: the host checks every buffer against maxStorageBufferRange. */
 #ifndef SIGMAFEM_VULKAN_ENSEMBLE_LAYOUT_H
 #define SIGMAFEM_VULKAN_ENSEMBLE_LAYOUT_H
@@ -19,22 +10,18 @@
 #  define SF_REAL double
 #endif
 
+#include "device_layout.h"
 #include "element.h"
 #include "step_constants.h"
 
 /* GLSL has no typedef. */
 #define real SF_REAL
 
-layout(push_constant) uniform SfPush {
-  uint S;               /* sigma points */
-  uint count;           /* elements, nodes, rows or observed nodes: the kernel's items */
-  int max_iterations;   /* CG iteration cap (cg_iteration) */
-  uint p;               /* the filter's parameters (recenter) */
-} sf_push;
+#define SF_UINT_FIELD(name) uint name;
+#define SF_INT_FIELD(name) int name;
+layout(push_constant) uniform SfPush { SF_PUSH_CONSTANTS(SF_UINT_FIELD, SF_INT_FIELD) } sf_push;
 
-/* Invocations per work-group of the element and node kernels (the host dispatches
- * ceil(items / SF_ITEMS_PER_GROUP) groups, in two dimensions past 65535). */
-#define SF_ITEMS_PER_GROUP 64
+/* The host dispatches ceil(items / SF_ITEMS_PER_GROUP) groups, in two dimensions past 65535. */
 
 /* The flattened global index over a 2-D grid of work-groups (x fastest), in shaders with
  * layout(local_size_x = SF_ITEMS_PER_GROUP). Not gl_WorkGroupSize: glslang takes it as 1
@@ -43,9 +30,6 @@ uint sf_global_id() {
   return (gl_WorkGroupID.y * gl_NumWorkGroups.x + gl_WorkGroupID.x) * SF_ITEMS_PER_GROUP +
          gl_LocalInvocationID.x;
 }
-
-/* The element rest state, 16 numbers per element: grad[12], vlambda, vmu, two unused. */
-#define SF_REST_STRIDE 16u
 
 /* Loads element e's rest state and node indices from buffers `rest_` and `nodes_`. */
 #define SF_LOAD_ELEMENT(rest_, nodes_, e, grad, vlambda, vmu, corner_nodes)     \

@@ -12,13 +12,13 @@
 layout(local_size_x = SF_ITEMS_PER_GROUP) in;
 
 #if defined(SF_ENTRY_NODE_RHS)
-layout(std430, binding = 8) restrict readonly buffer RestPositions { real rest_positions[]; };
-layout(std430, binding = 9) restrict readonly buffer X { real x[]; };
-layout(std430, binding = 10) restrict readonly buffer V { real v[]; };
-layout(std430, binding = 11) restrict readonly buffer ElementRhsOut { real element_rhs_out[]; };
-layout(std430, binding = 12) restrict readonly buffer ElementDiagonal { real element_diagonal[]; };
-layout(std430, binding = 13) restrict writeonly buffer Rhs { real rhs[]; };
-layout(std430, binding = 14) restrict writeonly buffer InverseDiagonal { real inverse_diagonal[]; };
+layout(std430, binding = SF_NODE_RHS_REST_POSITIONS) restrict readonly buffer RestPositions { real rest_positions[]; };
+layout(std430, binding = SF_NODE_RHS_X) restrict readonly buffer X { real x[]; };
+layout(std430, binding = SF_NODE_RHS_V) restrict readonly buffer V { real v[]; };
+layout(std430, binding = SF_NODE_RHS_ELEMENT_OUT) restrict readonly buffer ElementOut { real element_out[]; };
+layout(std430, binding = SF_NODE_RHS_ELEMENT_DIAGONAL) restrict readonly buffer ElementDiagonal { real element_diagonal[]; };
+layout(std430, binding = SF_NODE_RHS_RHS) restrict writeonly buffer Rhs { real rhs[]; };
+layout(std430, binding = SF_NODE_RHS_INVERSE_DIAGONAL) restrict writeonly buffer InverseDiagonal { real inverse_diagonal[]; };
 
 void main() {
   uint S = sf_push.S;
@@ -33,7 +33,7 @@ void main() {
   SF_LOAD_NODE_CONSTANTS(c, s, S, at)
   real f_elements[3];
   real diagonal[3];
-  SF_CORNER_SUMS(element_rhs_out, incidence_offsets, incidence, n, s, S, f_elements)
+  SF_CORNER_SUMS(element_out, incidence_offsets, incidence, n, s, S, f_elements)
   SF_CORNER_SUMS(element_diagonal, incidence_offsets, incidence, n, s, S, diagonal)
   real u[3];
   for (uint k = 0u; k < 3u; ++k) u[k] = x[(3u * n + k) * S + s] - rest_positions[3u * n + k];
@@ -47,9 +47,9 @@ void main() {
 }
 
 #elif defined(SF_ENTRY_NODE_PRODUCT)
-layout(std430, binding = 8) restrict readonly buffer D { real d[]; };
-layout(std430, binding = 9) restrict readonly buffer ElementOut { real element_out[]; };
-layout(std430, binding = 10) restrict writeonly buffer Q { real q[]; };
+layout(std430, binding = SF_NODE_PRODUCT_D) restrict readonly buffer D { real d[]; };
+layout(std430, binding = SF_NODE_PRODUCT_ELEMENT_OUT) restrict readonly buffer ElementOut { real element_out[]; };
+layout(std430, binding = SF_NODE_PRODUCT_Q) restrict writeonly buffer Q { real q[]; };
 
 void main() {
   uint S = sf_push.S;

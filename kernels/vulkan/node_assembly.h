@@ -7,14 +7,14 @@
 #include "ensemble_layout.h"
 #include "node_rows.h"
 
-layout(std430, binding = 0) restrict readonly buffer C { real c[]; };
-layout(std430, binding = 1) restrict readonly buffer IncidenceOffsets { int incidence_offsets[]; };
-layout(std430, binding = 2) restrict readonly buffer Incidence { int incidence[]; };
-layout(std430, binding = 3) restrict readonly buffer LigamentOffsets { int ligament_offsets[]; };
-layout(std430, binding = 4) restrict readonly buffer LigamentOfNode { int ligament_of_node[]; };
-layout(std430, binding = 5) restrict readonly buffer LigamentK { real ligament_k[]; };
-layout(std430, binding = 6) restrict readonly buffer ControlK { real control_k[]; };
-layout(std430, binding = 7) restrict readonly buffer Mass { real mass[]; };
+layout(std430, binding = SF_NODE_CONSTANTS) restrict readonly buffer C { real c[]; };
+layout(std430, binding = SF_NODE_INCIDENCE_OFFSETS) restrict readonly buffer IncidenceOffsets { int incidence_offsets[]; };
+layout(std430, binding = SF_NODE_INCIDENCE) restrict readonly buffer Incidence { int incidence[]; };
+layout(std430, binding = SF_NODE_LIGAMENT_OFFSETS) restrict readonly buffer LigamentOffsets { int ligament_offsets[]; };
+layout(std430, binding = SF_NODE_LIGAMENT_OF_NODE) restrict readonly buffer LigamentOfNode { int ligament_of_node[]; };
+layout(std430, binding = SF_NODE_LIGAMENT_K) restrict readonly buffer LigamentK { real ligament_k[]; };
+layout(std430, binding = SF_NODE_CONTROL_K) restrict readonly buffer ControlK { real control_k[]; };
+layout(std430, binding = SF_NODE_MASS) restrict readonly buffer Mass { real mass[]; };
 
 /* The spring on node n for sigma point s, from the buffers above. */
 #define SF_SPRING_OF(n, s, S, spring) \

@@ -7,10 +7,10 @@
 #include "observation_gather.h"
 
 layout(local_size_x = SF_ITEMS_PER_GROUP) in;
-layout(std430, binding = 0) restrict readonly buffer Nodes { int nodes[]; };
-layout(std430, binding = 1) restrict readonly buffer Weights { real weights[]; };
-layout(std430, binding = 2) restrict readonly buffer X { real x[]; };
-layout(std430, binding = 3) restrict writeonly buffer Y { real y[]; };
+layout(std430, binding = SF_OBSERVATION_GATHER_OBSERVED_NODES) restrict readonly buffer Nodes { int nodes[]; };
+layout(std430, binding = SF_OBSERVATION_GATHER_OBSERVED_WEIGHTS) restrict readonly buffer Weights { real weights[]; };
+layout(std430, binding = SF_OBSERVATION_GATHER_X) restrict readonly buffer X { real x[]; };
+layout(std430, binding = SF_OBSERVATION_GATHER_OBSERVATIONS) restrict writeonly buffer Y { real y[]; };
 
 void main() {
   uint S = sf_push.S;

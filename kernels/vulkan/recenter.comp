@@ -8,11 +8,11 @@
 
 layout(local_size_x = SF_ITEMS_PER_GROUP) in;
 /* scalars: [0] alpha, [1 .. p] the correction. directions, weights: p x S, [j * S + s]. */
-layout(std430, binding = 0) restrict readonly buffer Scalars { real scalars[]; };
-layout(std430, binding = 1) restrict readonly buffer Directions { real directions[]; };
-layout(std430, binding = 2) restrict readonly buffer Weights { real weights[]; };
-layout(std430, binding = 3) restrict buffer X { real x[]; };
-layout(std430, binding = 4) restrict buffer V { real v[]; };
+layout(std430, binding = SF_RECENTER_RECENTER_SCALARS) restrict readonly buffer Scalars { real scalars[]; };
+layout(std430, binding = SF_RECENTER_DIRECTIONS) restrict readonly buffer Directions { real directions[]; };
+layout(std430, binding = SF_RECENTER_WEIGHTS) restrict readonly buffer Weights { real weights[]; };
+layout(std430, binding = SF_RECENTER_X) restrict buffer X { real x[]; };
+layout(std430, binding = SF_RECENTER_V) restrict buffer V { real v[]; };
 
 void main() {
   uint S = sf_push.S;

@@ -5,11 +5,11 @@
 #include "ensemble_layout.h"
 
 layout(local_size_x = SF_ITEMS_PER_GROUP) in;
-layout(std430, binding = 0) restrict readonly buffer C { real c[]; };
-layout(std430, binding = 1) restrict readonly buffer BB { real bb[]; };
-layout(std430, binding = 2) restrict buffer DV { real dv[]; };
-layout(std430, binding = 3) restrict buffer X { real x[]; };
-layout(std430, binding = 4) restrict buffer V { real v[]; };
+layout(std430, binding = SF_STATE_UPDATE_CONSTANTS) restrict readonly buffer C { real c[]; };
+layout(std430, binding = SF_STATE_UPDATE_BB) restrict readonly buffer BB { real bb[]; };
+layout(std430, binding = SF_STATE_UPDATE_DV) restrict buffer DV { real dv[]; };
+layout(std430, binding = SF_STATE_UPDATE_X) restrict buffer X { real x[]; };
+layout(std430, binding = SF_STATE_UPDATE_V) restrict buffer V { real v[]; };
 
 void main() {
   uint S = sf_push.S;

@@ -357,7 +357,7 @@ TEST_P(EnsembleConformance, KernelsOfOneStepMatchTheReference) {
 
     // The system product A d (element products gathered at the nodes, springs, mass).
     ReferenceSimulation simulation = reference(s);
-    const Eigen::VectorXd springs = simulation.spring_stiffness();
+    const Eigen::VectorXd springs = simulation.node_springs();
     const ImplicitEulerSystem system(model_, frames, springs);
     Eigen::VectorXd expected;
     system.apply(d.col(s), expected);

@@ -48,7 +48,7 @@ class ConjugateGradientTest : public ::testing::Test {
           << "CG of warm-up step " << step;
     x_ = simulation.positions();
     element_frames(model, x_, frames_);
-    springs_ = simulation.spring_stiffness();
+    springs_ = simulation.node_springs();
     system_ = std::make_unique<ImplicitEulerSystem>(model, frames_, springs_);
     b_ = system_->right_hand_side(
         simulation.forces(x_, frames_, test::held_box_so(model, (kCgWarmUpSteps + 1) * model.dt)),

@@ -40,7 +40,7 @@ class FactorisedPreconditionerTest : public ::testing::Test {
   System next_system(const ReferenceSimulation& simulation, int step) const {
     System s;
     element_frames(held_.model, simulation.positions(), s.frames);
-    s.springs = simulation.spring_stiffness();
+    s.springs = simulation.node_springs();
     s.A = std::make_unique<ImplicitEulerSystem>(held_.model, s.frames, s.springs);
     s.b = s.A->right_hand_side(simulation.forces(simulation.positions(), s.frames, so(step)),
                                simulation.velocities());

@@ -45,7 +45,7 @@ class ImplicitEulerTest : public ::testing::Test {
     x_ = simulation.positions();
     v_ = simulation.velocities();
     element_frames(held_.model, x_, frames_);
-    springs_ = simulation.spring_stiffness();
+    springs_ = simulation.node_springs();
     force_ = simulation.forces(x_, frames_, test::held_box_so(held_.model, (kWarmUpSteps + 1) * held_.model.dt));
   }
 

@@ -1,0 +1,83 @@
+/* device_layout.h: how a device ensemble lays out its buffers and what each kernel takes, read
+ * by the OpenCL kernels, the Vulkan shaders and the host (host/ensemble/device_buffers.cpp
+ * builds its table of each kernel's buffers from the slots below; the shaders bind by them).
+ *
+ * Every per-sigma array has the sigma index innermost, so that neighbouring work-items
+ * (neighbouring sigma points) read neighbouring addresses:
+ *   per-dof     x[(3 * node + axis) * S + s]
+ *   per-element frames[(9 * e + i) * S + s],  corner outputs [(12 * e + i) * S + s]
+ * Shared data (rest shape, element rest state, mass) is stored once for all sigma points.
+ * Work-items of the element and node kernels: gid = item * S + s. */
+#ifndef SIGMAFEM_DEVICE_LAYOUT_H
+#define SIGMAFEM_DEVICE_LAYOUT_H
+
+/* The element rest state, 16 numbers per element: grad[12], vlambda, vmu, two unused. */
+#define SF_REST_STRIDE 16u
+
+/* Work-items per group of the element and node kernels. */
+#define SF_ITEMS_PER_GROUP 64
+
+/* The scalars every kernel is given (Vulkan: the 16 bytes of push constants, SfPush; OpenCL:
+ * the leading scalar arguments, those a kernel needs): the sigma points, the kernel's item
+ * count (elements, nodes, rows or observed points), the CG iteration cap and the filter's
+ * parameter count (recenter). UINT(name), INT(name) declare one each. */
+#define SF_PUSH_CONSTANTS(UINT, INT) UINT(S) UINT(count) INT(max_iterations) UINT(p)
+
+/* Buffer slots: a buffer's position among a kernel's buffer arguments (OpenCL: after its
+ * scalars) and its binding (Vulkan, descriptor set 0). */
+/* element_rhs */
+#define SF_ELEMENT_RHS_ELEMENT_NODES 0
+#define SF_ELEMENT_RHS_ELEMENT_REST 1
+#define SF_ELEMENT_RHS_FRAMES 2
+#define SF_ELEMENT_RHS_X 3
+#define SF_ELEMENT_RHS_V 4
+#define SF_ELEMENT_RHS_CONSTANTS 5
+#define SF_ELEMENT_RHS_ELEMENT_OUT 6
+#define SF_ELEMENT_RHS_ELEMENT_DIAGONAL 7
+/* element_product (d and active: dv or d, all_active or active, by the call) */
+#define SF_ELEMENT_PRODUCT_ELEMENT_NODES 0
+#define SF_ELEMENT_PRODUCT_ELEMENT_REST 1
+#define SF_ELEMENT_PRODUCT_FRAMES 2
+#define SF_ELEMENT_PRODUCT_D 3
+#define SF_ELEMENT_PRODUCT_ACTIVE 4
+#define SF_ELEMENT_PRODUCT_ELEMENT_OUT 5
+#define SF_ELEMENT_PRODUCT_CONSTANTS 6
+/* the node kernels (node_rhs, node_product, Vulkan's cg_start): what a node row reads
+ * (node_rows.h), then each kernel's own */
+#define SF_NODE_CONSTANTS 0
+#define SF_NODE_INCIDENCE_OFFSETS 1
+#define SF_NODE_INCIDENCE 2
+#define SF_NODE_LIGAMENT_OFFSETS 3
+#define SF_NODE_LIGAMENT_OF_NODE 4
+#define SF_NODE_LIGAMENT_K 5
+#define SF_NODE_CONTROL_K 6
+#define SF_NODE_MASS 7
+#define SF_NODE_RHS_REST_POSITIONS 8
+#define SF_NODE_RHS_X 9
+#define SF_NODE_RHS_V 10
+#define SF_NODE_RHS_ELEMENT_OUT 11
+#define SF_NODE_RHS_ELEMENT_DIAGONAL 12
+#define SF_NODE_RHS_RHS 13
+#define SF_NODE_RHS_INVERSE_DIAGONAL 14
+#define SF_NODE_PRODUCT_D 8
+#define SF_NODE_PRODUCT_ELEMENT_OUT 9
+#define SF_NODE_PRODUCT_Q 10
+/* state_update */
+#define SF_STATE_UPDATE_CONSTANTS 0
+#define SF_STATE_UPDATE_BB 1
+#define SF_STATE_UPDATE_DV 2
+#define SF_STATE_UPDATE_X 3
+#define SF_STATE_UPDATE_V 4
+/* observation_gather */
+#define SF_OBSERVATION_GATHER_OBSERVED_NODES 0
+#define SF_OBSERVATION_GATHER_OBSERVED_WEIGHTS 1
+#define SF_OBSERVATION_GATHER_X 2
+#define SF_OBSERVATION_GATHER_OBSERVATIONS 3
+/* recenter */
+#define SF_RECENTER_RECENTER_SCALARS 0
+#define SF_RECENTER_DIRECTIONS 1
+#define SF_RECENTER_WEIGHTS 2
+#define SF_RECENTER_X 3
+#define SF_RECENTER_V 4
+
+#endif /* SIGMAFEM_DEVICE_LAYOUT_H */
