@@ -20,9 +20,8 @@ static inline __attribute__((always_inline)) void sf_element_chunk_products(
     real grad[12];
     real vlambda;
     real vmu;
-    sf_load_rest(rest, e, grad, &vlambda, &vmu);
-    int corner_nodes[4];
-    sf_load_nodes(nodes, e, corner_nodes);
+    uint corner_nodes[4];
+    SF_LOAD_ELEMENT(rest, nodes, e, grad, vlambda, vmu, corner_nodes)
     /* The products of all sigma points first, then the additions, each a loop over the
      * sigma points on contiguous data: the compiler vectorises both (with the additions in
      * the first loop it could not, not knowing that the corners' nodes differ). */
@@ -31,8 +30,8 @@ static inline __attribute__((always_inline)) void sf_element_chunk_products(
       real frame[9];
       real corner[12];
       real product[12];
-      sf_load_frame(frames, e, s, S, frame);
-      sf_gather_corners(d, corner_nodes, s, S, corner);
+      SF_LOAD_FRAME(frames, e, s, S, frame)
+      SF_GATHER_CORNERS(d, corner_nodes, s, S, corner)
       sf_element_product(frame, grad, vlambda * lambda_scale[s], vmu, corner, product);
       SF_UNROLL
       for (int i = 0; i < 12; ++i) products[i][s] = product[i];

@@ -33,9 +33,8 @@ __kernel void element_product(uint S, uint element_count, uint node_count,
   real grad[12];
   real vlambda;
   real vmu;
-  sf_load_rest(rest, e, grad, &vlambda, &vmu);
-  int corner_nodes[4];
-  sf_load_nodes(nodes, e, corner_nodes);
+  uint corner_nodes[4];
+  SF_LOAD_ELEMENT(rest, nodes, e, grad, vlambda, vmu, corner_nodes)
   const real vlambda_model = vlambda;
   for (uint b = 0; b < SF_SIGMA_BLOCK; ++b) {
     uint s = first + b;
@@ -46,10 +45,10 @@ __kernel void element_product(uint S, uint element_count, uint node_count,
     real frame[9];
     real corner[12];
     real product[12];
-    sf_load_frame(frames, e, s, S, frame);
-    sf_gather_corners(d, corner_nodes, s, S, corner);
+    SF_LOAD_FRAME(frames, e, s, S, frame)
+    SF_GATHER_CORNERS(d, corner_nodes, s, S, corner)
     sf_element_product(frame, grad, vlambda, vmu, corner, product);
-    sf_store_corners(element_out, e, s, S, product);
+    SF_STORE_CORNERS(element_out, e, s, S, product)
   }
 #endif
 }

@@ -22,9 +22,8 @@ __kernel void element_rhs(uint S, uint element_count, __global const int* restri
   real grad[12];
   real vlambda;
   real vmu;
-  sf_load_rest(rest, e, grad, &vlambda, &vmu);
-  int corner_nodes[4];
-  sf_load_nodes(nodes, e, corner_nodes);
+  uint corner_nodes[4];
+  SF_LOAD_ELEMENT(rest, nodes, e, grad, vlambda, vmu, corner_nodes)
   const real vlambda_model = vlambda;
   for (uint b = 0; b < SF_SIGMA_BLOCK; ++b) {
     uint s = first + b;
@@ -33,17 +32,16 @@ __kernel void element_rhs(uint S, uint element_count, __global const int* restri
     real corner[12];
     real force[12];
     real product[12];
-    sf_gather_corners(x, corner_nodes, s, S, corner);
+    SF_GATHER_CORNERS(x, corner_nodes, s, S, corner)
     sf_element_rotation(grad, corner, c[SF_POLAR_ROTATION], frame);
-    SF_UNROLL
-    for (int i = 0; i < 9; ++i) frames[((size_t)9 * e + i) * S + s] = frame[i];
+    SF_STORE_FRAME(frames, e, s, S, frame)
     sf_element_force(frame, grad, vlambda, vmu, corner, force);
-    sf_gather_corners(v, corner_nodes, s, S, corner);
+    SF_GATHER_CORNERS(v, corner_nodes, s, S, corner)
     sf_element_product(frame, grad, vlambda, vmu, corner, product);
     SF_UNROLL
     for (int i = 0; i < 12; ++i) force[i] -= SF_SIGMA_CONSTANT(c, SF_VELOCITY_FACTOR, s, S) * product[i];
-    sf_store_corners(element_out, e, s, S, force);
+    SF_STORE_CORNERS(element_out, e, s, S, force)
     sf_element_diagonal(frame, grad, vlambda, vmu, product);
-    sf_store_corners(element_diagonal, e, s, S, product);
+    SF_STORE_CORNERS(element_diagonal, e, s, S, product)
   }
 }

@@ -14,9 +14,6 @@ __kernel void observation_gather(uint S, uint observed_count, __global const int
   uint axis = row % 3;
   real weight[4];
   real corner[4];
-  for (uint c = 0; c < 4; ++c) {
-    weight[c] = weights[4 * k + c];
-    corner[c] = x[((size_t)3 * nodes[4 * k + c] + axis) * S + s];
-  }
+  SF_LOAD_OBSERVED_POINT(nodes, weights, x, k, axis, s, S, weight, corner)
   y[gid] = sf_observed_coordinate(weight, corner);
 }

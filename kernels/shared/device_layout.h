@@ -11,8 +11,32 @@
 #ifndef SIGMAFEM_DEVICE_LAYOUT_H
 #define SIGMAFEM_DEVICE_LAYOUT_H
 
+#include "dialect.h"
+
 /* The element rest state, 16 numbers per element: grad[12], vlambda, vmu, two unused. */
 #define SF_REST_STRIDE 16u
+
+/* The index helpers of the element kernels, over the buffers of the layout above. */
+/* Element e's rest state (element.h's grad[12], vlambda, vmu) and its four nodes (uint). */
+#define SF_LOAD_ELEMENT(rest, nodes, e, grad, vlambda, vmu, corner_nodes)            \
+  SF_UNROLL for (uint i_ = 0u; i_ < 12u; ++i_) grad[i_] =                            \
+      rest[SF_INDEX(e) * SF_REST_STRIDE + i_];                                         \
+  vlambda = rest[SF_INDEX(e) * SF_REST_STRIDE + 12u];                                  \
+  vmu = rest[SF_INDEX(e) * SF_REST_STRIDE + 13u];                                      \
+  SF_UNROLL for (uint c_ = 0u; c_ < 4u; ++c_) corner_nodes[c_] = SF_UINT(nodes[4u * (e) + c_]);
+/* A per-dof buffer's values at an element's four corners for sigma point s. */
+#define SF_GATHER_CORNERS(v, corner_nodes, s, S, out)                                \
+  SF_UNROLL for (uint c_ = 0u; c_ < 4u; ++c_)                                          \
+    SF_UNROLL for (uint k_ = 0u; k_ < 3u; ++k_)                                        \
+      out[3u * c_ + k_] = v[SF_INDEX(3u * corner_nodes[c_] + k_) * (S) + (s)];
+/* Element e's frame for sigma point s, loaded and stored. */
+#define SF_LOAD_FRAME(frames, e, s, S, frame) \
+  SF_UNROLL for (uint i_ = 0u; i_ < 9u; ++i_) frame[i_] = frames[(SF_INDEX(9u) * (e) + i_) * (S) + (s)];
+#define SF_STORE_FRAME(frames, e, s, S, frame) \
+  SF_UNROLL for (uint i_ = 0u; i_ < 9u; ++i_) frames[(SF_INDEX(9u) * (e) + i_) * (S) + (s)] = frame[i_];
+/* 12 corner values of element e for sigma point s, stored. */
+#define SF_STORE_CORNERS(out, e, s, S, values) \
+  SF_UNROLL for (uint i_ = 0u; i_ < 12u; ++i_) out[(SF_INDEX(12u) * (e) + i_) * (S) + (s)] = values[i_];
 
 /* Work-items per group of the element and node kernels. */
 #define SF_ITEMS_PER_GROUP 64

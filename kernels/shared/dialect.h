@@ -4,7 +4,8 @@
  * adapt the few places where they differ: SF_IN/SF_OUT/SF_INOUT array parameters (GLSL
  * passes arrays by value with a direction), SF_STRUCT(name) a struct type (OpenCL C needs the
  * keyword, GLSL forbids it), SF_INDEX_TYPE and SF_INDEX(x) the type that indexes a buffer
- * (size_t, or GLSL's 32-bit uint), SF_ISFINITE (GLSL has no isfinite). */
+ * (size_t, or GLSL's 32-bit uint), SF_UINT(x) a conversion to uint, SF_ISFINITE (GLSL has no
+ * isfinite). */
 #ifndef SIGMAFEM_DIALECT_H
 #define SIGMAFEM_DIALECT_H
 
@@ -23,6 +24,7 @@
 #  define SF_STRUCT(name) name
 #  define SF_INDEX_TYPE std::size_t
 #  define SF_INDEX(x) static_cast<std::size_t>(x)
+#  define SF_UINT(x) static_cast<unsigned int>(x)
 typedef unsigned int uint;
 #elif defined(__OPENCL_VERSION__) /* OpenCL C on PoCL or a GPU driver */
 #  ifndef SF_REAL
@@ -42,6 +44,7 @@ typedef unsigned int uint;
 #  define SF_STRUCT(name) struct name
 #  define SF_INDEX_TYPE size_t
 #  define SF_INDEX(x) ((size_t)(x))
+#  define SF_UINT(x) ((uint)(x))
 #elif defined(VULKAN) /* GLSL through glslang for Vulkan */
 #  ifndef SF_REAL
 #    define SF_REAL float
@@ -57,6 +60,7 @@ typedef unsigned int uint;
 #  define SF_STRUCT(name) name
 #  define SF_INDEX_TYPE uint
 #  define SF_INDEX(x) uint(x)
+#  define SF_UINT(x) uint(x)
 #else
 #  error "dialect.h: expected C++, OpenCL C or Vulkan GLSL"
 #endif

@@ -32,7 +32,7 @@ void main() {
   real frame[9];
   real corner[12];
   real product[12];
-  for (uint i = 0u; i < 9u; ++i) frame[i] = frames[(9u * e + i) * S + s];
+  SF_LOAD_FRAME(frames, e, s, S, frame)
   SF_GATHER_CORNERS(d, corner_nodes, s, S, corner)
   sf_element_product(frame, grad, vlambda, vmu, corner, product);
   SF_STORE_CORNERS(element_out, e, s, S, product)

@@ -37,7 +37,7 @@ void main() {
   real product[12];
   SF_GATHER_CORNERS(x, corner_nodes, s, S, corner)
   sf_element_rotation(grad, corner, c[SF_POLAR_ROTATION], frame);
-  for (uint i = 0u; i < 9u; ++i) frames[(9u * e + i) * S + s] = frame[i];
+  SF_STORE_FRAME(frames, e, s, S, frame)
   sf_element_force(frame, grad, vlambda, vmu, corner, force);
   SF_GATHER_CORNERS(v, corner_nodes, s, S, corner)
   sf_element_product(frame, grad, vlambda, vmu, corner, product);

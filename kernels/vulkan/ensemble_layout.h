@@ -31,21 +31,4 @@ uint sf_global_id() {
          gl_LocalInvocationID.x;
 }
 
-/* Loads element e's rest state and node indices from buffers `rest_` and `nodes_`. */
-#define SF_LOAD_ELEMENT(rest_, nodes_, e, grad, vlambda, vmu, corner_nodes)     \
-  for (uint i_ = 0u; i_ < 12u; ++i_) grad[i_] = rest_[(e) * SF_REST_STRIDE + i_]; \
-  vlambda = rest_[(e) * SF_REST_STRIDE + 12u];                                    \
-  vmu = rest_[(e) * SF_REST_STRIDE + 13u];                                        \
-  for (uint c_ = 0u; c_ < 4u; ++c_) corner_nodes[c_] = uint(nodes_[4u * (e) + c_]);
-
-/* Gathers a per-dof array's values at an element's four corners for sigma point s. */
-#define SF_GATHER_CORNERS(v_, corner_nodes, s, S, out_)                 \
-  for (uint c_ = 0u; c_ < 4u; ++c_)                                     \
-    for (uint k_ = 0u; k_ < 3u; ++k_)                                   \
-      out_[3u * c_ + k_] = v_[(3u * corner_nodes[c_] + k_) * (S) + (s)];
-
-/* Stores 12 corner values of element e for sigma point s. */
-#define SF_STORE_CORNERS(out_, e, s, S, values)                          \
-  for (uint i_ = 0u; i_ < 12u; ++i_) out_[(12u * (e) + i_) * (S) + (s)] = values[i_];
-
 #endif /* SIGMAFEM_VULKAN_ENSEMBLE_LAYOUT_H */

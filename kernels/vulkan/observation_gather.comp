@@ -22,9 +22,6 @@ void main() {
   uint axis = row % 3u;
   real weight[4];
   real corner[4];
-  for (uint c = 0u; c < 4u; ++c) {
-    weight[c] = weights[4u * k + c];
-    corner[c] = x[(3u * uint(nodes[4u * k + c]) + axis) * S + s];
-  }
+  SF_LOAD_OBSERVED_POINT(nodes, weights, x, k, axis, s, S, weight, corner)
   y[gid] = sf_observed_coordinate(weight, corner);
 }

@@ -1,8 +1,8 @@
-/* state_update: v += dv, x += h v for every sigma point (as kernels/opencl/state_update.cl).
- * A sigma point whose right-hand side was zero keeps dv = 0 (CG's exact answer). */
+/* state_update: v += dv, x += h v for every row of every sigma point (state_update.h). */
 #version 450
 #extension GL_GOOGLE_include_directive : require
 #include "ensemble_layout.h"
+#include "state_update.h"
 
 layout(local_size_x = SF_ITEMS_PER_GROUP) in;
 layout(std430, binding = SF_STATE_UPDATE_CONSTANTS) restrict readonly buffer C { real c[]; };
@@ -15,9 +15,5 @@ void main() {
   uint S = sf_push.S;
   uint gid = sf_global_id();
   if (gid >= sf_push.count * S) return;
-  uint s = gid % S;
-  if (bb[s] == real(0)) dv[gid] = real(0);
-  real vi = v[gid] + dv[gid];
-  v[gid] = vi;
-  x[gid] += c[SF_H] * vi;
+  SF_STATE_UPDATE_ROW(gid, gid % S, c[SF_H], bb, dv, x, v)
 }
