@@ -424,8 +424,9 @@ static inline __attribute__((always_inline)) int sf_block_cg_iteration(
 }
 
 /* q = A d for the block, from the element chunks' copies of K d (element_product.cl, summed
- * in chunk order) and the nodal terms: node_product's arithmetic, done here so that the
- * iteration needs no launch of its own for it and finds q in cache. */
+ * in chunk order) and the nodal terms (node_rows.h's row, as node_product's): done here so
+ * that the iteration needs no launch of its own for it and finds q in cache. A node's springs
+ * and mass are found once for its three rows. */
 static inline __attribute__((always_inline)) void sf_block_node_product(
     uint first, uint count, uint chunks, uint S, uint node_count, __global const real* restrict c,
     __global const int* restrict ligament_offsets, __global const int* restrict ligament_of_node,
@@ -434,21 +435,21 @@ static inline __attribute__((always_inline)) void sf_block_node_product(
     __global const real* restrict element_out, __global real* restrict q) {
   const size_t copy_size = (size_t)3 * node_count * S;
   /* The block's factors of A (step_constants.h), read once: the same at every node. */
-  real mass_factor[SF_BLOCK_MAX];     /* 1 + h b */
-  real spring_factor[SF_BLOCK_MAX];   /* h (h + a) */
-  real elastic[SF_BLOCK_MAX];         /* h (h + a) times Young's modulus scale, on the elements' K d */
+  real stiffness_factor[SF_BLOCK_MAX];
+  real young_scale[SF_BLOCK_MAX];
+  real mass_factor[SF_BLOCK_MAX];
   for (uint i = 0; i < count; ++i) {
+    stiffness_factor[i] = SF_SIGMA_CONSTANT(c, SF_STIFFNESS_FACTOR, first + i, S);
+    young_scale[i] = SF_SIGMA_CONSTANT(c, SF_YOUNG_SCALE, first + i, S);
     mass_factor[i] = SF_SIGMA_CONSTANT(c, SF_MASS_FACTOR, first + i, S);
-    spring_factor[i] = SF_SIGMA_CONSTANT(c, SF_STIFFNESS_FACTOR, first + i, S);
-    elastic[i] = spring_factor[i] * SF_SIGMA_CONSTANT(c, SF_YOUNG_SCALE, first + i, S);
   }
   for (uint n = 0; n < node_count; ++n) {
-    real nodal[SF_BLOCK_MAX];    /* (1 + h b) m + h (h + a) k: the nodal terms of A */
+    real spring[SF_BLOCK_MAX];
+    real m[SF_BLOCK_MAX];
     for (uint i = 0; i < count; ++i) {
-      real spring;
       SF_NODE_SPRING(ligament_offsets, ligament_of_node, ligament_k, control_k, n, first + i, S,
-                     spring)
-      nodal[i] = mass_factor[i] * sf_solver_mass(mass[n], spring) + spring_factor[i] * spring;
+                     spring[i])
+      m[i] = sf_solver_mass(mass[n], spring[i]);
     }
     SF_UNROLL
     for (int k = 0; k < 3; ++k) {
@@ -458,7 +459,8 @@ static inline __attribute__((always_inline)) void sf_block_node_product(
       for (uint chunk = 0; chunk < chunks; ++chunk)
         for (uint i = 0; i < count; ++i) sum[i] += element_out[chunk * copy_size + row + i];
       for (uint i = 0; i < count; ++i)
-        q[row + i] = elastic[i] * sum[i] + nodal[i] * d[row + i];
+        q[row + i] = sf_system_row(stiffness_factor[i], young_scale[i], mass_factor[i], sum[i],
+                                   spring[i], m[i], d[row + i]);
     }
   }
 }
