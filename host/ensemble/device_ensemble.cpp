@@ -1,5 +1,6 @@
 #include "host/ensemble/device_ensemble.h"
 
+#include <algorithm>
 #include <stdexcept>
 
 #include "host/common/device_error.h"
@@ -36,6 +37,13 @@ std::vector<DeviceBufferSpec> DeviceEnsemble::buffer_specs(const DeviceBufferSiz
   std::vector<DeviceBufferSpec> specs = device_buffer_specs(model_, observed_, S_, step_constants_.size(), sizes);
   ligament_k_ = specs[static_cast<int>(DeviceBuffer::ligament_k)].reals;
   return specs;
+}
+
+StepReport DeviceEnsemble::step_report(const std::vector<std::int32_t>& iterations,
+                                       const std::vector<std::uint32_t>& converged,
+                                       const std::vector<double>& rr, const std::vector<double>& bb) {
+  expected_iterations_ = *std::max_element(iterations.begin(), iterations.end());
+  return solver_report(iterations, converged, rr, bb);
 }
 
 void DeviceEnsemble::set_parameters(const Eigen::MatrixXd& theta) {

@@ -9,6 +9,7 @@
 
 #include <Eigen/Core>
 #include <cstddef>
+#include <cstdint>
 #include <string>
 #include <vector>
 
@@ -58,6 +59,27 @@ class DeviceEnsemble : public SimulationEnsemble {
   // Also takes the model's stiffnesses into ligament_k_ (set_parameters() changes only the
   // estimated ligaments').
   std::vector<DeviceBufferSpec> buffer_specs(const DeviceBufferSizes& sizes);
+  // CG's iterations after the start, checked on the host only now and then: `run_batch(count)`
+  // runs `count` iterations and says whether a sigma point is still iterating. The first batch
+  // is as long as the last step needed (warm-started steps need about the same), later ones
+  // an eighth of that; a sigma point that is done is left alone by the kernels, so
+  // overshooting changes nothing.
+  template <class RunBatch>
+  void iterate_in_batches(RunBatch run_batch) const {
+    const int cap = model_.solver.cg_max_iterations;
+    int batch = expected_iterations_ > 1 ? expected_iterations_ : 1;
+    for (int done = 0; done < cap;) {
+      const int count = batch < cap - done ? batch : cap - done;
+      done += count;
+      if (!run_batch(count)) break;
+      batch = expected_iterations_ / 8 > 2 ? expected_iterations_ / 8 : 2;
+    }
+  }
+  // The step's solver report from CG's per-sigma results; notes the iterations for the next
+  // step's first batch.
+  StepReport step_report(const std::vector<std::int32_t>& iterations,
+                         const std::vector<std::uint32_t>& converged, const std::vector<double>& rr,
+                         const std::vector<double>& bb);
 
   // The back end's transfers: `count` reals of a buffer; the stiffnesses (ligament_k_) for
   // the next step; the device's name; A d of the `d` buffer into `q` (system_product).

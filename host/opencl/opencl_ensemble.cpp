@@ -224,14 +224,8 @@ void OpenClEnsemble::conjugate_gradient() {
   } else {
     run_cg(k_cg_start_);
   }
-  // Iterate, checking on the host only now and then: first after as many iterations as the
-  // last step needed (warm-started steps need about the same), then in small batches. A
-  // sigma point that is done is left alone by the kernels, so overshooting changes nothing.
-  const int cap = model_.solver.cg_max_iterations;
-  int batch = std::max(1, expected_iterations_);
   std::vector<cl_uint> active(S_);
-  for (int done = 0; done < cap;) {
-    const int count = std::min(batch, cap - done);
+  iterate_in_batches([&](int count) {
     for (int i = 0; i < count; ++i) {
       element_product(DeviceBuffer::d, DeviceBuffer::active);
       if (cg_per_group_) node_product(DeviceBuffer::d);   // on a CPU cg_iteration does it
@@ -243,11 +237,10 @@ void OpenClEnsemble::conjugate_gradient() {
         run_cg(k_cg_iteration_);
       }
     }
-    done += count;
-    device_.queue().enqueueReadBuffer(buffer(DeviceBuffer::active), CL_TRUE, 0, S_ * sizeof(cl_uint), active.data());
-    if (std::none_of(active.begin(), active.end(), [](cl_uint a) { return a != 0; })) break;
-    batch = std::max(2, expected_iterations_ / 8);
-  }
+    device_.queue().enqueueReadBuffer(buffer(DeviceBuffer::active), CL_TRUE, 0, S_ * sizeof(cl_uint),
+                                      active.data());
+    return std::any_of(active.begin(), active.end(), [](cl_uint a) { return a != 0; });
+  });
 }
 
 StepReport OpenClEnsemble::advance(const Eigen::Vector3d& so_position) {
@@ -270,9 +263,8 @@ StepReport OpenClEnsemble::advance(const Eigen::Vector3d& so_position) {
     queue.enqueueReadBuffer(buffer(DeviceBuffer::bb), CL_FALSE, 0, bb_bytes.size(), bb_bytes.data());
     queue.finish();
     const Precision precision = device_.precision();
-    report = solver_report(iterations, converged, from_device_reals(rr_bytes.data(), S_, precision),
-                           from_device_reals(bb_bytes.data(), S_, precision));
-    expected_iterations_ = *std::max_element(iterations.begin(), iterations.end());
+    report = step_report(iterations, converged, from_device_reals(rr_bytes.data(), S_, precision),
+                         from_device_reals(bb_bytes.data(), S_, precision));
   } catch (const cl::Error& error) {
     throw opencl_failure("advancing the OpenCL ensemble", error);
   }

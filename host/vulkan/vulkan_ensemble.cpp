@@ -239,24 +239,19 @@ StepReport VulkanEnsemble::advance(const Eigen::Vector3d& so_position) {
   }
   device_.barrier(cmd);
 
-  // Then batches until every sigma point is done or the cap is reached. A sigma point that
-  // is done is left alone by the shaders, so iterations past its end change nothing.
-  const int cap = model_.solver.cg_max_iterations;
-  int batch = std::max(1, expected_iterations_);
+  // Then batches until every sigma point is done or the cap is reached, each submitted and
+  // waited for, with the S active flags read back.
   std::vector<std::uint32_t> active(S);
-  for (int done = 0; done < cap;) {
-    const int count = std::min(batch, cap - done);
+  iterate_in_batches([&](int count) {
     record_cg_iterations(cmd, count);
-    done += count;
     device_.copy_to_host(cmd, buffer(DeviceBuffer::active), 4 * S, at_active);
     device_.submit_and_wait(cmd);
     ++last_step_waits_;
     std::memcpy(active.data(), static_cast<const unsigned char*>(device_.read_back()) + at_active,
                 4 * S);
     cmd = device_.begin();
-    if (std::none_of(active.begin(), active.end(), [](std::uint32_t a) { return a != 0; })) break;
-    batch = std::max(2, expected_iterations_ / 8);
-  }
+    return std::any_of(active.begin(), active.end(), [](std::uint32_t a) { return a != 0; });
+  });
 
   // The state update, the solver report and the observations, in one more submission.
   dispatch_items(cmd, k_state_update_, s_state_update_, 3 * nodes_ * S,
@@ -284,9 +279,8 @@ StepReport VulkanEnsemble::advance(const Eigen::Vector3d& so_position) {
     observations_cache_ = from_device_reals(area + at_observations, rows * S, precision);
     observations_current_ = true;
   }
-  expected_iterations_ = *std::max_element(iterations.begin(), iterations.end());
-  return solver_report(iterations, converged, from_device_reals(area + at_rr, S, precision),
-                       from_device_reals(area + at_bb, S, precision));
+  return step_report(iterations, converged, from_device_reals(area + at_rr, S, precision),
+                     from_device_reals(area + at_bb, S, precision));
 }
 
 void VulkanEnsemble::predicted_observations(Eigen::MatrixXd& y) const {
