@@ -179,6 +179,26 @@ const std::vector<DeviceBuffer>& kernel_buffers(DeviceKernel kernel) {
       by_slot({{SF_RECENTER_RECENTER_SCALARS, B::recenter_scalars},
                {SF_RECENTER_DIRECTIONS, B::directions}, {SF_RECENTER_WEIGHTS, B::weights},
                {SF_RECENTER_X, B::x}, {SF_RECENTER_V, B::v}}),
+      // Vulkan's cg_start, cg_start_partials, cg_start_scalars
+      by_slot({SF_NODE_ROW_SLOTS, {SF_CG_START_ELEMENT_OUT, B::element_out},
+               {SF_CG_START_RHS, B::rhs}, {SF_CG_START_INVERSE_DIAGONAL, B::inverse_diagonal},
+               {SF_CG_START_DV, B::dv}, {SF_CG_START_R, B::r}, {SF_CG_START_Z, B::z},
+               {SF_CG_START_D, B::d}, {SF_CG_START_BB, B::bb}, {SF_CG_START_RR, B::rr},
+               {SF_CG_START_RZ, B::rz}, {SF_CG_START_ACTIVE, B::active},
+               {SF_CG_START_CONVERGED, B::converged}, {SF_CG_START_ITERATIONS, B::iterations},
+               {SF_CG_START_PARTIAL, B::partial}, {SF_CG_START_OWN_ACTIVE, B::own_active},
+               {SF_CG_START_OWN_ITERATIONS, B::own_iterations}, {SF_CG_START_OWN_RZ, B::own_rz}}),
+      // Vulkan's cg_iteration, cg_dot, cg_update, cg_direction
+      by_slot({{SF_CG_ITERATION_CONSTANTS, B::constants},
+               {SF_CG_ITERATION_INVERSE_DIAGONAL, B::inverse_diagonal},
+               {SF_CG_ITERATION_DV, B::dv}, {SF_CG_ITERATION_R, B::r}, {SF_CG_ITERATION_Z, B::z},
+               {SF_CG_ITERATION_D, B::d}, {SF_CG_ITERATION_Q, B::q}, {SF_CG_ITERATION_BB, B::bb},
+               {SF_CG_ITERATION_RR, B::rr}, {SF_CG_ITERATION_RZ, B::rz},
+               {SF_CG_ITERATION_ACTIVE, B::active}, {SF_CG_ITERATION_CONVERGED, B::converged},
+               {SF_CG_ITERATION_ITERATIONS, B::iterations}, {SF_CG_ITERATION_PARTIAL, B::partial},
+               {SF_CG_ITERATION_OWN_ACTIVE, B::own_active},
+               {SF_CG_ITERATION_OWN_ITERATIONS, B::own_iterations},
+               {SF_CG_ITERATION_OWN_RZ, B::own_rz}}),
   };
 #undef SF_NODE_ROW_SLOTS
   return table[static_cast<std::size_t>(kernel)];

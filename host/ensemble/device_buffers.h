@@ -68,9 +68,10 @@ std::vector<DeviceBufferSpec> device_buffer_specs(const Model& model, const Obse
                                                   int S, std::size_t step_constant_count,
                                                   const DeviceBufferSizes& sizes);
 
-// The kernels that both back ends have, and the buffers each takes, in argument/binding order.
+// The kernels that both back ends have, and Vulkan's two CG binding sets (the start's shaders,
+// the iteration's), and the buffers each takes, in argument/binding order.
 enum class DeviceKernel { element_rhs, node_rhs, element_product, node_product, state_update,
-                          observation_gather, recenter };
+                          observation_gather, recenter, vulkan_cg_start, vulkan_cg_iteration };
 const std::vector<DeviceBuffer>& kernel_buffers(DeviceKernel kernel);
 // `buffers` with `from` replaced by `to` (a kernel run on other inputs: element_product on dv).
 std::vector<DeviceBuffer> with_buffer(std::vector<DeviceBuffer> buffers, DeviceBuffer from,

@@ -6,7 +6,6 @@
 #include <string>
 
 #include "host/ensemble/device_readout.h"
-#include "device_layout.h"
 #include "host/ensemble/device_limits.h"
 
 namespace sigmafem {
@@ -68,15 +67,8 @@ VulkanEnsemble::VulkanEnsemble(const Model& model, std::vector<int> estimated,
   // The CG shaders (conjugate_gradient.comp): the start's three share one set of bindings
   // (the node rows' buffers first: cg_start does the warm start's gather), the iteration's
   // four another.
-  std::vector<DeviceBuffer> start = kernel_buffers(DeviceKernel::node_product);
-  start.resize(SF_NODE_MASS + 1);
-  start.insert(start.end(), {B::element_out, B::rhs, B::inverse_diagonal, B::dv, B::r, B::z, B::d,
-                             B::bb, B::rr, B::rz, B::active, B::converged, B::iterations,
-                             B::partial, B::own_active, B::own_iterations, B::own_rz});
-  const std::vector<DeviceBuffer> iteration = {
-      B::constants, B::inverse_diagonal, B::dv, B::r, B::z, B::d, B::q, B::bb, B::rr, B::rz,
-      B::active, B::converged, B::iterations, B::partial, B::own_active, B::own_iterations,
-      B::own_rz};
+  const std::vector<DeviceBuffer>& start = kernel_buffers(DeviceKernel::vulkan_cg_start);
+  const std::vector<DeviceBuffer>& iteration = kernel_buffers(DeviceKernel::vulkan_cg_iteration);
   const std::uint32_t partitions = static_cast<std::uint32_t>(cg_partitions_);
   auto cg_kernel = [&](const char* name, const std::vector<DeviceBuffer>& buffers) {
     return device_.kernel(name, static_cast<int>(buffers.size()), cg_group_, partitions);

@@ -104,4 +104,42 @@
 #define SF_RECENTER_X 3
 #define SF_RECENTER_V 4
 
+/* Vulkan's CG shaders (conjugate_gradient.comp; OpenCL's CG kernels take lists of their own,
+ * host/opencl/opencl_ensemble.cpp). The start's three shaders: the node rows' slots, then */
+#define SF_CG_START_ELEMENT_OUT 8
+#define SF_CG_START_RHS 9
+#define SF_CG_START_INVERSE_DIAGONAL 10
+#define SF_CG_START_DV 11
+#define SF_CG_START_R 12
+#define SF_CG_START_Z 13
+#define SF_CG_START_D 14
+#define SF_CG_START_BB 15
+#define SF_CG_START_RR 16
+#define SF_CG_START_RZ 17
+#define SF_CG_START_ACTIVE 18
+#define SF_CG_START_CONVERGED 19
+#define SF_CG_START_ITERATIONS 20
+#define SF_CG_START_PARTIAL 21
+#define SF_CG_START_OWN_ACTIVE 22
+#define SF_CG_START_OWN_ITERATIONS 23
+#define SF_CG_START_OWN_RZ 24
+/* the iteration's four (x of CG is the velocity change dv): */
+#define SF_CG_ITERATION_CONSTANTS 0
+#define SF_CG_ITERATION_INVERSE_DIAGONAL 1
+#define SF_CG_ITERATION_DV 2
+#define SF_CG_ITERATION_R 3
+#define SF_CG_ITERATION_Z 4
+#define SF_CG_ITERATION_D 5
+#define SF_CG_ITERATION_Q 6
+#define SF_CG_ITERATION_BB 7
+#define SF_CG_ITERATION_RR 8
+#define SF_CG_ITERATION_RZ 9
+#define SF_CG_ITERATION_ACTIVE 10
+#define SF_CG_ITERATION_CONVERGED 11
+#define SF_CG_ITERATION_ITERATIONS 12
+#define SF_CG_ITERATION_PARTIAL 13
+#define SF_CG_ITERATION_OWN_ACTIVE 14
+#define SF_CG_ITERATION_OWN_ITERATIONS 15
+#define SF_CG_ITERATION_OWN_RZ 16
+
 #endif /* SIGMAFEM_DEVICE_LAYOUT_H */

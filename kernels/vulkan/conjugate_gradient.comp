@@ -75,24 +75,24 @@ void sf_partition_nodes(uint p, out uint begin, out uint end) {
     sum_ += partial[((quantity) * (S) + (s)) * SF_PARTITIONS + p_];
 
 #if defined(SF_START_FAMILY)
-/* One descriptor set for the three start shaders (and the OpenCL kernels' argument order). */
-layout(std430, binding = 8) restrict readonly buffer ElementOut { real element_out[]; };
-layout(std430, binding = 9) restrict readonly buffer B { real b[]; };
-layout(std430, binding = 10) restrict readonly buffer InverseDiagonal { real inverse_diagonal[]; };
-layout(std430, binding = 11) restrict readonly buffer X { real x[]; };
-layout(std430, binding = 12) restrict writeonly buffer R { real r[]; };
-layout(std430, binding = 13) restrict writeonly buffer Z { real z[]; };
-layout(std430, binding = 14) restrict writeonly buffer D { real d[]; };
-layout(std430, binding = 15) restrict writeonly buffer BB { real bb[]; };
-layout(std430, binding = 16) restrict writeonly buffer RR { real rr[]; };
-layout(std430, binding = 17) restrict writeonly buffer RZ { real rz[]; };
-layout(std430, binding = 18) restrict writeonly buffer Active { uint active_flags[]; };
-layout(std430, binding = 19) restrict writeonly buffer Converged { uint converged[]; };
-layout(std430, binding = 20) restrict writeonly buffer Iterations { int iterations[]; };
-layout(std430, binding = 21) restrict buffer Partial { real partial[]; };
-layout(std430, binding = 22) restrict writeonly buffer OwnActive { uint own_active[]; };
-layout(std430, binding = 23) restrict writeonly buffer OwnIterations { int own_iterations[]; };
-layout(std430, binding = 24) restrict writeonly buffer OwnRz { real own_rz[]; };
+/* One descriptor set for the three start shaders: the node rows' buffers (node_assembly.h), then these. */
+layout(std430, binding = SF_CG_START_ELEMENT_OUT) restrict readonly buffer ElementOut { real element_out[]; };
+layout(std430, binding = SF_CG_START_RHS) restrict readonly buffer B { real b[]; };
+layout(std430, binding = SF_CG_START_INVERSE_DIAGONAL) restrict readonly buffer InverseDiagonal { real inverse_diagonal[]; };
+layout(std430, binding = SF_CG_START_DV) restrict readonly buffer X { real x[]; };
+layout(std430, binding = SF_CG_START_R) restrict writeonly buffer R { real r[]; };
+layout(std430, binding = SF_CG_START_Z) restrict writeonly buffer Z { real z[]; };
+layout(std430, binding = SF_CG_START_D) restrict writeonly buffer D { real d[]; };
+layout(std430, binding = SF_CG_START_BB) restrict writeonly buffer BB { real bb[]; };
+layout(std430, binding = SF_CG_START_RR) restrict writeonly buffer RR { real rr[]; };
+layout(std430, binding = SF_CG_START_RZ) restrict writeonly buffer RZ { real rz[]; };
+layout(std430, binding = SF_CG_START_ACTIVE) restrict writeonly buffer Active { uint active_flags[]; };
+layout(std430, binding = SF_CG_START_CONVERGED) restrict writeonly buffer Converged { uint converged[]; };
+layout(std430, binding = SF_CG_START_ITERATIONS) restrict writeonly buffer Iterations { int iterations[]; };
+layout(std430, binding = SF_CG_START_PARTIAL) restrict buffer Partial { real partial[]; };
+layout(std430, binding = SF_CG_START_OWN_ACTIVE) restrict writeonly buffer OwnActive { uint own_active[]; };
+layout(std430, binding = SF_CG_START_OWN_ITERATIONS) restrict writeonly buffer OwnIterations { int own_iterations[]; };
+layout(std430, binding = SF_CG_START_OWN_RZ) restrict writeonly buffer OwnRz { real own_rz[]; };
 
 /* Over nodes [begin, end) of sigma point s, with q = A x (x = the last step's dv, products
  * in element_out): r = b - q, z = M^-1 r, d = z; and the group's sums b.b, r.r, r.z. */
@@ -177,23 +177,23 @@ void main() {
 #  endif
 
 #else /* the iteration's shaders: one descriptor set for the four */
-layout(std430, binding = 0) restrict readonly buffer C { real c[]; };
-layout(std430, binding = 1) restrict readonly buffer InverseDiagonal { real inverse_diagonal[]; };
-layout(std430, binding = 2) restrict buffer X { real x[]; };
-layout(std430, binding = 3) restrict buffer R { real r[]; };
-layout(std430, binding = 4) restrict buffer Z { real z[]; };
-layout(std430, binding = 5) restrict buffer D { real d[]; };
-layout(std430, binding = 6) restrict readonly buffer Q { real q[]; };
-layout(std430, binding = 7) restrict readonly buffer BB { real bb[]; };
-layout(std430, binding = 8) restrict buffer RR { real rr[]; };
-layout(std430, binding = 9) restrict buffer RZ { real rz[]; };
-layout(std430, binding = 10) restrict buffer Active { uint active_flags[]; };
-layout(std430, binding = 11) restrict buffer Converged { uint converged[]; };
-layout(std430, binding = 12) restrict buffer Iterations { int iterations[]; };
-layout(std430, binding = 13) restrict buffer Partial { real partial[]; };
-layout(std430, binding = 14) restrict buffer OwnActive { uint own_active[]; };
-layout(std430, binding = 15) restrict buffer OwnIterations { int own_iterations[]; };
-layout(std430, binding = 16) restrict buffer OwnRz { real own_rz[]; };
+layout(std430, binding = SF_CG_ITERATION_CONSTANTS) restrict readonly buffer C { real c[]; };
+layout(std430, binding = SF_CG_ITERATION_INVERSE_DIAGONAL) restrict readonly buffer InverseDiagonal { real inverse_diagonal[]; };
+layout(std430, binding = SF_CG_ITERATION_DV) restrict buffer X { real x[]; };
+layout(std430, binding = SF_CG_ITERATION_R) restrict buffer R { real r[]; };
+layout(std430, binding = SF_CG_ITERATION_Z) restrict buffer Z { real z[]; };
+layout(std430, binding = SF_CG_ITERATION_D) restrict buffer D { real d[]; };
+layout(std430, binding = SF_CG_ITERATION_Q) restrict readonly buffer Q { real q[]; };
+layout(std430, binding = SF_CG_ITERATION_BB) restrict readonly buffer BB { real bb[]; };
+layout(std430, binding = SF_CG_ITERATION_RR) restrict buffer RR { real rr[]; };
+layout(std430, binding = SF_CG_ITERATION_RZ) restrict buffer RZ { real rz[]; };
+layout(std430, binding = SF_CG_ITERATION_ACTIVE) restrict buffer Active { uint active_flags[]; };
+layout(std430, binding = SF_CG_ITERATION_CONVERGED) restrict buffer Converged { uint converged[]; };
+layout(std430, binding = SF_CG_ITERATION_ITERATIONS) restrict buffer Iterations { int iterations[]; };
+layout(std430, binding = SF_CG_ITERATION_PARTIAL) restrict buffer Partial { real partial[]; };
+layout(std430, binding = SF_CG_ITERATION_OWN_ACTIVE) restrict buffer OwnActive { uint own_active[]; };
+layout(std430, binding = SF_CG_ITERATION_OWN_ITERATIONS) restrict buffer OwnIterations { int own_iterations[]; };
+layout(std430, binding = SF_CG_ITERATION_OWN_RZ) restrict buffer OwnRz { real own_rz[]; };
 
 /* The group's d.q over nodes [begin, end) of sigma point s. */
 real sf_dq_rows(uint s, uint S, uint begin, uint end) {
