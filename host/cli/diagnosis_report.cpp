@@ -12,6 +12,7 @@
 #include "host/common/atomic_file.h"
 #include "host/common/output_set.h"
 #include "host/common/input_error.h"
+#include "host/diagnosis/diagnosis_conclusion.h"
 
 namespace sigmafem::cli {
 namespace fs = std::filesystem;
@@ -76,24 +77,17 @@ std::string fixed(double x, int digits) {
   return out.str();
 }
 
-std::string general(double x) {
-  std::ostringstream out;
-  out.precision(4);
-  out << x;
-  return out.str();
-}
-
 std::string estimate_text(const EffectEstimate& e) {
   std::ostringstream out;
   out << "`" << e.name << "` = (";
-  for (std::size_t j = 0; j < e.value.size(); ++j) out << (j ? ", " : "") << general(e.value[j]);
+  for (std::size_t j = 0; j < e.value.size(); ++j) out << (j ? ", " : "") << significant_digits(e.value[j], 4);
   out << ") +- (";
-  for (std::size_t j = 0; j < e.std.size(); ++j) out << (j ? ", " : "") << general(e.std[j]);
+  for (std::size_t j = 0; j < e.std.size(); ++j) out << (j ? ", " : "") << significant_digits(e.std[j], 4);
   out << ")";
   if (!e.units.empty() && !e.units[0].empty()) out << " " << e.units[0];
   if (std::any_of(e.path_ratio.begin(), e.path_ratio.end(), [](double r) { return r > 1.0; })) {
     out << ", std x path ratio (";
-    for (std::size_t j = 0; j < e.path_ratio.size(); ++j) out << (j ? ", " : "") << general(std::max(1.0, e.path_ratio[j]));
+    for (std::size_t j = 0; j < e.path_ratio.size(); ++j) out << (j ? ", " : "") << significant_digits(std::max(1.0, e.path_ratio[j]), 4);
     out << ")";
   }
   return out.str();

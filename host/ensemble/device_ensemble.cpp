@@ -39,6 +39,12 @@ std::vector<DeviceBufferSpec> DeviceEnsemble::buffer_specs(const DeviceBufferSiz
   return specs;
 }
 
+std::size_t DeviceEnsemble::take_device_bytes(const DeviceBufferSpec& spec, std::size_t real_size) {
+  const std::size_t bytes = spec.count * (spec.integer ? sizeof(std::int32_t) : real_size);
+  device_bytes_ += bytes;
+  return bytes;
+}
+
 StepReport DeviceEnsemble::step_report(const std::vector<std::int32_t>& iterations,
                                        const std::vector<std::uint32_t>& converged,
                                        const std::vector<double>& rr, const std::vector<double>& bb) {

@@ -8,6 +8,7 @@
 #pragma once
 
 #include <Eigen/Core>
+#include <algorithm>
 #include <cstddef>
 #include <cstdint>
 #include <string>
@@ -59,6 +60,8 @@ class DeviceEnsemble : public SimulationEnsemble {
   // Also takes the model's stiffnesses into ligament_k_ (set_parameters() changes only the
   // estimated ligaments').
   std::vector<DeviceBufferSpec> buffer_specs(const DeviceBufferSizes& sizes);
+  // The bytes of buffer `spec` with `real_size`-byte reals, counted into device_bytes_.
+  std::size_t take_device_bytes(const DeviceBufferSpec& spec, std::size_t real_size);
   // CG's iterations after the start, checked on the host only now and then: `run_batch(count)`
   // runs `count` iterations and says whether a sigma point is still iterating. The first batch
   // is as long as the last step needed (warm-started steps need about the same), later ones
@@ -67,12 +70,12 @@ class DeviceEnsemble : public SimulationEnsemble {
   template <class RunBatch>
   void iterate_in_batches(RunBatch run_batch) const {
     const int cap = model_.solver.cg_max_iterations;
-    int batch = expected_iterations_ > 1 ? expected_iterations_ : 1;
+    int batch = std::max(1, expected_iterations_);
     for (int done = 0; done < cap;) {
-      const int count = batch < cap - done ? batch : cap - done;
+      const int count = std::min(batch, cap - done);
       done += count;
       if (!run_batch(count)) break;
-      batch = expected_iterations_ / 8 > 2 ? expected_iterations_ / 8 : 2;
+      batch = std::max(2, expected_iterations_ / 8);
     }
   }
   // The step's solver report from CG's per-sigma results; notes the iterations for the next

@@ -70,8 +70,7 @@ OpenClEnsemble::OpenClEnsemble(const Model& model, std::vector<int> estimated,
     // The chunks' copies of K d on a CPU live in the element outputs (element_product.cl).
     const std::size_t dof = 3 * static_cast<std::size_t>(nodes_) * S_;
     for (const DeviceBufferSpec& spec : buffer_specs({element_chunks_ * dof, cg_partitions_})) {
-      const std::size_t bytes = spec.count * (spec.integer ? sizeof(cl_int) : device_.real_size());
-      device_bytes_ += bytes;
+      const std::size_t bytes = take_device_bytes(spec, device_.real_size());
       buffers_.emplace_back(device_.context(), CL_MEM_READ_WRITE, bytes);
       if (spec.integer && !spec.integers.empty())
         device_.queue().enqueueWriteBuffer(buffers_.back(), CL_TRUE, 0, bytes, spec.integers.data());

@@ -42,8 +42,7 @@ VulkanEnsemble::VulkanEnsemble(const Model& model, std::vector<int> estimated,
 
   // The partitions' buffers are bound but unused with one partition.
   for (const DeviceBufferSpec& spec : buffer_specs({0, cg_partitions_})) {
-    const std::size_t bytes = spec.count * (spec.integer ? sizeof(std::int32_t) : device_.real_size());
-    device_bytes_ += bytes;
+    const std::size_t bytes = take_device_bytes(spec, device_.real_size());
     buffers_.push_back(device_.buffer(bytes, spec.what));
     if (spec.integer) device_.upload(buffers_.back(), spec.integers.data(), bytes);
     if (!spec.reals.empty()) write_reals(spec.id, spec.reals);
