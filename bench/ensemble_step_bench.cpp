@@ -166,12 +166,18 @@ void BM_filter_step(benchmark::State& state, const Backend& backend, const std::
     const Eigen::Vector3d so = observe();
     filter.step(so, y);
   }
+  // The CPU back end's factorisations in the timed steps (issue 18: what a step costs).
+  const auto* cpu = dynamic_cast<const CpuEnsemble*>(ensemble.get());
+  const int factorisations_before = cpu ? cpu->factorisations() : 0;
   for (auto _ : state) {
     state.PauseTiming();
     const Eigen::Vector3d so = observe();
     state.ResumeTiming();
     benchmark::DoNotOptimize(filter.step(so, y));
   }
+  if (cpu)
+    state.counters["factorisations_per_step"] =
+        (cpu->factorisations() - factorisations_before) / static_cast<double>(state.iterations());
   state.counters["sigma_points"] = ensemble->sigma_count();
   state.counters["tetrahedra"] = model.element_count();
   state.SetLabel(backend.label + ", " + name + ", simplex");

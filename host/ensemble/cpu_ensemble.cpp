@@ -9,30 +9,6 @@
 namespace sigmafem {
 namespace {
 
-// Runs body(s) for s = 0..count-1 on up to `threads` threads, in interleaved chunks.
-template <class Body>
-void parallel_for(int count, int threads, const Body& body) {
-  const int workers = std::max(1, std::min(threads, count));
-  if (workers == 1) {
-    for (int s = 0; s < count; ++s) body(s);
-    return;
-  }
-  std::vector<std::thread> pool;
-  std::vector<std::exception_ptr> errors(workers);
-  for (int w = 0; w < workers; ++w) {
-    pool.emplace_back([&, w]() {
-      try {
-        for (int s = w; s < count; s += workers) body(s);
-      } catch (...) {
-        errors[w] = std::current_exception();
-      }
-    });
-  }
-  for (std::thread& thread : pool) thread.join();
-  for (const std::exception_ptr& error : errors)
-    if (error) std::rethrow_exception(error);
-}
-
 // Own factors converge in about half the iterations of a shared one (bench/RESULTS.md) and
 // suit diagnose, whose sigma points differ by whole effects, but they hold S factors: up to
 // 1 GiB of them (S = 16 on a 4768-tetrahedron liver takes about 30 MB), one shared above.
@@ -51,9 +27,13 @@ CpuEnsemble::CpuEnsemble(const Model& model, std::vector<int> estimated, Observe
     if (l < 0 || l >= static_cast<int>(model.ligaments.size()))
       throw std::invalid_argument("CpuEnsemble: no ligament " + std::to_string(l));
   check_observed_points(observed_, model.node_count(), "CpuEnsemble");
-  simulations_.assign(sigma_count, ReferenceSimulation(model));
+  ReferenceSimulation first(model);
+  // One assembly pattern for all the factors' refreshes, not one per sigma point.
+  if (preconditioner_ != Preconditioner::jacobi) first.assembly_pattern();
+  simulations_.assign(sigma_count, first);
   const int cores = static_cast<int>(std::thread::hardware_concurrency());
   threads_ = threads > 0 ? threads : std::max(1, cores);
+  pool_ = std::make_unique<WorkerPool>(std::min(threads_, sigma_count));
 }
 
 void CpuEnsemble::make_factors() {
@@ -100,7 +80,7 @@ StepReport CpuEnsemble::advance(const Eigen::Vector3d& so_position) {
   if (preconditioner_ != Preconditioner::jacobi && factors_.empty()) make_factors();
   // A shared factor is made again here, between steps; own ones in each simulation's step.
   if (shared_factor_ && factors_[0]->due()) factors_[0]->factorise(simulations_[0].system_matrix());
-  parallel_for(S, threads_, [&](int s) {
+  pool_->run(S, [&](int s) {
     const CgResult cg = simulations_[s].step(so_position);
     report.cg_iterations[s] = cg.iterations;
     report.relative_residual[s] = cg.relative_residual;

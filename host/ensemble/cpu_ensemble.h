@@ -1,7 +1,8 @@
 // CpuEnsemble: the Ensemble (filter/ensemble.h) on the CPU reference: one ReferenceSimulation
 // per sigma point, in double precision. It is the back end the device ensembles are checked
 // against, and the one that runs anywhere. Sigma points are independent, so they run on
-// worker threads (one per core, at most S); each one's arithmetic is unchanged by that, so
+// worker threads kept for the ensemble's life (host/common/worker_pool.h: one per core, at
+// most S, the caller's included); each one's arithmetic is unchanged by that, so
 // results do not depend on the thread count.
 //
 // CG's preconditioner (host/common/device_options.h): Jacobi, as the lone ReferenceSimulation,
@@ -22,6 +23,7 @@
 
 #include "host/common/device_options.h"
 #include "host/ensemble/simulation_ensemble.h"
+#include "host/common/worker_pool.h"
 #include "host/mesh/observed_points.h"
 #include "host/model/model.h"
 #include "host/reference/factorised_preconditioner.h"
@@ -64,6 +66,7 @@ class CpuEnsemble : public SimulationEnsemble {
   std::vector<int> estimated_;
   ObservedPoints observed_;
   int threads_;
+  std::unique_ptr<WorkerPool> pool_;   // threads_ threads at most, one per sigma point
   Preconditioner preconditioner_;
   // Empty with Jacobi and before the first step; then one per sigma point, or one shared.
   // The simulations hold pointers to them: unique_ptrs, so that moving the ensemble does

@@ -74,26 +74,29 @@ void element_diagonal(const Model& model, const std::vector<Frame>& frames,
 }
 
 Eigen::SparseMatrix<double> assemble_element_stiffness(const Model& model,
-                                                       const std::vector<Frame>& frames) {
-  std::vector<Eigen::Triplet<double>> triplets;
-  triplets.reserve(model.elements.size() * 144);
+                                                       const std::vector<Frame>& frames,
+                                                       const AssemblyPattern& pattern) {
+  Eigen::SparseMatrix<double> K = pattern.zeros();
+  double* values = K.valuePtr();
   for (std::size_t e = 0; e < model.elements.size(); ++e) {
     const ElementRest& element = model.elements[e];
     // Column j of R K_e R^T is the element product of the j-th unit vector: one definition
-    // of the tangent for the matrix-free and the assembled paths.
+    // of the tangent for the matrix-free and the assembled paths. Each entry sums its
+    // elements' parts in element order.
     for (int j = 0; j < 12; ++j) {
       double unit[12] = {0.0}, column[12];
       unit[j] = 1.0;
       shared::sf_element_product(frames[e].data(), element.grad.data(), element.vlambda,
                                  element.vmu, unit, column);
-      const int col = 3 * element.nodes[j / 3] + j % 3;
-      for (int i = 0; i < 12; ++i)
-        triplets.emplace_back(3 * element.nodes[i / 3] + i % 3, col, column[i]);
+      for (int i = 0; i < 12; ++i) values[pattern.element_slot(e, i, j)] += column[i];
     }
   }
-  Eigen::SparseMatrix<double> K(model.dof_count(), model.dof_count());
-  K.setFromTriplets(triplets.begin(), triplets.end());
   return K;
+}
+
+Eigen::SparseMatrix<double> assemble_element_stiffness(const Model& model,
+                                                       const std::vector<Frame>& frames) {
+  return assemble_element_stiffness(model, frames, AssemblyPattern(model));
 }
 
 Eigen::Matrix3d element_rotation(const Model& model, const std::vector<Frame>& frames, int e) {

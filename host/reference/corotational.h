@@ -12,6 +12,7 @@
 #include <vector>
 
 #include "host/model/model.h"
+#include "host/reference/assembly_pattern.h"
 
 namespace sigmafem {
 
@@ -32,7 +33,11 @@ void element_product(const Model& model, const std::vector<Frame>& frames,
 void element_diagonal(const Model& model, const std::vector<Frame>& frames,
                       Eigen::VectorXd& diagonal);
 
-// The elastic tangent stiffness as a sparse matrix (for the direct solve and the tests).
+// The elastic tangent stiffness as a sparse matrix with the pattern's sparsity (the
+// factors, the direct solve); without one, a pattern made for the call (the tests).
+Eigen::SparseMatrix<double> assemble_element_stiffness(const Model& model,
+                                                       const std::vector<Frame>& frames,
+                                                       const AssemblyPattern& pattern);
 Eigen::SparseMatrix<double> assemble_element_stiffness(const Model& model,
                                                        const std::vector<Frame>& frames);
 

@@ -11,6 +11,7 @@
 
 #include <Eigen/Core>
 #include <Eigen/SparseCholesky>
+#include <vector>
 
 namespace sigmafem {
 
@@ -34,7 +35,9 @@ class FactorisedPreconditioner {
   void operator()(const Eigen::VectorXd& r, Eigen::VectorXd& z) const { z = llt_.solve(r); }
 
  private:
+  bool same_pattern(const Eigen::SparseMatrix<double>& A) const;
   Eigen::SimplicialLLT<Eigen::SparseMatrix<double>> llt_;
+  std::vector<int> outer_, inner_;   // the pattern analysed (empty: none yet)
   bool ready_ = false;
   bool fresh_ = false;      // factorised since the last record()
   int factorisations_ = 0;

@@ -40,10 +40,12 @@ Eigen::VectorXd ImplicitEulerSystem::diagonal() const {
   return mass_factor_ * dof_mass_ + stiffness_factor_ * (diag + dof_spring_);
 }
 
-Eigen::SparseMatrix<double> ImplicitEulerSystem::assemble() const {
-  Eigen::SparseMatrix<double> A = assemble_element_stiffness(model_, frames_) * stiffness_factor_;
-  Eigen::VectorXd extra = mass_factor_ * dof_mass_ + stiffness_factor_ * dof_spring_;
-  for (int i = 0; i < A.rows(); ++i) A.coeffRef(i, i) += extra[i];
+Eigen::SparseMatrix<double> ImplicitEulerSystem::assemble(const AssemblyPattern& pattern) const {
+  Eigen::SparseMatrix<double> A = assemble_element_stiffness(model_, frames_, pattern);
+  double* values = A.valuePtr();
+  for (Eigen::Index k = 0; k < A.nonZeros(); ++k) values[k] *= stiffness_factor_;
+  const Eigen::VectorXd extra = mass_factor_ * dof_mass_ + stiffness_factor_ * dof_spring_;
+  for (int i = 0; i < A.rows(); ++i) values[pattern.diagonal_slot(i)] += extra[i];
   return A;
 }
 

@@ -11,6 +11,7 @@
 #include <vector>
 
 #include "host/model/model.h"
+#include "host/reference/assembly_pattern.h"
 #include "host/reference/corotational.h"
 
 namespace sigmafem {
@@ -29,8 +30,9 @@ class ImplicitEulerSystem {
   void operator()(const Eigen::VectorXd& d, Eigen::VectorXd& y) const { apply(d, y); }
   // diag(A).
   Eigen::VectorXd diagonal() const;
-  // A assembled, for the direct solve.
-  Eigen::SparseMatrix<double> assemble() const;
+  // A assembled with the pattern's sparsity (built once per mesh), for the factors and the
+  // direct solve.
+  Eigen::SparseMatrix<double> assemble(const AssemblyPattern& pattern) const;
   // The right-hand side h (f - (h + a) K v - b M v) for the force f at x_n and velocity v.
   Eigen::VectorXd right_hand_side(const Eigen::VectorXd& force,
                                   const Eigen::VectorXd& velocity) const;

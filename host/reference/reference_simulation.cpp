@@ -115,7 +115,7 @@ CgResult ReferenceSimulation::step(const Eigen::Vector3d& so_position) {
   const bool factored = solver_ == LinearSolver::conjugate_gradient && factor_ != nullptr;
   // A factor that cannot be made (not positive definite: a candidate's negative stiffness)
   // leaves this step to Jacobi; the next one tries again.
-  if (factored && refresh_factor_ && factor_->due()) factor_->factorise(system.assemble());
+  if (factored && refresh_factor_ && factor_->due()) factor_->factorise(system.assemble(assembly_pattern()));
   if (factored && factor_->ready()) {
     result = preconditioned_conjugate_gradient(system, *factor_, b, dv_,
                                                model_.solver.cg_max_iterations,
@@ -125,7 +125,7 @@ CgResult ReferenceSimulation::step(const Eigen::Vector3d& so_position) {
     result = conjugate_gradient(system, inverse_diagonal, b, dv_, model_.solver.cg_max_iterations,
                                 model_.solver.cg_tolerance);
   } else {
-    Eigen::SimplicialLDLT<Eigen::SparseMatrix<double>> ldlt(system.assemble());
+    Eigen::SimplicialLDLT<Eigen::SparseMatrix<double>> ldlt(system.assemble(assembly_pattern()));
     if (ldlt.info() != Eigen::Success)
       throw std::runtime_error("direct solve: the implicit Euler matrix is not positive definite");
     dv_ = ldlt.solve(b);
@@ -146,7 +146,12 @@ CgResult ReferenceSimulation::step(const Eigen::Vector3d& so_position) {
 Eigen::SparseMatrix<double> ReferenceSimulation::system_matrix() const {
   std::vector<Frame> frames;
   element_frames(model_, x_, frames);
-  return ImplicitEulerSystem(model_, frames, node_springs()).assemble();
+  return ImplicitEulerSystem(model_, frames, node_springs()).assemble(assembly_pattern());
+}
+
+const AssemblyPattern& ReferenceSimulation::assembly_pattern() const {
+  if (!assembly_pattern_) assembly_pattern_ = std::make_shared<const AssemblyPattern>(model_);
+  return *assembly_pattern_;
 }
 
 double ReferenceSimulation::kinetic_energy() const {

@@ -12,11 +12,13 @@
 
 #include <Eigen/Core>
 #include <Eigen/SparseCore>
+#include <memory>
 #include <vector>
 
 #include "host/model/effects.h"
 #include "host/model/model.h"
 #include "host/model/so_history.h"
+#include "host/reference/assembly_pattern.h"
 #include "host/reference/conjugate_gradient.h"
 #include "host/reference/corotational.h"
 
@@ -48,6 +50,9 @@ class ReferenceSimulation {
   }
   // The matrix the next step solves with, at the current state (CpuEnsemble factorises one).
   Eigen::SparseMatrix<double> system_matrix() const;
+  // The sparsity its assembly fills, made at the first assembly; copies of the simulation
+  // share it (CpuEnsemble makes it once, before copying the simulation per sigma point).
+  const AssemblyPattern& assembly_pattern() const;
 
   // Physics effects on top of the model given at construction (diagnose estimates them per
   // sigma point); PhysicsEffects{} restores the model.
@@ -77,6 +82,7 @@ class ReferenceSimulation {
   LinearSolver solver_ = LinearSolver::conjugate_gradient;
   FactorisedPreconditioner* factor_ = nullptr;
   bool refresh_factor_ = false;
+  mutable std::shared_ptr<const AssemblyPattern> assembly_pattern_;   // null until needed
   Eigen::VectorXd x_, v_;
   Eigen::VectorXd dv_;                 // last velocity change: the CG warm start
   std::vector<Frame> frames_;

@@ -74,7 +74,7 @@ TEST_F(ConjugateGradientTest, AgreesWithEigenConjugateGradientAndTheDirectSolve)
   EXPECT_LE((b_ - Ax).norm(), kSolveTolerance * b_.norm())
       << "true relative residual |b - A x| / |b| at exit";
 
-  const Eigen::SparseMatrix<double> A = system_->assemble();
+  const Eigen::SparseMatrix<double> A = system_->assemble(AssemblyPattern(held_.model));
   // DiagonalPreconditioner is Eigen's default: Jacobi, as ours.
   Eigen::ConjugateGradient<Eigen::SparseMatrix<double>, Eigen::Lower | Eigen::Upper,
                            Eigen::DiagonalPreconditioner<double>>

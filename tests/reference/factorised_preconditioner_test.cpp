@@ -88,6 +88,23 @@ TEST_F(FactorisedPreconditionerTest, TheFactorOfANearbySystemNeedsFewIterationsF
   EXPECT_LE((x_factor - x_jacobi).norm(), kPcgAgreement * x_jacobi.norm());
 }
 
+TEST_F(FactorisedPreconditionerTest, AFactorMadeAgainKeepsItsOrderingAndHasAFreshFactorsNumbers) {
+  // The first factorisation orders the pattern; the second, of another step's matrix with the
+  // same pattern, keeps that ordering: its solves are a freshly computed factor's, bit for bit.
+  FactorisedPreconditioner factor;
+  ASSERT_TRUE(factor.factorise(simulation_->system_matrix()));
+  for (int step = 31; step <= 40; ++step) simulation_->step(so(step));
+  const Eigen::SparseMatrix<double> later = simulation_->system_matrix();
+  ASSERT_TRUE(factor.factorise(later));
+  const Eigen::SimplicialLLT<Eigen::SparseMatrix<double>> fresh(later);
+  const Eigen::VectorXd r = next_system(*simulation_, 41).b;
+  Eigen::VectorXd z;
+  factor(r, z);
+  const Eigen::VectorXd expected = fresh.solve(r);
+  for (Eigen::Index i = 0; i < r.size(); ++i) ASSERT_EQ(z[i], expected[i]) << "row " << i;
+  EXPECT_EQ(factor.factorisations(), 2);
+}
+
 TEST(FactorisedPreconditioner, RefusesAMatrixThatIsNotPositiveDefinite) {
   Eigen::SparseMatrix<double> minus_identity(3, 3);
   minus_identity.setIdentity();
