@@ -377,6 +377,8 @@ BENCHMARK_CAPTURE(BM_filter_step, opencl_liver_fine_38144, kOpenCl, std::string(
     ->Iterations(20)->Unit(benchmark::kMillisecond)->UseRealTime();
 BENCHMARK_CAPTURE(BM_filter_step, vulkan_liver_fine_38144, kVulkan, std::string("liver_fine"))
     ->Iterations(20)->Unit(benchmark::kMillisecond)->UseRealTime();
+BENCHMARK_CAPTURE(BM_filter_step, cpu_liver_fine_38144, kCpu, std::string("liver_fine"))
+    ->Iterations(20)->Unit(benchmark::kMillisecond)->UseRealTime();
 
 }  // namespace
 }  // namespace sigmafem
