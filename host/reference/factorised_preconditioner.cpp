@@ -32,6 +32,34 @@ bool FactorisedPreconditioner::same_pattern(const Eigen::SparseMatrix<double>& A
          std::equal(inner_.begin(), inner_.end(), A.innerIndexPtr());
 }
 
+void FactorisedPreconditioner::operator()(const Eigen::VectorXd& r, Eigen::VectorXd& z) const {
+  const Eigen::SparseMatrix<double>& L = llt_.matrixL().nestedExpression();   // lower, by columns
+  const int n = static_cast<int>(L.cols());
+  const int* begin = L.outerIndexPtr();   // column j: entries begin[j] (the diagonal) .. begin[j + 1]
+  const int* row = L.innerIndexPtr();
+  const double* value = L.valuePtr();
+  const int* order = llt_.permutationP().indices().data();
+  Eigen::VectorXd y(n);
+  for (int i = 0; i < n; ++i) y[order[i]] = r[i];
+  // L y' = y, column by column: each solved entry is taken out of the rows below it.
+  for (int j = 0; j < n; ++j) {
+    const double solved = y[j] / value[begin[j]];
+    y[j] = solved;
+    for (int k = begin[j] + 1; k < begin[j + 1]; ++k) y[row[k]] -= value[k] * solved;
+  }
+  // L^T x = y', row j of L^T being column j of L, from the last row up.
+  for (int j = n - 1; j >= 0; --j) {
+    double sum[4] = {0.0, 0.0, 0.0, 0.0};
+    int k = begin[j] + 1;
+    for (; k + 3 < begin[j + 1]; k += 4)
+      for (int lane = 0; lane < 4; ++lane) sum[lane] += value[k + lane] * y[row[k + lane]];
+    for (; k < begin[j + 1]; ++k) sum[0] += value[k] * y[row[k]];
+    y[j] = (y[j] - ((sum[0] + sum[1]) + (sum[2] + sum[3]))) / value[begin[j]];
+  }
+  z.resize(n);
+  for (int i = 0; i < n; ++i) z[i] = y[order[i]];
+}
+
 double FactorisedPreconditioner::bytes() const {
   if (!ready_) return 0.0;
   const double nonzeros = static_cast<double>(llt_.matrixL().nestedExpression().nonZeros());
