@@ -61,6 +61,28 @@ void element_product(const Model& model, const std::vector<Frame>& frames,
   }
 }
 
+void element_stiffness_block(const double frame[9], const ElementRest& element, double block[144]) {
+  // With F = frame and w_c = F^T grad_c (corner c's gradient on the world axes), element.h's
+  // product of the unit vector of corner d, axis l gives at corner c, axis k
+  //   vmu (grad_c . grad_d) delta_kl + vmu w_d,k w_c,l + vlambda w_c,k w_d,l,
+  // since F^T F = I for both frames (QR and polar). Written out, about 700 flops against the
+  // twelve products' 3200 (a factor's refresh assembles every element).
+  const double* grad = element.grad.data();
+  double w[4][3];
+  for (int c = 0; c < 4; ++c)
+    for (int k = 0; k < 3; ++k)
+      w[c][k] = frame[k] * grad[3 * c] + frame[3 + k] * grad[3 * c + 1] + frame[6 + k] * grad[3 * c + 2];
+  for (int d = 0; d < 4; ++d)
+    for (int c = 0; c < 4; ++c) {
+      const double gg = grad[3 * c] * grad[3 * d] + grad[3 * c + 1] * grad[3 * d + 1] +
+                        grad[3 * c + 2] * grad[3 * d + 2];
+      for (int l = 0; l < 3; ++l)
+        for (int k = 0; k < 3; ++k)
+          block[12 * (3 * d + l) + 3 * c + k] = element.vmu * (w[d][k] * w[c][l] + (k == l ? gg : 0.0)) +
+                                                element.vlambda * w[c][k] * w[d][l];
+    }
+}
+
 void element_diagonal(const Model& model, const std::vector<Frame>& frames,
                       Eigen::VectorXd& diagonal) {
   diagonal.setZero(model.dof_count());
@@ -78,18 +100,12 @@ Eigen::SparseMatrix<double> assemble_element_stiffness(const Model& model,
                                                        const AssemblyPattern& pattern) {
   Eigen::SparseMatrix<double> K = pattern.zeros();
   double* values = K.valuePtr();
+  double block[144];
   for (std::size_t e = 0; e < model.elements.size(); ++e) {
-    const ElementRest& element = model.elements[e];
-    // Column j of R K_e R^T is the element product of the j-th unit vector: one definition
-    // of the tangent for the matrix-free and the assembled paths. Each entry sums its
-    // elements' parts in element order.
-    for (int j = 0; j < 12; ++j) {
-      double unit[12] = {0.0}, column[12];
-      unit[j] = 1.0;
-      shared::sf_element_product(frames[e].data(), element.grad.data(), element.vlambda,
-                                 element.vmu, unit, column);
-      for (int i = 0; i < 12; ++i) values[pattern.element_slot(e, i, j)] += column[i];
-    }
+    element_stiffness_block(frames[e].data(), model.elements[e], block);
+    // Each entry sums its elements' parts in element order.
+    for (int j = 0; j < 12; ++j)
+      for (int i = 0; i < 12; ++i) values[pattern.element_slot(e, i, j)] += block[12 * j + i];
   }
   return K;
 }

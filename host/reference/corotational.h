@@ -33,6 +33,10 @@ void element_product(const Model& model, const std::vector<Frame>& frames,
 void element_diagonal(const Model& model, const std::vector<Frame>& frames,
                       Eigen::VectorXd& diagonal);
 
+// R K_e R^T of one element at its frame: entry (i, j), i and j being 3 * corner + axis, at
+// block[12 j + i]; element_product's matrix (to rounding), written out for assembly.
+void element_stiffness_block(const double frame[9], const ElementRest& element, double block[144]);
+
 // The elastic tangent stiffness as a sparse matrix with the pattern's sparsity (the
 // factors, the direct solve); without one, a pattern made for the call (the tests).
 Eigen::SparseMatrix<double> assemble_element_stiffness(const Model& model,

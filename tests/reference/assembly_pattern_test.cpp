@@ -1,7 +1,8 @@
 // AssemblyPattern (host/reference/assembly_pattern.h): every element entry and every diagonal
 // entry, an unused node's included, has its slot in the pattern, and the tangent assembled
-// into the slots is, bit for bit, the sum of the element blocks that triplets give (the
-// assembly it replaced), so the factors' numbers did not change with it.
+// into the slots is, bit for bit, the sum of the element blocks that triplets give in element
+// order (the assembly it replaced). That the blocks are the element product's matrix is
+// corotational_test.cpp's.
 #include "host/reference/assembly_pattern.h"
 
 #include <gtest/gtest.h>
@@ -9,7 +10,6 @@
 #include <Eigen/SparseCore>
 #include <vector>
 
-#include "host/model/shared_element.h"
 #include "host/reference/corotational.h"
 #include "host/reference/reference_simulation.h"
 #include "tests/reference/structured_mesh.h"
@@ -52,19 +52,18 @@ TEST(AssemblyPattern, AssemblesTheSameBitsAsTripletsOfTheElementBlocks) {
   std::vector<Frame> frames;
   element_frames(held.model, simulation.positions(), frames);
 
-  // The triplet assembly that the pattern replaced: each column of an element block from the
-  // element product of a unit vector, summed by setFromTriplets in element order.
+  // The triplet assembly that the pattern replaced: the element blocks' entries summed by
+  // setFromTriplets in element order.
   std::vector<Eigen::Triplet<double>> triplets;
-  for (const ElementRest& element : held.model.elements)
-    for (int j = 0; j < 12; ++j) {
-      double unit[12] = {0.0}, column[12];
-      unit[j] = 1.0;
-      shared::sf_element_product(frames[&element - held.model.elements.data()].data(),
-                                 element.grad.data(), element.vlambda, element.vmu, unit, column);
+  for (std::size_t e = 0; e < held.model.elements.size(); ++e) {
+    const ElementRest& element = held.model.elements[e];
+    double block[144];
+    element_stiffness_block(frames[e].data(), element, block);
+    for (int j = 0; j < 12; ++j)
       for (int i = 0; i < 12; ++i)
         triplets.emplace_back(3 * element.nodes[i / 3] + i % 3, 3 * element.nodes[j / 3] + j % 3,
-                              column[i]);
-    }
+                              block[12 * j + i]);
+  }
   Eigen::SparseMatrix<double> expected(held.model.dof_count(), held.model.dof_count());
   expected.setFromTriplets(triplets.begin(), triplets.end());
 

@@ -156,29 +156,35 @@ TEST_F(CorotationalTest, TangentIsTheForceJacobianAtRigidlyMovedRest) {
 }
 
 TEST_F(CorotationalTest, MatrixFreeProductAndDiagonalEqualTheAssembledMatrix) {
-  // A deformed, rotated state: 1% random strain of each node's cell and a large rotation.
+  // A deformed, rotated state: 1% random strain of each node's cell and a large rotation. The
+  // assembled blocks are written out from the product (element_stiffness_block), so this is
+  // also the check of that formula, with either frame.
   const Eigen::VectorXd deformed = rest_ + test::random_vector(random_, rest_.size(), 1e-2 * kCellSize);
   const Eigen::VectorXd x = test::rigidly_moved(
       deformed, test::rotation_about(Eigen::Vector3d(1.0, 1.0, -2.0), 2.0), Eigen::Vector3d(0.2, 0.0, 0.1));
-  std::vector<Frame> frames;
-  element_frames(model_, x, frames);
-  const Eigen::SparseMatrix<double> K = assemble_element_stiffness(model_, frames);
-  const Eigen::MatrixXd K_dense(K);
-  EXPECT_LE((K_dense - K_dense.transpose()).norm(), kAssemblySymmetryTolerance * K_dense.norm())
-      << "asymmetry of the assembled tangent of a deformed state";
-  for (int trial = 0; trial < 3; ++trial) {
-    const Eigen::VectorXd d = test::random_vector(random_, x.size());
-    Eigen::VectorXd y;
-    element_product(model_, frames, d, y);
-    const Eigen::VectorXd expected = K * d;
-    EXPECT_LE((y - expected).norm(), kProductTolerance * expected.norm())
-        << "element_product vs the assembled tangent times a vector, trial " << trial;
+  for (ElementRotation rotation : {ElementRotation::qr, ElementRotation::polar}) {
+    model_.material.rotation = rotation;
+    const char* name = rotation == ElementRotation::qr ? "QR frames" : "polar frames";
+    std::vector<Frame> frames;
+    element_frames(model_, x, frames);
+    const Eigen::SparseMatrix<double> K = assemble_element_stiffness(model_, frames);
+    const Eigen::MatrixXd K_dense(K);
+    EXPECT_LE((K_dense - K_dense.transpose()).norm(), kAssemblySymmetryTolerance * K_dense.norm())
+        << "asymmetry of the assembled tangent of a deformed state, " << name;
+    for (int trial = 0; trial < 3; ++trial) {
+      const Eigen::VectorXd d = test::random_vector(random_, x.size());
+      Eigen::VectorXd y;
+      element_product(model_, frames, d, y);
+      const Eigen::VectorXd expected = K * d;
+      EXPECT_LE((y - expected).norm(), kProductTolerance * expected.norm())
+          << "element_product vs the assembled tangent times a vector, trial " << trial << ", " << name;
+    }
+    Eigen::VectorXd diagonal;
+    element_diagonal(model_, frames, diagonal);
+    const Eigen::VectorXd expected_diagonal = K_dense.diagonal();
+    EXPECT_LE((diagonal - expected_diagonal).norm(), kProductTolerance * expected_diagonal.norm())
+        << "element_diagonal vs the assembled tangent's diagonal, " << name;
   }
-  Eigen::VectorXd diagonal;
-  element_diagonal(model_, frames, diagonal);
-  const Eigen::VectorXd expected_diagonal = K_dense.diagonal();
-  EXPECT_LE((diagonal - expected_diagonal).norm(), kProductTolerance * expected_diagonal.norm())
-      << "element_diagonal vs the assembled tangent's diagonal";
 }
 
 TEST_F(CorotationalTest, ForceAndTangentAreObjective) {
