@@ -22,8 +22,8 @@
 #include <vector>
 
 #include "host/common/device_options.h"
-#include "host/ensemble/simulation_ensemble.h"
 #include "host/common/worker_pool.h"
+#include "host/ensemble/simulation_ensemble.h"
 #include "host/mesh/observed_points.h"
 #include "host/model/model.h"
 #include "host/reference/factorised_preconditioner.h"
