@@ -55,6 +55,30 @@ TEST_F(CpuEnsembleTest, EachSigmaPointIsTheReferenceWithItsStiffness) {
   }
 }
 
+TEST_F(CpuEnsembleTest, ResultsDoNotDependOnTheThreadCount) {
+  // Sigma points are taken by whichever thread comes free (host/common/worker_pool.h) and
+  // their own factors are made again at different steps: each one's arithmetic is its own, so
+  // one, two and three threads give the same bits.
+  const std::vector<int> estimated = {0, 2};
+  const int S = 5;
+  Eigen::MatrixXd theta(2, S);
+  for (int s = 0; s < S; ++s) {
+    theta(0, s) = std::log(100.0 + 40.0 * s);
+    theta(1, s) = std::log(300.0 - 30.0 * s);
+  }
+  std::vector<Eigen::MatrixXd> observed;
+  for (int threads : {1, 2, 3}) {
+    CpuEnsemble ensemble(model_, estimated, scenario_.observations.nodes, S, threads);
+    ensemble.set_parameters(theta);
+    for (int k = 1; k <= 12; ++k) ensemble.advance(so(k));
+    Eigen::MatrixXd y;
+    ensemble.predicted_observations(y);
+    observed.push_back(y);
+  }
+  EXPECT_EQ(observed[0], observed[1]) << "one thread against two";
+  EXPECT_EQ(observed[0], observed[2]) << "one thread against three";
+}
+
 // Observed points anywhere (host/mesh/observed_points.h): a point located at a node gives
 // that node's position bit for bit; a point at a face's centre stays at the centre of the
 // deformed face (the mean of its three nodes), and an interior point moves with its
