@@ -53,6 +53,10 @@ const Backend kOpenClPerIteration{"opencl", Precision::single,
 const Backend kOpenClWholeSolve{"opencl", Precision::single,
                                 "opencl single, device 0, CG solve in one launch",
                                 SolveLaunch::whole_solve};
+// OpenCL's CPU form with one factor of sigma point 0's system as CG's preconditioner.
+const Backend kOpenClFactorised{"opencl", Precision::single,
+                                "opencl single, device 0, one shared factor",
+                                SolveLaunch::automatic, Preconditioner::factorised};
 // CG with one work-group per sigma point whatever the mesh (on a GPU: before partitions).
 const Backend kOpenClOneGroup{"opencl", Precision::single,
                               "opencl single, device 0, CG a work-group per sigma point",
@@ -282,6 +286,9 @@ void BM_cloud_observation(benchmark::State& state, const Backend& backend) {
 // Against S, on the liver refined once (4768 tetrahedra).
 BENCHMARK_CAPTURE(BM_ensemble_step, opencl_liver_4768, kOpenCl, std::string("liver"), 1)
     ->RangeMultiplier(2)->Range(1, 256)->Unit(benchmark::kMillisecond)->UseRealTime();
+BENCHMARK_CAPTURE(BM_ensemble_step, opencl_factorised_liver_4768, kOpenClFactorised,
+                  std::string("liver"), 1)
+    ->Arg(4)->Arg(16)->Unit(benchmark::kMillisecond)->UseRealTime();
 BENCHMARK_CAPTURE(BM_ensemble_step, opencl_per_iteration_liver_4768, kOpenClPerIteration,
                   std::string("liver"), 1)
     ->RangeMultiplier(2)->Range(1, 16)->Unit(benchmark::kMillisecond)->UseRealTime();
@@ -351,6 +358,8 @@ BENCHMARK_CAPTURE(BM_ensemble_step, cpu_box_large_117240, kCpu, std::string("box
 // A whole filter step on the liver.
 BENCHMARK_CAPTURE(BM_filter_step, opencl, kOpenCl, std::string("liver"))
     ->Unit(benchmark::kMillisecond)->UseRealTime();
+BENCHMARK_CAPTURE(BM_filter_step, opencl_factorised, kOpenClFactorised, std::string("liver"))
+    ->Unit(benchmark::kMillisecond)->UseRealTime();
 BENCHMARK_CAPTURE(BM_filter_step, opencl_per_iteration, kOpenClPerIteration, std::string("liver"))
     ->Unit(benchmark::kMillisecond)->UseRealTime();
 BENCHMARK_CAPTURE(BM_filter_step, opencl_whole_solve, kOpenClWholeSolve, std::string("liver"))
@@ -376,6 +385,9 @@ BENCHMARK_CAPTURE(BM_cloud_observation, cpu, kCpu)->Arg(1000)->Unit(benchmark::k
 BENCHMARK_CAPTURE(BM_filter_step, opencl_liver_fine_38144, kOpenCl, std::string("liver_fine"))
     ->Iterations(20)->Unit(benchmark::kMillisecond)->UseRealTime();
 BENCHMARK_CAPTURE(BM_filter_step, vulkan_liver_fine_38144, kVulkan, std::string("liver_fine"))
+    ->Iterations(20)->Unit(benchmark::kMillisecond)->UseRealTime();
+BENCHMARK_CAPTURE(BM_filter_step, opencl_factorised_liver_fine_38144, kOpenClFactorised,
+                  std::string("liver_fine"))
     ->Iterations(20)->Unit(benchmark::kMillisecond)->UseRealTime();
 BENCHMARK_CAPTURE(BM_filter_step, cpu_liver_fine_38144, kCpu, std::string("liver_fine"))
     ->Iterations(20)->Unit(benchmark::kMillisecond)->UseRealTime();

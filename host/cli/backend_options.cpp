@@ -32,9 +32,9 @@ void add_backend_options(CLI::App* command, BackendChoice& choice) {
       ->check(CLI::IsMember({"single", "double"}))
       ->capture_default_str();
   command->add_option("--preconditioner", choice.preconditioner,
-                      "CG's preconditioner: jacobi, factorised (sparse Cholesky factors, one per "
-                      "sigma point or one they share; cpu back end only) or auto (factorised on "
-                      "cpu, jacobi on the devices)")
+                      "CG's preconditioner: jacobi, factorised (sparse Cholesky factors: on cpu one "
+                      "per sigma point or one they share, on OpenCL's CPU device one they share; "
+                      "not vulkan) or auto (factorised on cpu, jacobi on the devices)")
       ->check(CLI::IsMember({"auto", "jacobi", "factorised"}))
       ->capture_default_str();
 }

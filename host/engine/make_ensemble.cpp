@@ -21,9 +21,9 @@ std::unique_ptr<SimulationEnsemble> make_ensemble(const std::string& backend, co
   if (backend == "cpu")
     return std::make_unique<CpuEnsemble>(model, estimated, observed, sigma_count, 0,
                                          options.preconditioner);
-  if (options.preconditioner == Preconditioner::factorised)
-    throw InputError("--preconditioner factorised: only the cpu back end has it (the " + backend +
-                     " kernels precondition CG with Jacobi)");
+  if (options.preconditioner == Preconditioner::factorised && backend == "vulkan")
+    throw InputError("--preconditioner factorised: the cpu back end and OpenCL on a CPU device "
+                     "have it (the vulkan kernels precondition CG with Jacobi)");
   if (backend == "opencl")
     return std::make_unique<OpenClEnsemble>(model, estimated, observed, sigma_count, options);
   if (backend == "vulkan")

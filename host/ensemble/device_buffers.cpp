@@ -78,6 +78,10 @@ std::vector<DeviceBufferSpec> device_buffer_specs(const Model& model, const Obse
   for (std::size_t row = 0; row < 3 * static_cast<std::size_t>(nodes); ++row)
     std::fill_n(initial_positions.begin() + static_cast<std::ptrdiff_t>(row * S), S, rest_positions[row]);
 
+  // The factor's arrays, written at its first refresh (one element each without a factor).
+  const std::size_t rows = sizes.factor_nonzeros > 0 ? 3 * static_cast<std::size_t>(nodes) : 0;
+  const std::size_t factor_nonzeros = std::max<std::size_t>(1, sizes.factor_nonzeros);
+
   const std::size_t groups = static_cast<std::size_t>(S) * sizes.cg_partitions;
   const std::size_t sigma = static_cast<std::size_t>(S);
   auto reals = [](DeviceBuffer id, const char* what, std::size_t count) {
@@ -129,6 +133,11 @@ std::vector<DeviceBufferSpec> device_buffer_specs(const Model& model, const Obse
       reals(B::recenter_scalars, "re-centring", 1 + kDeviceMaxParameters),
       reals(B::directions, "re-centring", static_cast<std::size_t>(kDeviceMaxParameters) * sigma),
       reals(B::weights, "re-centring", static_cast<std::size_t>(kDeviceMaxParameters) * sigma),
+      integers(B::factor_columns, "the factor", std::vector<int>(rows + 1, 0)),
+      integers(B::factor_rows, "the factor", std::vector<int>(factor_nonzeros, 0)),
+      reals(B::factor_values, "the factor", factor_nonzeros),
+      integers(B::factor_order, "the factor", std::vector<int>(std::max<std::size_t>(1, rows), 0)),
+      reals(B::factor_work, "the factor", rows * sigma),
   };
   for (int i = 0; i < kDeviceBufferCount; ++i)   // the list above is in DeviceBuffer order
     if (specs[i].id != static_cast<DeviceBuffer>(i)) throw std::logic_error("device_buffer_specs: out of order");

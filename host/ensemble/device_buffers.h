@@ -43,6 +43,11 @@ enum class DeviceBuffer : int {
   partial, own_active, own_iterations, own_rz,
   // The re-centring's inputs (pack_recentering).
   recenter_scalars, directions, weights,
+  // A sparse Cholesky factor of one sigma point's system as CG's preconditioner (OpenCL's CPU
+  // form with --preconditioner factorised; one element each without): L by columns (each
+  // column's start, its rows and values, the diagonal first), the ordering, and a work vector
+  // per sigma point (FactorisedPreconditioner).
+  factor_columns, factor_rows, factor_values, factor_order, factor_work,
   count
 };
 constexpr int kDeviceBufferCount = static_cast<int>(DeviceBuffer::count);
@@ -61,6 +66,7 @@ struct DeviceBufferSpec {
 struct DeviceBufferSizes {
   std::size_t element_out = 0;    // at least 12 per element and sigma point
   int cg_partitions = 1;          // CG work-groups per sigma point
+  std::size_t factor_nonzeros = 0;   // of CG's factor, if it has one (0: Jacobi)
 };
 
 // Every buffer of an ensemble of `model` with S sigma points, in DeviceBuffer order.

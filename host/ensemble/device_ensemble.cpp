@@ -1,6 +1,7 @@
 #include "host/ensemble/device_ensemble.h"
 
 #include <algorithm>
+#include <cmath>
 #include <stdexcept>
 
 #include "host/common/device_error.h"
@@ -56,10 +57,25 @@ void DeviceEnsemble::set_parameters(const Eigen::MatrixXd& theta) {
   check_parameter_matrix(theta, parameter_count(), sigma_count(), who_);
   ligament_k_from_theta(model_, estimated_, theta, S_, ligament_k_);
   upload_ligament_k();
+  representative_theta_ = theta.col(0);
 }
 
 void DeviceEnsemble::set_physics_effects(const std::vector<PhysicsEffects>& effects) {
   step_constants_.set_physics_effects(effects, who_);
+  representative_effects_ = effects.at(0);
+}
+
+Eigen::SparseMatrix<double> DeviceEnsemble::representative_system(const Eigen::VectorXd& x,
+                                                                  const Eigen::VectorXd& v) const {
+  if (!representative_) representative_ = std::make_unique<ReferenceSimulation>(model_);
+  std::vector<double> stiffness;
+  for (const SpringSet& ligament : model_.ligaments) stiffness.push_back(ligament.stiffness);
+  for (Eigen::Index j = 0; j < representative_theta_.size(); ++j)
+    stiffness[static_cast<std::size_t>(estimated_[static_cast<std::size_t>(j)])] = std::exp(representative_theta_[j]);
+  representative_->set_ligament_stiffness(stiffness);
+  representative_->set_physics_effects(representative_effects_);
+  representative_->set_state(x, v);
+  return representative_->system_matrix();
 }
 
 std::vector<double> DeviceEnsemble::column_of(DeviceBuffer buffer, std::size_t rows, int s) const {

@@ -8,9 +8,11 @@
 #pragma once
 
 #include <Eigen/Core>
+#include <Eigen/SparseCore>
 #include <algorithm>
 #include <cstddef>
 #include <cstdint>
+#include <memory>
 #include <string>
 #include <vector>
 
@@ -20,6 +22,7 @@
 #include "host/ensemble/simulation_ensemble.h"
 #include "host/mesh/observed_points.h"
 #include "host/model/model.h"
+#include "host/reference/reference_simulation.h"
 
 namespace sigmafem {
 
@@ -78,6 +81,11 @@ class DeviceEnsemble : public SimulationEnsemble {
       batch = std::max(2, expected_iterations_ / 8);
     }
   }
+  // Sigma point 0's implicit-Euler matrix at state (x, v), assembled on the host with its
+  // stiffnesses and effects: what a factor shared by the sigma points is made of (the CPU
+  // back end's shared factor is sigma point 0's too).
+  Eigen::SparseMatrix<double> representative_system(const Eigen::VectorXd& x,
+                                                    const Eigen::VectorXd& v) const;
   // The step's solver report from CG's per-sigma results; notes the iterations for the next
   // step's first batch.
   StepReport step_report(const std::vector<std::int32_t>& iterations,
@@ -107,6 +115,9 @@ class DeviceEnsemble : public SimulationEnsemble {
 
  private:
   std::vector<double> column_of(DeviceBuffer buffer, std::size_t rows, int s) const;
+  Eigen::VectorXd representative_theta_;        // sigma point 0's parameters (none yet: the model's)
+  PhysicsEffects representative_effects_;       // and its effects
+  mutable std::unique_ptr<ReferenceSimulation> representative_;   // keeps its assembly pattern
 };
 
 }  // namespace sigmafem

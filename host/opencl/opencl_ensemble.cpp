@@ -58,18 +58,30 @@ OpenClEnsemble::OpenClEnsemble(const Model& model, std::vector<int> estimated,
   const int units = static_cast<int>(std::max(1u, info.compute_units));
   cg_block_ = (S_ + units - 1) / units;
   while (S_ % cg_block_ != 0) --cg_block_;
+  // --preconditioner factorised: a factor of sigma point 0's system shared by the sigma
+  // points, in the CPU form's CG (the GPU form has Jacobi only); analysed here for its size,
+  // made at the first step and again when due.
+  if (options.preconditioner == Preconditioner::factorised) {
+    if (!cpu_form)
+      throw DeviceError("--preconditioner factorised: OpenCL has it on a CPU device only (its "
+                        "GPU kernels precondition CG with Jacobi); device " + info.name);
+    factor_ = std::make_unique<FactorisedPreconditioner>();
+    const ReferenceSimulation rest(model_);
+    factor_->analyse(representative_system(rest.positions(), rest.velocities()));
+  }
   device_.build_program("-DSF_SIGMA_BLOCK=" + std::to_string(sigma_block_) +
                         " -DSF_ELEMENT_CHUNKS=" + std::to_string(element_chunks_) +
                         " -DSF_CG_PER_GROUP=" + std::to_string(cg_per_group_ ? 1 : 0) +
                         " -DSF_GROUP_SIZE=" + std::to_string(cg_group_) +
                         " -DSF_CG_BLOCK=" + std::to_string(cg_block_) +
-                        " -DSF_CG_PARTITIONS=" + std::to_string(cg_partitions_));
+                        " -DSF_CG_PARTITIONS=" + std::to_string(cg_partitions_) +
+                        " -DSF_FACTOR=" + std::to_string(factor_ ? 1 : 0));
 
   using B = DeviceBuffer;
   try {
     // The chunks' copies of K d on a CPU live in the element outputs (element_product.cl).
     const std::size_t dof = 3 * static_cast<std::size_t>(nodes_) * S_;
-    for (const DeviceBufferSpec& spec : buffer_specs({element_chunks_ * dof, cg_partitions_})) {
+    for (const DeviceBufferSpec& spec : buffer_specs({element_chunks_ * dof, cg_partitions_, factor_ ? factor_->nonzeros() : 0})) {
       const std::size_t bytes = take_device_bytes(spec, device_.real_size());
       buffers_.emplace_back(device_.context(), CL_MEM_READ_WRITE, bytes);
       if (spec.integer && !spec.integers.empty())
@@ -107,14 +119,23 @@ OpenClEnsemble::OpenClEnsemble(const Model& model, std::vector<int> estimated,
     set_arguments(k_recenter_, kernel_buffers(DeviceKernel::recenter), S, rows,
                   static_cast<cl_uint>(estimated_.size()));
     // The CG kernels' buffers (conjugate_gradient.cl).
-    set_arguments(k_cg_start_, {B::constants, B::q, B::rhs, B::inverse_diagonal, B::r, B::z, B::d,
-                                B::bb, B::rr, B::rz, B::active, B::converged, B::iterations}, S, N);
+    // The factor's buffers, last, where the CPU form's CG has them (SF_FACTOR).
+    const std::vector<DeviceBuffer> factor =
+        factor_ ? std::vector<DeviceBuffer>{B::factor_columns, B::factor_rows, B::factor_values,
+                                            B::factor_order, B::factor_work}
+                : std::vector<DeviceBuffer>{};
+    std::vector<DeviceBuffer> start = {B::constants, B::q, B::rhs, B::inverse_diagonal, B::r, B::z,
+                                       B::d, B::bb, B::rr, B::rz, B::active, B::converged,
+                                       B::iterations};
+    start.insert(start.end(), factor.begin(), factor.end());
+    set_arguments(k_cg_start_, start, S, N);
     std::vector<DeviceBuffer> iteration = {B::constants, B::inverse_diagonal, B::dv, B::r, B::z,
                                            B::d, B::q, B::bb, B::rr, B::rz, B::active,
                                            B::converged, B::iterations};
     if (!cg_per_group_)   // the CPU form also does node_product's part
       iteration.insert(iteration.end(), {B::ligament_offsets, B::ligament_of_node, B::ligament_k,
                                          B::control_k, B::mass, B::element_out});
+    iteration.insert(iteration.end(), factor.begin(), factor.end());
     set_arguments(k_cg_iteration_, iteration, S, N, cap);
     if (cg_partitions_ > 1) {
       set_arguments(k_cg_start_partials_, {B::q, B::rhs, B::inverse_diagonal, B::r, B::z, B::d, B::partial},
@@ -129,12 +150,15 @@ OpenClEnsemble::OpenClEnsemble(const Model& model, std::vector<int> estimated,
                                       B::active, B::converged, B::iterations, B::own_active,
                                       B::own_iterations, B::own_rz}, S, N, cap);
     }
-    if (whole_solve_)
-      set_arguments(k_cg_solve_, {B::constants, B::element_nodes, B::element_rest, B::frames,
-                                  B::ligament_offsets, B::ligament_of_node, B::ligament_k,
-                                  B::control_k, B::mass, B::rhs, B::inverse_diagonal, B::dv, B::r,
-                                  B::z, B::d, B::q, B::element_out, B::bb, B::rr, B::rz, B::active,
-                                  B::converged, B::iterations}, S, E, N, cap);
+    if (whole_solve_) {
+      std::vector<DeviceBuffer> solve = {B::constants, B::element_nodes, B::element_rest, B::frames,
+                                         B::ligament_offsets, B::ligament_of_node, B::ligament_k,
+                                         B::control_k, B::mass, B::rhs, B::inverse_diagonal, B::dv,
+                                         B::r, B::z, B::d, B::q, B::element_out, B::bb, B::rr,
+                                         B::rz, B::active, B::converged, B::iterations};
+      solve.insert(solve.end(), factor.begin(), factor.end());
+      set_arguments(k_cg_solve_, solve, S, E, N, cap);
+    }
     device_.queue().finish();
   } catch (const cl::Error& error) {
     throw opencl_failure("setting up the OpenCL ensemble", error);
@@ -246,6 +270,7 @@ StepReport OpenClEnsemble::advance(const Eigen::Vector3d& so_position) {
   const std::size_t dof = 3 * static_cast<std::size_t>(nodes_) * S_;
   StepReport report;
   try {
+    if (factor_ && factor_->due()) refresh_factor();
     write_reals(DeviceBuffer::constants, step_constants_.next_step(model_, so_position));
     run(k_element_rhs_, element_items());
     run(k_node_rhs_, static_cast<std::size_t>(nodes_) * S_);
@@ -264,10 +289,35 @@ StepReport OpenClEnsemble::advance(const Eigen::Vector3d& so_position) {
     const Precision precision = device_.precision();
     report = step_report(iterations, converged, from_device_reals(rr_bytes.data(), S_, precision),
                          from_device_reals(bb_bytes.data(), S_, precision));
+    if (factor_) factor_->record(*std::max_element(iterations.begin(), iterations.end()));
   } catch (const cl::Error& error) {
     throw opencl_failure("advancing the OpenCL ensemble", error);
   }
   return report;
+}
+
+void OpenClEnsemble::refresh_factor() {
+  // A matrix that is not positive definite (a negative stiffness of sigma point 0) leaves the
+  // last factor in place, and the next step tries again; with no factor yet, CG has nothing
+  // to run with.
+  if (!factor_->factorise(representative_system(positions(0), velocities(0)))) {
+    if (!factor_uploaded_)
+      throw DeviceError("--preconditioner factorised: sigma point 0's system is not positive "
+                        "definite (a negative stiffness?); run with --preconditioner jacobi");
+    return;
+  }
+  const Eigen::SparseMatrix<double>& L = factor_->lower();
+  cl::CommandQueue& queue = device_.queue();
+  auto write_integers = [&](DeviceBuffer id, const int* data, std::size_t count) {
+    queue.enqueueWriteBuffer(buffer(id), CL_TRUE, 0, count * sizeof(cl_int), data);
+  };
+  const std::size_t rows = static_cast<std::size_t>(L.cols());
+  const std::size_t nonzeros = static_cast<std::size_t>(L.nonZeros());
+  write_integers(DeviceBuffer::factor_columns, L.outerIndexPtr(), rows + 1);
+  write_integers(DeviceBuffer::factor_rows, L.innerIndexPtr(), nonzeros);
+  write_integers(DeviceBuffer::factor_order, factor_->order(), rows);
+  write_reals(DeviceBuffer::factor_values, std::vector<double>(L.valuePtr(), L.valuePtr() + nonzeros));
+  factor_uploaded_ = true;
 }
 
 void OpenClEnsemble::predicted_observations(Eigen::MatrixXd& y) const {

@@ -11,11 +11,13 @@
 #pragma once
 
 #include <Eigen/Core>
+#include <memory>
 #include <vector>
 
 #include "host/ensemble/device_ensemble.h"
 #include "host/model/model.h"
 #include "host/opencl/opencl_device.h"
+#include "host/reference/factorised_preconditioner.h"
 
 namespace sigmafem {
 
@@ -56,6 +58,8 @@ class OpenClEnsemble : public DeviceEnsemble {
   void run(cl::Kernel& kernel, std::size_t items, std::size_t local = 0) const;
   void run_cg(cl::Kernel& kernel) const;   // cg_start or cg_iteration, as SF_CG_PER_GROUP
   void run_partitions(cl::Kernel& kernel) const;   // a CG kernel's S x P groups (GPU form)
+  // Makes the factor again from sigma point 0's state when it is due, and uploads it.
+  void refresh_factor();
 
   mutable OpenClDevice device_;
   bool cg_per_group_ = true;                // SF_CG_PER_GROUP: CG kernels a group per sigma (GPU)
@@ -66,6 +70,10 @@ class OpenClEnsemble : public DeviceEnsemble {
   int cg_block_ = 1;                        // SF_CG_BLOCK: sigma points per CG work-item (CPU)
   int cg_partitions_ = 1;                   // SF_CG_PARTITIONS: CG work-groups per sigma (GPU)
   std::vector<cl::Buffer> buffers_;         // by DeviceBuffer
+  // CG's preconditioner with --preconditioner factorised (CPU form): one sparse Cholesky
+  // factor of sigma point 0's system, shared by all (SF_FACTOR); null: Jacobi.
+  std::unique_ptr<FactorisedPreconditioner> factor_;
+  bool factor_uploaded_ = false;
 
   // Mutable: enqueueing a kernel (also from the const read-outs) changes no visible state.
   mutable cl::Kernel k_element_rhs_, k_node_rhs_, k_element_product_, k_node_product_;

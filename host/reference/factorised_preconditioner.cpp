@@ -8,20 +8,22 @@ bool FactorisedPreconditioner::factorise(const Eigen::SparseMatrix<double>& A) {
   // The ordering (AMD) and the symbolic analysis depend only on the pattern, and cost 60% of
   // a numeric factorisation on the liver: made again only when the pattern changes (an
   // AssemblyPattern keeps it the same from step to step). The numbers are compute()'s.
-  if (!same_pattern(A)) {
-    llt_.analyzePattern(A);
-    outer_.clear();
-    inner_.clear();
-    if (A.isCompressed()) {
-      outer_.assign(A.outerIndexPtr(), A.outerIndexPtr() + A.outerSize() + 1);
-      inner_.assign(A.innerIndexPtr(), A.innerIndexPtr() + A.nonZeros());
-    }
-  }
+  if (!same_pattern(A)) analyse(A);
   llt_.factorize(A);
   ready_ = llt_.info() == Eigen::Success;
   fresh_ = true;
   if (ready_) ++factorisations_;
   return ready_;
+}
+
+void FactorisedPreconditioner::analyse(const Eigen::SparseMatrix<double>& A) {
+  llt_.analyzePattern(A);
+  outer_.clear();
+  inner_.clear();
+  if (A.isCompressed()) {
+    outer_.assign(A.outerIndexPtr(), A.outerIndexPtr() + A.outerSize() + 1);
+    inner_.assign(A.innerIndexPtr(), A.innerIndexPtr() + A.nonZeros());
+  }
 }
 
 bool FactorisedPreconditioner::same_pattern(const Eigen::SparseMatrix<double>& A) const {
@@ -33,12 +35,12 @@ bool FactorisedPreconditioner::same_pattern(const Eigen::SparseMatrix<double>& A
 }
 
 void FactorisedPreconditioner::operator()(const Eigen::VectorXd& r, Eigen::VectorXd& z) const {
-  const Eigen::SparseMatrix<double>& L = llt_.matrixL().nestedExpression();   // lower, by columns
+  const Eigen::SparseMatrix<double>& L = lower();
   const int n = static_cast<int>(L.cols());
   const int* begin = L.outerIndexPtr();   // column j: entries begin[j] (the diagonal) .. begin[j + 1]
   const int* row = L.innerIndexPtr();
   const double* value = L.valuePtr();
-  const int* order = llt_.permutationP().indices().data();
+  const int* order = this->order();
   Eigen::VectorXd y(n);
   for (int i = 0; i < n; ++i) y[order[i]] = r[i];
   // L y' = y, column by column: each solved entry is taken out of the rows below it.

@@ -20,6 +20,13 @@ class FactorisedPreconditioner {
   // Factorises A (symmetric positive definite). Returns false, and leaves the object
   // unusable until the next success, when A is not positive definite.
   bool factorise(const Eigen::SparseMatrix<double>& A);
+  // Orders and analyses A's pattern without factorising: the factor's size (nonzeros()) is
+  // then known, and factorise() of a matrix with that pattern keeps the analysis.
+  void analyse(const Eigen::SparseMatrix<double>& A);
+  // Nonzeros of L (after analyse() or a factorise()).
+  std::size_t nonzeros() const {
+    return static_cast<std::size_t>(llt_.matrixL().nestedExpression().nonZeros());
+  }
   bool ready() const { return ready_; }
   int factorisations() const { return factorisations_; }
   // Memory the factor holds (its nonzeros with their row indices), 0 before the first.
@@ -30,6 +37,12 @@ class FactorisedPreconditioner {
   bool due() const { return !fresh_ && (after_ < 0 || last_ > 2 * after_ + 2); }
   // The most CG iterations of a step just done with this factor.
   void record(int most_iterations);
+
+  // The factor itself, for a device that solves with it (OpenClEnsemble): A = P^T L L^T P,
+  // L lower triangular by columns with each column's diagonal entry first, P the ordering
+  // (order()[i] is row i's position in L's rows). Valid while ready().
+  const Eigen::SparseMatrix<double>& lower() const { return llt_.matrixL().nestedExpression(); }
+  const int* order() const { return llt_.permutationP().indices().data(); }
 
   // z = A_rep^-1 r = P^T L^-T L^-1 P r. The substitutions are written here, not Eigen's
   // solve(), so that the backward one sums each row of L^T in four partial sums: one chain

@@ -332,6 +332,67 @@ void cg_direction(uint S, uint node_count, int max_iterations, __global const re
  * constant where they are inlined, so their loops have a fixed length. */
 #define SF_BLOCK_MAX SF_SIGMA_BLOCK
 
+/* CG's preconditioner on a CPU: Jacobi, or with SF_FACTOR = 1 a sparse Cholesky factor of one
+ * sigma point's system made on the host (FactorisedPreconditioner, the CPU back end's), shared
+ * by every sigma point: z = P^T L^-T L^-1 P r, L by columns, the diagonal first in each.
+ * The block's sigma points are innermost, so each entry of L is read once for the block. */
+#ifndef SF_FACTOR
+#  define SF_FACTOR 0
+#endif
+#if SF_FACTOR
+/* The factor's buffers as the last arguments of the kernels and helpers that use them. */
+#  define SF_FACTOR_ARGUMENTS                                                                \
+    , __global const int *restrict factor_columns, __global const int *restrict factor_rows, \
+        __global const real *restrict factor_values,                                        \
+        __global const int *restrict factor_order, __global real *restrict factor_work
+#  define SF_FACTOR_PASS , factor_columns, factor_rows, factor_values, factor_order, factor_work
+
+static inline __attribute__((always_inline)) void sf_block_factor_solve(
+    uint first, uint count, uint S, uint rows, __global const real* restrict r,
+    __global real* restrict z SF_FACTOR_ARGUMENTS) {
+  __global real* restrict y = factor_work;
+  for (uint i = 0; i < rows; ++i) {
+    size_t from = (size_t)i * S + first;
+    size_t to = (size_t)factor_order[i] * S + first;
+    for (uint b = 0; b < count; ++b) y[to + b] = r[from + b];
+  }
+  for (uint j = 0; j < rows; ++j) { /* L y' = y: each solved entry out of the rows below */
+    size_t at = (size_t)j * S + first;
+    real diagonal = factor_values[factor_columns[j]];
+    real solved[SF_BLOCK_MAX];
+    for (uint b = 0; b < count; ++b) {
+      solved[b] = y[at + b] / diagonal;
+      y[at + b] = solved[b];
+    }
+    for (int k = factor_columns[j] + 1; k < factor_columns[j + 1]; ++k) {
+      real value = factor_values[k];
+      __global real* restrict below = y + (size_t)factor_rows[k] * S + first;
+      for (uint b = 0; b < count; ++b) below[b] -= value * solved[b];
+    }
+  }
+  for (uint j = rows; j-- > 0;) { /* L^T x = y', from the last row up */
+    size_t at = (size_t)j * S + first;
+    real sum[SF_BLOCK_MAX];
+    for (uint b = 0; b < count; ++b) sum[b] = (real)0;
+    for (int k = factor_columns[j] + 1; k < factor_columns[j + 1]; ++k) {
+      real value = factor_values[k];
+      __global const real* restrict below = y + (size_t)factor_rows[k] * S + first;
+      for (uint b = 0; b < count; ++b) sum[b] += value * below[b];
+    }
+    real diagonal = factor_values[factor_columns[j]];
+    for (uint b = 0; b < count; ++b) y[at + b] = (y[at + b] - sum[b]) / diagonal;
+  }
+  for (uint i = 0; i < rows; ++i) {
+    size_t to = (size_t)i * S + first;
+    size_t from = (size_t)factor_order[i] * S + first;
+    for (uint b = 0; b < count; ++b) z[to + b] = y[from + b];
+  }
+}
+#else
+#  define SF_FACTOR_ARGUMENTS
+#  define SF_FACTOR_PASS
+#endif
+
 /* The warm start of the block first .. first + count - 1, given q = A x: r = b - q,
  * z = M^-1 r, d = z, the scalars and the flags. Returns whether any of them goes on. */
 static inline __attribute__((always_inline)) int sf_block_cg_start(
@@ -340,17 +401,39 @@ static inline __attribute__((always_inline)) int sf_block_cg_start(
     __global const real* restrict inverse_diagonal, __global real* restrict r,
     __global real* restrict z, __global real* restrict d, __global real* restrict bb,
     __global real* restrict rr, __global real* restrict rz, __global uint* restrict active,
-    __global uint* restrict converged, __global int* restrict iterations) {
+    __global uint* restrict converged, __global int* restrict iterations SF_FACTOR_ARGUMENTS) {
   real sum_bb[SF_BLOCK_MAX];
   real sum_rr[SF_BLOCK_MAX];
   real sum_rz[SF_BLOCK_MAX];
   for (uint i = 0; i < count; ++i) sum_bb[i] = sum_rr[i] = sum_rz[i] = (real)0;
+#if SF_FACTOR
+  /* r = b - q and the sums b.b, r.r; z from the factor; d = z and r.z. */
+  for (uint row = 0; row < rows; ++row) {
+    for (uint i = 0; i < count; ++i) {
+      size_t at = (size_t)row * S + first + i;
+      real bi = b[at];
+      real ri = bi - q[at];
+      r[at] = ri;
+      sum_bb[i] += bi * bi;
+      sum_rr[i] += ri * ri;
+    }
+  }
+  sf_block_factor_solve(first, count, S, rows, r, z SF_FACTOR_PASS);
+  for (uint row = 0; row < rows; ++row) {
+    for (uint i = 0; i < count; ++i) {
+      size_t at = (size_t)row * S + first + i;
+      d[at] = z[at];
+      sum_rz[i] += r[at] * z[at];
+    }
+  }
+#else
   for (uint row = 0; row < rows; ++row) {
     for (uint i = 0; i < count; ++i) {
       size_t at = (size_t)row * S + first + i;
       SF_CG_START_ROW(at, q[at], b, inverse_diagonal, r, z, d, sum_bb[i], sum_rr[i], sum_rz[i])
     }
   }
+#endif
   int any = 0;
   for (uint i = 0; i < count; ++i)
     any |= sf_cg_start_scalars(first + i, sum_bb[i], sum_rr[i], sum_rz[i], c, bb, rr, rz, active,
@@ -368,7 +451,7 @@ static inline __attribute__((always_inline)) int sf_block_cg_iteration(
     __global real* restrict r, __global real* restrict z, __global real* restrict d,
     __global const real* restrict q, __global const real* restrict bb,
     __global real* restrict rr, __global real* restrict rz, __global uint* restrict active,
-    __global uint* restrict converged, __global int* restrict iterations) {
+    __global uint* restrict converged, __global int* restrict iterations SF_FACTOR_ARGUMENTS) {
   int going[SF_BLOCK_MAX];
   int any = 0;
   for (uint i = 0; i < count; ++i) {
@@ -390,12 +473,31 @@ static inline __attribute__((always_inline)) int sf_block_cg_iteration(
     alpha[i] = going[i] ? rz[first + i] / sum_dq[i] : (real)0;
     rr_new[i] = rz_new[i] = (real)0;
   }
+#if SF_FACTOR
+  /* x += alpha d, r -= alpha q and r.r; z from the factor; r.z. */
+  for (uint row = 0; row < rows; ++row) {
+    for (uint i = 0; i < count; ++i) {
+      size_t at = (size_t)row * S + first + i;
+      x[at] += alpha[i] * d[at];
+      real ri = r[at] - alpha[i] * q[at];
+      r[at] = ri;
+      rr_new[i] += ri * ri;
+    }
+  }
+  sf_block_factor_solve(first, count, S, rows, r, z SF_FACTOR_PASS);
+  for (uint row = 0; row < rows; ++row)
+    for (uint i = 0; i < count; ++i) {
+      size_t at = (size_t)row * S + first + i;
+      rz_new[i] += r[at] * z[at];
+    }
+#else
   for (uint row = 0; row < rows; ++row) {
     for (uint i = 0; i < count; ++i) {
       size_t at = (size_t)row * S + first + i;
       SF_CG_UPDATE_ROW(at, alpha[i], x, r, z, d, q, inverse_diagonal, rr_new[i], rz_new[i])
     }
   }
+#endif
   real beta[SF_BLOCK_MAX];
   any = 0;
   for (uint i = 0; i < count; ++i) {
@@ -471,11 +573,12 @@ __kernel void cg_start(uint S, uint node_count, __global const real* restrict c,
                        __global real* restrict z, __global real* restrict d,
                        __global real* restrict bb, __global real* restrict rr,
                        __global real* restrict rz, __global uint* restrict active,
-                       __global uint* restrict converged, __global int* restrict iterations) {
+                       __global uint* restrict converged, __global int* restrict iterations
+                       SF_FACTOR_ARGUMENTS) {
   uint first = (uint)get_global_id(0) * SF_CG_BLOCK;
   if (first >= S) return;
   sf_block_cg_start(first, SF_CG_BLOCK, S, 3 * node_count, c, q, b, inverse_diagonal, r, z, d, bb, rr, rz,
-                    active, converged, iterations);
+                    active, converged, iterations SF_FACTOR_PASS);
 }
 
 /* One iteration after element_product: q = A d (sf_block_node_product), then the update. */
@@ -493,7 +596,7 @@ __kernel void cg_iteration(uint S, uint node_count, int max_iterations,
                            __global const real* restrict ligament_k,
                            __global const real* restrict control_k,
                            __global const real* restrict mass,
-                           __global const real* restrict element_out) {
+                           __global const real* restrict element_out SF_FACTOR_ARGUMENTS) {
   uint first = (uint)get_global_id(0) * SF_CG_BLOCK;
   if (first >= S) return;
   int any = 0;
@@ -502,7 +605,7 @@ __kernel void cg_iteration(uint S, uint node_count, int max_iterations,
   sf_block_node_product(first, SF_CG_BLOCK, SF_ELEMENT_CHUNKS, S, node_count, c, ligament_offsets, ligament_of_node, ligament_k,
                         control_k, mass, d, element_out, q);
   sf_block_cg_iteration(first, SF_CG_BLOCK, S, 3 * node_count, max_iterations, c, inverse_diagonal, x, r, z,
-                        d, q, bb, rr, rz, active, converged, iterations);
+                        d, q, bb, rr, rz, active, converged, iterations SF_FACTOR_PASS);
 }
 
 /* The whole solve in one launch, for small meshes: one work-item takes every sigma point
@@ -524,20 +627,21 @@ __kernel void cg_solve(uint S, uint element_count, uint node_count, int max_iter
                        __global real* restrict q, __global real* restrict element_out,
                        __global real* restrict bb, __global real* restrict rr,
                        __global real* restrict rz, __global uint* restrict active,
-                       __global uint* restrict converged, __global int* restrict iterations) {
+                       __global uint* restrict converged, __global int* restrict iterations
+                       SF_FACTOR_ARGUMENTS) {
   if (get_global_id(0) != 0) return;
   const uint rows = 3 * node_count;
   sf_element_chunk_products(0, element_count, S, node_count, nodes, rest, frames, c, x, element_out);
   sf_block_node_product(0, SF_SIGMA_BLOCK, 1, S, node_count, c, ligament_offsets, ligament_of_node,
                         ligament_k, control_k, mass, x, element_out, q);
   int any = sf_block_cg_start(0, SF_SIGMA_BLOCK, S, rows, c, q, b, inverse_diagonal, r, z, d, bb,
-                              rr, rz, active, converged, iterations);
+                              rr, rz, active, converged, iterations SF_FACTOR_PASS);
   while (any) {
     sf_element_chunk_products(0, element_count, S, node_count, nodes, rest, frames, c, d, element_out);
     sf_block_node_product(0, SF_SIGMA_BLOCK, 1, S, node_count, c, ligament_offsets,
                           ligament_of_node, ligament_k, control_k, mass, d, element_out, q);
     any = sf_block_cg_iteration(0, SF_SIGMA_BLOCK, S, rows, max_iterations, c, inverse_diagonal,
-                                x, r, z, d, q, bb, rr, rz, active, converged, iterations);
+                                x, r, z, d, q, bb, rr, rz, active, converged, iterations SF_FACTOR_PASS);
   }
 }
 #endif
