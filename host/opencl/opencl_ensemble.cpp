@@ -81,7 +81,9 @@ OpenClEnsemble::OpenClEnsemble(const Model& model, std::vector<int> estimated,
   try {
     // The chunks' copies of K d on a CPU live in the element outputs (element_product.cl).
     const std::size_t dof = 3 * static_cast<std::size_t>(nodes_) * S_;
-    for (const DeviceBufferSpec& spec : buffer_specs({element_chunks_ * dof, cg_partitions_, factor_ ? factor_->nonzeros() : 0})) {
+    const DeviceBufferSizes sizes{element_chunks_ * dof, cg_partitions_,
+                                  factor_ ? factor_->nonzeros() : 0};
+    for (const DeviceBufferSpec& spec : buffer_specs(sizes)) {
       const std::size_t bytes = take_device_bytes(spec, device_.real_size());
       buffers_.emplace_back(device_.context(), CL_MEM_READ_WRITE, bytes);
       if (spec.integer && !spec.integers.empty())
