@@ -19,6 +19,7 @@
 #include "host/diagnosis/diagnosis.h"
 #include "host/engine/choose_backend.h"
 #include "host/engine/estimation_options.h"
+#include "host/engine/make_ensemble.h"
 #include "host/model/model.h"
 #include "host/scenario/scenario.h"
 
@@ -114,6 +115,7 @@ Action add_diagnose_command(CLI::App& app) {
         sigma_point_count(set, static_cast<int>(scenario.filter->estimate.size())));
     diagnose_options.backend = report.backend = backend.backend;
     report.backend_reason = backend.reason;
+    report.preconditioner = preconditioner_used(backend.backend, diagnose_options.device);
     if (!options->quiet) std::cout << "backend: " << backend.backend << " (" << backend.reason << ")\n" << std::flush;
     std::stringstream names(options->candidates);
     for (std::string name; std::getline(names, name, ',');)

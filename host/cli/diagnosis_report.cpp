@@ -126,6 +126,7 @@ json write_diagnosis_report(const Scenario& scenario, const Diagnosis& d, const 
   j["data"] = report.data_dir;
   j["backend"] = report.backend;
   j["backend_reason"] = report.backend_reason;
+  j["preconditioner"] = report.preconditioner;
   const std::string sigma_points =
       options.sigma_points ? to_string(*options.sigma_points) : scenario.filter->sigma_points;
   j["sigma_points"] = sigma_points;

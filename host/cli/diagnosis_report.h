@@ -17,6 +17,7 @@ struct DiagnosisReport {
   std::string out_dir;
   std::string backend;          // the back end that ran (cpu, opencl, vulkan)
   std::string backend_reason;   // "given", or why --backend auto chose it
+  std::string preconditioner;   // CG's: factorised or jacobi
   nlohmann::ordered_json truth_effects;   // truth.json's effects when present, else null
 };
 

@@ -195,6 +195,7 @@ nlohmann::ordered_json write_estimation_report(const EstimationReport& report, c
   summary["data"] = report.data_dir;
   summary["backend"] = report.backend;
   summary["backend_reason"] = report.backend_reason;
+  summary["preconditioner"] = report.preconditioner;
   summary["sigma_points"] = report.sigma_points;
   summary["sigma_count"] = report.sigma_count;
   summary["complete"] = run.complete;

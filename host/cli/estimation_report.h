@@ -23,6 +23,7 @@ struct EstimationReport {
   std::string out_dir;
   std::string backend;          // the back end that ran (cpu, opencl, vulkan)
   std::string backend_reason;   // "given", or why --backend auto chose it
+  std::string preconditioner;   // CG's: factorised or jacobi
   std::string sigma_points;
   int sigma_count = 0;
   std::vector<std::string> names;             // estimated ligaments

@@ -33,6 +33,12 @@ std::unique_ptr<SimulationEnsemble> make_ensemble(const std::string& backend, co
   throw InputError("--backend " + backend + ": unknown back end (available: " + names + ")");
 }
 
+std::string preconditioner_used(const std::string& backend, const DeviceOptions& options) {
+  const bool factors = backend == "cpu" ? options.preconditioner != Preconditioner::jacobi
+                                        : options.preconditioner == Preconditioner::factorised;
+  return factors ? "factorised" : "jacobi";
+}
+
 std::unique_ptr<EffectEnsemble> make_effect_ensemble(const std::string& backend, Model model,
                                                      std::vector<int> estimated,
                                                      const ObservedPoints& observed, int sigma_count,

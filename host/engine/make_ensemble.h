@@ -21,12 +21,17 @@ std::vector<std::string> available_backends();
 
 // "auto" is resolve_backend()'s choice (host/engine/choose_backend.h). Throws InputError
 // for an unknown name, DeviceError when the device cannot run it.
-// The CPU back end takes only `options.preconditioner` (automatic: the factors);
-// a device back end refuses Preconditioner::factorised with an InputError.
+// The CPU back end takes only `options.preconditioner` (automatic: the factors); OpenCL
+// takes Preconditioner::factorised on a CPU device (a DeviceError on a GPU), Vulkan refuses it
+// with an InputError.
 std::unique_ptr<SimulationEnsemble> make_ensemble(const std::string& backend, const Model& model,
                                                   const std::vector<int>& estimated,
                                                   const ObservedPoints& observed, int sigma_count,
                                                   const DeviceOptions& options = {});
+
+// The preconditioner that `backend` (not "auto") runs CG with under `options`: "factorised"
+// or "jacobi", for the reports.
+std::string preconditioner_used(const std::string& backend, const DeviceOptions& options);
 
 // The ensemble of `model` on `backend` with the candidate `effects` estimated (EffectEnsemble):
 // the ligament of every ligament effect is appended to the model and to `estimated` first.

@@ -272,6 +272,8 @@ TEST_F(CliTest, EstimateWritesEstimatesSummaryResidualsAndPlots) {
   const json summary = json::parse(summary_file);
   EXPECT_EQ(summary["backend"], expected.backend);
   EXPECT_EQ(summary["backend_reason"], expected.reason);
+  // Which preconditioner CG ran with: the CPU back end's factors, Jacobi on a device.
+  EXPECT_EQ(summary["preconditioner"], expected.backend == "cpu" ? "factorised" : "jacobi");
   EXPECT_TRUE(summary["complete"].get<bool>());
   EXPECT_EQ(summary["filter_steps"].get<int>(), 30);
   EXPECT_TRUE(summary["errors"].is_object()) << "truth.csv was in the data folder";
