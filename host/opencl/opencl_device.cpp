@@ -7,7 +7,9 @@
 namespace sigmafem {
 
 // The kernels of kernels/opencl/, with their includes inlined (cmake/embed_kernel_sources.cmake).
-extern const char* const kOpenClKernelSource;
+// The text in parts, to be joined in order.
+extern const char* const kOpenClKernelSource[];
+extern const int kOpenClKernelSource_parts;
 
 namespace {
 
@@ -93,7 +95,9 @@ void OpenClDevice::build_program(const std::string& defines) {
                               (precision_ == Precision::double_precision ? " -DSF_USE_DOUBLE" : "") +
                               (defines.empty() ? "" : " " + defines);
   try {
-    program_ = cl::Program(context_, std::string(kOpenClKernelSource));
+    std::string source;
+    for (int part = 0; part < kOpenClKernelSource_parts; ++part) source += kOpenClKernelSource[part];
+    program_ = cl::Program(context_, source);
     program_.build({device_}, options.c_str());
   } catch (const cl::Error& error) {
     if (error.err() != CL_BUILD_PROGRAM_FAILURE) throw opencl_failure("building the kernels", error);
