@@ -32,8 +32,7 @@ CpuEnsemble::CpuEnsemble(const Model& model, std::vector<int> estimated, Observe
   if (preconditioner_ != Preconditioner::jacobi) first.assembly_pattern();
   simulations_.assign(sigma_count, first);
   const int cores = static_cast<int>(std::thread::hardware_concurrency());
-  threads_ = threads > 0 ? threads : std::max(1, cores);
-  pool_ = std::make_unique<WorkerPool>(std::min(threads_, sigma_count));
+  pool_ = std::make_unique<WorkerPool>(std::min(threads > 0 ? threads : std::max(1, cores), sigma_count));
 }
 
 void CpuEnsemble::make_factors() {

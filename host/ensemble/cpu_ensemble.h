@@ -65,8 +65,7 @@ class CpuEnsemble : public SimulationEnsemble {
   std::vector<ReferenceSimulation> simulations_;
   std::vector<int> estimated_;
   ObservedPoints observed_;
-  int threads_;
-  std::unique_ptr<WorkerPool> pool_;   // threads_ threads at most, one per sigma point
+  std::unique_ptr<WorkerPool> pool_;   // the threads asked (0: the cores), at most S
   Preconditioner preconditioner_;
   // Empty with Jacobi and before the first step; then one per sigma point, or one shared.
   // The simulations hold pointers to them: unique_ptrs, so that moving the ensemble does

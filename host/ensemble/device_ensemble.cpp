@@ -68,8 +68,7 @@ void DeviceEnsemble::set_physics_effects(const std::vector<PhysicsEffects>& effe
 Eigen::SparseMatrix<double> DeviceEnsemble::representative_system(const Eigen::VectorXd& x,
                                                                   const Eigen::VectorXd& v) const {
   if (!representative_) representative_ = std::make_unique<ReferenceSimulation>(model_);
-  std::vector<double> stiffness;
-  for (const SpringSet& ligament : model_.ligaments) stiffness.push_back(ligament.stiffness);
+  std::vector<double> stiffness = representative_->ligament_stiffness();   // the others: the model's
   for (Eigen::Index j = 0; j < representative_theta_.size(); ++j)
     stiffness[static_cast<std::size_t>(estimated_[static_cast<std::size_t>(j)])] = std::exp(representative_theta_[j]);
   representative_->set_ligament_stiffness(stiffness);

@@ -315,9 +315,14 @@ void OpenClEnsemble::refresh_factor() {
   };
   const std::size_t rows = static_cast<std::size_t>(L.cols());
   const std::size_t nonzeros = static_cast<std::size_t>(L.nonZeros());
-  write_integers(DeviceBuffer::factor_columns, L.outerIndexPtr(), rows + 1);
-  write_integers(DeviceBuffer::factor_rows, L.innerIndexPtr(), nonzeros);
-  write_integers(DeviceBuffer::factor_order, factor_->order(), rows);
+  // The factor's pattern and ordering are the same at every refresh (the representative's
+  // assembly pattern does not change, so neither does the analysis): only the values go down
+  // again.
+  if (!factor_uploaded_) {
+    write_integers(DeviceBuffer::factor_columns, L.outerIndexPtr(), rows + 1);
+    write_integers(DeviceBuffer::factor_rows, L.innerIndexPtr(), nonzeros);
+    write_integers(DeviceBuffer::factor_order, factor_->order(), rows);
+  }
   write_reals(DeviceBuffer::factor_values, std::vector<double>(L.valuePtr(), L.valuePtr() + nonzeros));
   factor_uploaded_ = true;
 }
