@@ -28,9 +28,10 @@ enum class KernelForm { automatic, cpu, gpu };
 
 // CG's preconditioner: Jacobi (the oracle's and the device kernels'), or sparse Cholesky
 // factors, one per sigma point of the CPU ensemble or one they share (CpuEnsemble,
-// host/reference/factorised_preconditioner.h), or on OpenCL's CPU form one factor of sigma
-// point 0's system that all share (OpenClEnsemble); automatic is the factors on the CPU back
-// end and Jacobi on the devices (the GPU forms and Vulkan have no other yet).
+// host/reference/factorised_preconditioner.h), or on OpenCL's CPU form one factor of the
+// mean sigma point's system that all share (OpenClEnsemble); automatic is the factors on the
+// CPU back end and on OpenCL's CPU form, Jacobi on the GPU forms and Vulkan (they have no
+// other yet).
 enum class Preconditioner { automatic, jacobi, factorised };
 
 struct DeviceOptions {

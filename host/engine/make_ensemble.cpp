@@ -34,8 +34,15 @@ std::unique_ptr<SimulationEnsemble> make_ensemble(const std::string& backend, co
 }
 
 std::string preconditioner_used(const std::string& backend, const DeviceOptions& options) {
-  const bool factors = backend == "cpu" ? options.preconditioner != Preconditioner::jacobi
-                                        : options.preconditioner == Preconditioner::factorised;
+  bool factors = false;
+  if (backend == "cpu") factors = options.preconditioner != Preconditioner::jacobi;
+  if (backend == "opencl") {
+    const std::vector<OpenClDeviceInfo> devices = list_opencl_devices();
+    const std::string type = options.device >= 0 && options.device < static_cast<int>(devices.size())
+                                 ? devices[static_cast<std::size_t>(options.device)].type
+                                 : "";
+    factors = opencl_uses_factor(options.preconditioner, opencl_cpu_form(options.kernel_form, type));
+  }
   return factors ? "factorised" : "jacobi";
 }
 

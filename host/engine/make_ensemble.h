@@ -22,15 +22,15 @@ std::vector<std::string> available_backends();
 // "auto" is resolve_backend()'s choice (host/engine/choose_backend.h). Throws InputError
 // for an unknown name, DeviceError when the device cannot run it.
 // The CPU back end takes only `options.preconditioner` (automatic: the factors); OpenCL
-// takes Preconditioner::factorised on a CPU device (a DeviceError on a GPU), Vulkan refuses it
-// with an InputError.
+// has its shared factor on a CPU device (automatic: there, not on a GPU; factorised on a GPU
+// is a DeviceError), Vulkan refuses factorised with an InputError.
 std::unique_ptr<SimulationEnsemble> make_ensemble(const std::string& backend, const Model& model,
                                                   const std::vector<int>& estimated,
                                                   const ObservedPoints& observed, int sigma_count,
                                                   const DeviceOptions& options = {});
 
 // The preconditioner that `backend` (not "auto") runs CG with under `options`: "factorised"
-// or "jacobi", for the reports.
+// or "jacobi", for the reports. For OpenCL it asks the device's type.
 std::string preconditioner_used(const std::string& backend, const DeviceOptions& options);
 
 // The ensemble of `model` on `backend` with the candidate `effects` estimated (EffectEnsemble):

@@ -57,7 +57,7 @@ void DeviceEnsemble::set_parameters(const Eigen::MatrixXd& theta) {
   check_parameter_matrix(theta, parameter_count(), sigma_count(), who_);
   ligament_k_from_theta(model_, estimated_, theta, S_, ligament_k_);
   upload_ligament_k();
-  representative_theta_ = theta.col(0);
+  representative_theta_ = theta.rowwise().mean();
 }
 
 void DeviceEnsemble::set_physics_effects(const std::vector<PhysicsEffects>& effects) {
@@ -75,6 +75,14 @@ Eigen::SparseMatrix<double> DeviceEnsemble::representative_system(const Eigen::V
   representative_->set_physics_effects(representative_effects_);
   representative_->set_state(x, v);
   return representative_->system_matrix();
+}
+
+Eigen::SparseMatrix<double> DeviceEnsemble::representative_system() const {
+  const std::size_t rows = 3 * static_cast<std::size_t>(nodes_);
+  const auto mean = [&](DeviceBuffer buffer) -> Eigen::VectorXd {
+    return from_sigma_rows(read_reals(buffer, rows * S_), rows, S_).rowwise().mean();
+  };
+  return representative_system(mean(DeviceBuffer::x), mean(DeviceBuffer::v));
 }
 
 std::vector<double> DeviceEnsemble::column_of(DeviceBuffer buffer, std::size_t rows, int s) const {

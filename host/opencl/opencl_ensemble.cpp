@@ -1,6 +1,7 @@
 #include "host/opencl/opencl_ensemble.h"
 
 #include <algorithm>
+#include <cmath>
 #include <stdexcept>
 #include <string>
 
@@ -17,6 +18,15 @@ std::size_t round_up(std::size_t n, std::size_t multiple) {
 
 }  // namespace
 
+bool opencl_cpu_form(KernelForm form, const std::string& device_type) {
+  return form == KernelForm::automatic ? device_type == "cpu" : form == KernelForm::cpu;
+}
+
+bool opencl_uses_factor(Preconditioner preconditioner, bool cpu_form) {
+  return preconditioner == Preconditioner::factorised ||
+         (preconditioner == Preconditioner::automatic && cpu_form);
+}
+
 OpenClEnsemble::OpenClEnsemble(const Model& model, std::vector<int> estimated,
                                ObservedPoints observed, int sigma_count,
                                const DeviceOptions& options)
@@ -29,8 +39,7 @@ OpenClEnsemble::OpenClEnsemble(const Model& model, std::vector<int> estimated,
 
   // The CPU form or the GPU form of the kernels (DeviceOptions::kernel_form): the device's
   // type decides unless a test forces one.
-  const bool cpu_form = options.kernel_form == KernelForm::automatic ? info.type == "cpu"
-                                                                     : options.kernel_form == KernelForm::cpu;
+  const bool cpu_form = opencl_cpu_form(options.kernel_form, info.type);
   // Element kernels: on a CPU device one work-item takes an element for all S sigma points,
   // so the compiler vectorises over them; elsewhere one work-item per (element, sigma).
   sigma_block_ = cpu_form ? S_ : 1;
@@ -58,10 +67,10 @@ OpenClEnsemble::OpenClEnsemble(const Model& model, std::vector<int> estimated,
   const int units = static_cast<int>(std::max(1u, info.compute_units));
   cg_block_ = (S_ + units - 1) / units;
   while (S_ % cg_block_ != 0) --cg_block_;
-  // --preconditioner factorised: a factor of sigma point 0's system shared by the sigma
-  // points, in the CPU form's CG (the GPU form has Jacobi only); analysed here for its size,
-  // made at the first step and again when due.
-  if (options.preconditioner == Preconditioner::factorised) {
+  // A factor of the representative's system shared by the sigma points, in the CPU form's
+  // CG (the GPU form has Jacobi only); analysed here for its size, made at the first step
+  // and again when due.
+  if (opencl_uses_factor(options.preconditioner, cpu_form)) {
     if (!cpu_form)
       throw DeviceError("--preconditioner factorised: OpenCL has it on a CPU device only (its "
                         "GPU kernels precondition CG with Jacobi); device " + info.name);
@@ -83,6 +92,8 @@ OpenClEnsemble::OpenClEnsemble(const Model& model, std::vector<int> estimated,
     const std::size_t dof = 3 * static_cast<std::size_t>(nodes_) * S_;
     const DeviceBufferSizes sizes{element_chunks_ * dof, cg_partitions_,
                                   factor_ ? factor_->nonzeros() : 0};
+    written_.resize(kDeviceBufferCount);
+    write_done_.resize(written_.size());
     for (const DeviceBufferSpec& spec : buffer_specs(sizes)) {
       const std::size_t bytes = take_device_bytes(spec, device_.real_size());
       buffers_.emplace_back(device_.context(), CL_MEM_READ_WRITE, bytes);
@@ -175,11 +186,22 @@ void OpenClEnsemble::set_arguments(cl::Kernel& kernel, const std::vector<DeviceB
   for (DeviceBuffer id : buffers) kernel.setArg(index++, buffer(id));
 }
 
+OpenClEnsemble::~OpenClEnsemble() {
+  try {
+    device_.queue().finish();
+  } catch (const cl::Error&) {   // nothing to report to from a destructor; the copies go
+  }
+}
+
 void OpenClEnsemble::write_reals(DeviceBuffer id, const std::vector<double>& values) {
   if (values.empty()) return;
-  const std::vector<unsigned char> bytes = to_device_reals(values, device_.precision());
+  observations_ready_ = false;
+  const auto slot = static_cast<std::size_t>(id);
   try {
-    device_.queue().enqueueWriteBuffer(buffer(id), CL_TRUE, 0, bytes.size(), bytes.data());
+    if (write_done_[slot]()) write_done_[slot].wait();   // its last write has read the copy
+    written_[slot] = to_device_reals(values, device_.precision());
+    device_.queue().enqueueWriteBuffer(buffer(id), CL_FALSE, 0, written_[slot].size(),
+                                       written_[slot].data(), nullptr, &write_done_[slot]);
   } catch (const cl::Error& error) {
     throw opencl_failure("writing to the device", error);
   }
@@ -287,7 +309,9 @@ StepReport OpenClEnsemble::advance(const Eigen::Vector3d& so_position) {
     queue.enqueueReadBuffer(buffer(DeviceBuffer::converged), CL_FALSE, 0, S_ * sizeof(cl_uint), converged.data());
     queue.enqueueReadBuffer(buffer(DeviceBuffer::rr), CL_FALSE, 0, rr_bytes.size(), rr_bytes.data());
     queue.enqueueReadBuffer(buffer(DeviceBuffer::bb), CL_FALSE, 0, bb_bytes.size(), bb_bytes.data());
+    enqueue_observations();
     queue.finish();
+    observations_ready_ = !observed_.empty();
     const Precision precision = device_.precision();
     report = step_report(iterations, converged, from_device_reals(rr_bytes.data(), S_, precision),
                          from_device_reals(bb_bytes.data(), S_, precision));
@@ -299,20 +323,14 @@ StepReport OpenClEnsemble::advance(const Eigen::Vector3d& so_position) {
 }
 
 void OpenClEnsemble::refresh_factor() {
-  // A matrix that is not positive definite (a negative stiffness of sigma point 0) leaves the
-  // last factor in place, and the next step tries again; with no factor yet, CG has nothing
-  // to run with.
-  if (!factor_->factorise(representative_system(positions(0), velocities(0)))) {
-    if (!factor_uploaded_)
-      throw DeviceError("--preconditioner factorised: sigma point 0's system is not positive "
-                        "definite (a negative stiffness?); run with --preconditioner jacobi");
+  const Eigen::SparseMatrix<double> A = representative_system();
+  if (!factor_->factorise(A)) {
+    // A matrix that is not positive definite (a diverged state?) leaves the last factor in
+    // place, and the next step tries again.
+    if (!factor_uploaded_ && !diagonal_uploaded_) upload_diagonal_factor(A);
     return;
   }
   const Eigen::SparseMatrix<double>& L = factor_->lower();
-  cl::CommandQueue& queue = device_.queue();
-  auto write_integers = [&](DeviceBuffer id, const int* data, std::size_t count) {
-    queue.enqueueWriteBuffer(buffer(id), CL_TRUE, 0, count * sizeof(cl_int), data);
-  };
   const std::size_t rows = static_cast<std::size_t>(L.cols());
   const std::size_t nonzeros = static_cast<std::size_t>(L.nonZeros());
   // The factor's pattern and ordering are the same at every refresh (the representative's
@@ -325,6 +343,30 @@ void OpenClEnsemble::refresh_factor() {
   }
   write_reals(DeviceBuffer::factor_values, std::vector<double>(L.valuePtr(), L.valuePtr() + nonzeros));
   factor_uploaded_ = true;
+  diagonal_uploaded_ = false;
+}
+
+void OpenClEnsemble::upload_diagonal_factor(const Eigen::SparseMatrix<double>& A) {
+  const int rows = static_cast<int>(A.rows());
+  std::vector<int> columns(static_cast<std::size_t>(rows) + 1), order(static_cast<std::size_t>(rows));
+  std::vector<double> values(static_cast<std::size_t>(rows));
+  for (int i = 0; i < rows; ++i) {
+    columns[static_cast<std::size_t>(i)] = i;
+    order[static_cast<std::size_t>(i)] = i;
+    const double d = A.coeff(i, i);
+    // A row whose diagonal is not positive (or not finite) is left unscaled.
+    values[static_cast<std::size_t>(i)] = std::isfinite(d) && d > 0.0 ? std::sqrt(d) : 1.0;
+  }
+  columns.back() = rows;
+  write_integers(DeviceBuffer::factor_columns, columns.data(), columns.size());
+  write_integers(DeviceBuffer::factor_rows, order.data(), order.size());   // row i: i
+  write_integers(DeviceBuffer::factor_order, order.data(), order.size());
+  write_reals(DeviceBuffer::factor_values, values);
+  diagonal_uploaded_ = true;
+}
+
+void OpenClEnsemble::write_integers(DeviceBuffer id, const int* data, std::size_t count) {
+  device_.queue().enqueueWriteBuffer(buffer(id), CL_TRUE, 0, count * sizeof(cl_int), data);
 }
 
 void OpenClEnsemble::predicted_observations(Eigen::MatrixXd& y) const {
@@ -334,15 +376,30 @@ void OpenClEnsemble::predicted_observations(Eigen::MatrixXd& y) const {
     return;
   }
   try {
-    run(k_observation_gather_, rows * S_);
-    y = from_sigma_rows(read_reals(DeviceBuffer::observations, rows * S_), rows, S_);
+    if (!observations_ready_) {
+      enqueue_observations();
+      device_.queue().finish();
+      observations_ready_ = true;
+    }
+    y = from_sigma_rows(from_device_reals(observation_bytes_.data(), rows * S_, device_.precision()),
+                        rows, S_);
   } catch (const cl::Error& error) {
     throw opencl_failure("reading the observations", error);
   }
 }
 
+void OpenClEnsemble::enqueue_observations() const {
+  const std::size_t rows = observed_.size() * 3;
+  if (rows == 0) return;
+  run(k_observation_gather_, rows * S_);
+  observation_bytes_.resize(rows * S_ * device_.real_size());
+  device_.queue().enqueueReadBuffer(buffer(DeviceBuffer::observations), CL_FALSE, 0,
+                                    observation_bytes_.size(), observation_bytes_.data());
+}
+
 void OpenClEnsemble::recenter(const Recentering& r) {
   const RecenteringInputs in = pack_recentering(r, S_, "OpenClEnsemble");
+  observations_ready_ = false;
   try {
     k_recenter_.setArg(2, static_cast<cl_uint>(in.p));
     write_reals(DeviceBuffer::recenter_scalars, in.scalars);

@@ -21,6 +21,14 @@
 
 namespace sigmafem {
 
+// The form of the kernels OpenClEnsemble builds on a device of this type ("cpu", "gpu", ...;
+// OpenClDeviceInfo::type): `form`, or the device's own unless a test forces one.
+bool opencl_cpu_form(KernelForm form, const std::string& device_type);
+// Whether it preconditions CG with one shared factor: asked, or by default (automatic) on the
+// CPU form, where it is faster on every case measured (bench/RESULTS.md, issue 18); the GPU
+// form has Jacobi only.
+bool opencl_uses_factor(Preconditioner preconditioner, bool cpu_form);
+
 class OpenClEnsemble : public DeviceEnsemble {
  public:
   // Elements x sigma points up to which a CPU device runs the whole CG solve in one launch.
@@ -31,15 +39,19 @@ class OpenClEnsemble : public DeviceEnsemble {
   // build failure, too little memory).
   OpenClEnsemble(const Model& model, std::vector<int> estimated, ObservedPoints observed,
                  int sigma_count, const DeviceOptions& options);
+  ~OpenClEnsemble() override;   // waits for the writes still reading their host copies
 
   StepReport advance(const Eigen::Vector3d& so_position) override;
   void predicted_observations(Eigen::MatrixXd& y) const override;
   void recenter(const Recentering& recentering) override;
   const OpenClDeviceInfo& device_info() const { return device_.info(); }
+  // Factorisations of the shared factor so far (0 with Jacobi).
+  int factorisations() const { return factor_ ? factor_->factorisations() : 0; }
 
  private:
   std::vector<double> read_reals(DeviceBuffer buffer, std::size_t count) const override;
   void write_reals(DeviceBuffer buffer, const std::vector<double>& values) override;
+  void write_integers(DeviceBuffer buffer, const int* data, std::size_t count);   // waits
   void upload_ligament_k() override;
   std::string device_name() const override { return device_.info().name; }
   void run_system_product() override;
@@ -58,8 +70,15 @@ class OpenClEnsemble : public DeviceEnsemble {
   void run(cl::Kernel& kernel, std::size_t items, std::size_t local = 0) const;
   void run_cg(cl::Kernel& kernel) const;   // cg_start or cg_iteration, as SF_CG_PER_GROUP
   void run_partitions(cl::Kernel& kernel) const;   // a CG kernel's S x P groups (GPU form)
-  // Makes the factor again from sigma point 0's state when it is due, and uploads it.
+  // The observation gather and its read, not waited for.
+  void enqueue_observations() const;
+  // Makes the factor again from the representative (the mean sigma point) when it is due,
+  // and uploads it; with no factor yet and a representative that is not positive definite,
+  // uploads its diagonal instead (upload_diagonal_factor).
   void refresh_factor();
+  // A stand-in for the factor: L = sqrt(diag A), no reordering, so that z = r / diag A, which
+  // is Jacobi's preconditioner, until a factorisation succeeds.
+  void upload_diagonal_factor(const Eigen::SparseMatrix<double>& A);
 
   mutable OpenClDevice device_;
   bool cg_per_group_ = true;                // SF_CG_PER_GROUP: CG kernels a group per sigma (GPU)
@@ -70,10 +89,20 @@ class OpenClEnsemble : public DeviceEnsemble {
   int cg_block_ = 1;                        // SF_CG_BLOCK: sigma points per CG work-item (CPU)
   int cg_partitions_ = 1;                   // SF_CG_PARTITIONS: CG work-groups per sigma (GPU)
   std::vector<cl::Buffer> buffers_;         // by DeviceBuffer
-  // CG's preconditioner with --preconditioner factorised (CPU form): one sparse Cholesky
-  // factor of sigma point 0's system, shared by all (SF_FACTOR); null: Jacobi.
+  // Writes do not wait for the device (write_reals): each buffer's host copy is kept until
+  // its write is done (the event), and the next read waits for them all. A wait on PoCL
+  // hands the work to its threads and back, about 0.1 ms; a filter step wrote five times.
+  std::vector<std::vector<unsigned char>> written_;   // by DeviceBuffer
+  std::vector<cl::Event> write_done_;                 // by DeviceBuffer
+  // The observations of the state advance() left, read back with its report (one wait
+  // instead of two): valid until anything is written or re-centred.
+  mutable std::vector<unsigned char> observation_bytes_;
+  mutable bool observations_ready_ = false;
+  // CG's preconditioner on the CPU form (opencl_uses_factor): one sparse Cholesky factor of
+  // the representative's system, shared by all (SF_FACTOR); null: Jacobi.
   std::unique_ptr<FactorisedPreconditioner> factor_;
-  bool factor_uploaded_ = false;
+  bool factor_uploaded_ = false;     // a factor is on the device (its pattern and ordering)
+  bool diagonal_uploaded_ = false;   // the diagonal stand-in is
 
   // Mutable: enqueueing a kernel (also from the const read-outs) changes no visible state.
   mutable cl::Kernel k_element_rhs_, k_node_rhs_, k_element_product_, k_node_product_;

@@ -336,9 +336,6 @@ void cg_direction(uint S, uint node_count, int max_iterations, __global const re
  * sigma point's system made on the host (FactorisedPreconditioner, the CPU back end's), shared
  * by every sigma point: z = P^T L^-T L^-1 P r, L by columns, the diagonal first in each.
  * The block's sigma points are innermost, so each entry of L is read once for the block. */
-#ifndef SF_FACTOR
-#  define SF_FACTOR 0
-#endif
 #if SF_FACTOR
 /* The factor's buffers as the last arguments of the kernels and helpers that use them. */
 #  define SF_FACTOR_ARGUMENTS                                                                \

@@ -41,7 +41,9 @@ __kernel void element_rhs(uint S, uint element_count, __global const int* restri
     SF_UNROLL
     for (int i = 0; i < 12; ++i) force[i] -= SF_SIGMA_CONSTANT(c, SF_VELOCITY_FACTOR, s, S) * product[i];
     SF_STORE_CORNERS(element_out, e, s, S, force)
+#if !SF_FACTOR /* the Jacobi diagonal, which a factor does not need */
     sf_element_diagonal(frame, grad, vlambda, vmu, product);
     SF_STORE_CORNERS(element_diagonal, e, s, S, product)
+#endif
   }
 }

@@ -29,6 +29,12 @@ typedef SF_REAL real;
 #  define SF_ELEMENT_CHUNKS 0
 #endif
 
+/* 1: CG is preconditioned by a sparse Cholesky factor (conjugate_gradient.cl, the CPU form),
+ * and the Jacobi diagonal is neither made (element_rhs, node_rhs) nor read. */
+#ifndef SF_FACTOR
+#  define SF_FACTOR 0
+#endif
+
 /* The item (element or node) and the first sigma point of the block that work-item `gid`
  * takes in the blocked kernels; 0 for a work-item past the end (the global size is rounded
  * up to whole work-groups). */

@@ -25,9 +25,11 @@ __kernel void node_rhs(uint S, uint node_count, __global const real* c,
   struct SfNodeConstants at;
   SF_LOAD_NODE_CONSTANTS(c, s, S, at)
   real f_elements[3];
-  real diagonal[3];
   SF_CORNER_SUMS(element_out, incidence_offsets, incidence, n, s, S, f_elements)
+#if !SF_FACTOR /* the Jacobi diagonal, which a factor does not need */
+  real diagonal[3];
   SF_CORNER_SUMS(element_diagonal, incidence_offsets, incidence, n, s, S, diagonal)
+#endif
   real u[3];
   for (int k = 0; k < 3; ++k) u[k] = x[((size_t)3 * n + k) * S + s] - rest_positions[3 * n + k];
   real law = sf_ligament_law(spring, control_k[n], u, at.inverse_d0_squared);
@@ -36,7 +38,9 @@ __kernel void node_rhs(uint S, uint node_count, __global const real* c,
     size_t row = ((size_t)3 * n + k) * S + s;
     rhs[row] = sf_node_rhs_row(at, k, f_elements[k], u[k], v[row], spring, control_k[n], law,
                                mass[n], m);
+#if !SF_FACTOR
     inverse_diagonal[row] = sf_node_inverse_diagonal(at, diagonal[k], spring, m);
+#endif
   }
 }
 
