@@ -9,6 +9,7 @@ GpuPresence find_gpus() {
   GpuPresence gpus;
   const std::vector<OpenClDeviceInfo> opencl = list_opencl_devices();
   if (!opencl.empty() && opencl[0].type == "gpu") gpus.opencl = opencl[0].name;
+  if (!opencl.empty() && opencl[0].type == "cpu") gpus.opencl_cpu = opencl[0].name;
   const std::vector<VulkanDeviceInfo> vulkan = list_vulkan_devices();
   if (!vulkan.empty() && vulkan[0].type.find("gpu") != std::string::npos)
     gpus.vulkan = vulkan[0].name;
@@ -19,8 +20,17 @@ BackendDecision choose_backend(const GpuPresence& gpus, long long elements, int 
   const long long pairs = elements * sigma_count;
   const std::string size = std::to_string(elements) + " tetrahedra x " +
                            std::to_string(sigma_count) + " sigma points";
-  if (gpus.opencl.empty() && gpus.vulkan.empty())
+  if (gpus.opencl.empty() && gpus.vulkan.empty()) {
+    const std::string bounds = "up to " + std::to_string(kCpuDeviceElements) +
+                               " tetrahedra or from " + std::to_string(kCpuDevicePairs) + " pairs";
+    if (!gpus.opencl_cpu.empty() && (elements <= kCpuDeviceElements || pairs >= kCpuDevicePairs))
+      return {"opencl", "auto: no GPU; " + size + " on the CPU device " + gpus.opencl_cpu +
+                            ", faster there than the CPU back end (" + bounds + ")"};
+    if (!gpus.opencl_cpu.empty())
+      return {"cpu", "auto: no GPU; " + size + ": the CPU back end is faster than OpenCL on the "
+                     "CPU device between its bounds (" + bounds + ")"};
     return {"cpu", "auto: no GPU; the CPU back end is the fastest without one"};
+  }
   if (pairs < kGpuPairs)
     return {"cpu", "auto: " + size + " is too small for the GPU to pay (from " +
                        std::to_string(kGpuPairs) + " pairs)"};

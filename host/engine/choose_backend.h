@@ -4,10 +4,14 @@
 // 8-12 ms against 30 ms for the CPU back end on 2 cores, while the 596-tetrahedron liver's
 // filter step (S = 4, 2 384 pairs) took 2.9-3.8 ms there against 1.6 ms on 2 CPU cores, and
 // S = 16 on it (9 536 pairs) was even. OpenCL before Vulkan: it was ahead on the large meshes
-// (117k box 75 against 90 ms, 38k filter step 23.5 against 61 ms). Otherwise the CPU back end:
-// with its sparse factors (3-4 CG iterations a step) it beat OpenCL on PoCL on every liver
-// case measured on 2 cores (filter step 1.6 against 2.7 ms, 4768 liver at S = 16 30 against
-// 64 ms).
+// (117k box 75 against 90 ms, 38k filter step 23.5 against 61 ms). Without a GPU, OpenCL on
+// a CPU device (PoCL) up to kCpuDeviceElements tetrahedra or from kCpuDevicePairs pairs: with
+// its shared factor (stop 44) it stepped the liver ahead of the CPU back end on 2 cores
+// (filter step 1.2-1.4 against 1.4-1.6 ms; 596 x 16 2.1 against 4.7 ms; 4768 x 4 8.3 against
+// 21 ms; 4768 x 16 23 against 47 ms) and the 38k liver at S = 16 (336 against 2333 ms, where
+// the CPU back end's S factors outgrow its memory budget and it shares one), but not the
+// 38k liver's filter step at S = 4 (374 against 268 ms: the shared factor takes 5.7 CG
+// iterations there, the CPU back end's own factors 2-3). Otherwise the CPU back end.
 #pragma once
 
 #include <string>
@@ -18,12 +22,18 @@ namespace sigmafem {
 
 // Element x sigma-point pairs in one product from which a GPU is chosen.
 constexpr long long kGpuPairs = 16384;
+// Without a GPU, OpenCL on a CPU device is chosen over the CPU back end up to this many
+// tetrahedra (between the 4768 measured faster on it and the 38144 measured slower at S = 4)
+// or from this many element-sigma pairs (between 38144 x 4, slower, and 38144 x 16, faster).
+constexpr long long kCpuDeviceElements = 16384;
+constexpr long long kCpuDevicePairs = 262144;
 
 // Device 0 of each device back end when it is a GPU: its name, "" when it is not a GPU or
-// there is none.
+// there is none; and OpenCL's device 0 when it is a CPU device (PoCL).
 struct GpuPresence {
   std::string opencl;
   std::string vulkan;
+  std::string opencl_cpu;
 };
 GpuPresence find_gpus();
 

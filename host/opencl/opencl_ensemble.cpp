@@ -353,8 +353,10 @@ void OpenClEnsemble::upload_diagonal_factor(const Eigen::SparseMatrix<double>& A
   for (int i = 0; i < rows; ++i) {
     columns[static_cast<std::size_t>(i)] = i;
     order[static_cast<std::size_t>(i)] = i;
-    const double d = A.coeff(i, i);
-    // A row whose diagonal is not positive (or not finite) is left unscaled.
+    // |diag A|: a preconditioner must be positive definite (a negative diagonal would be
+    // Jacobi's with the sign of the whole system turned); a row whose diagonal is 0 or not
+    // finite is left unscaled.
+    const double d = std::abs(A.coeff(i, i));
     values[static_cast<std::size_t>(i)] = std::isfinite(d) && d > 0.0 ? std::sqrt(d) : 1.0;
   }
   columns.back() = rows;

@@ -76,8 +76,8 @@ class OpenClEnsemble : public DeviceEnsemble {
   // and uploads it; with no factor yet and a representative that is not positive definite,
   // uploads its diagonal instead (upload_diagonal_factor).
   void refresh_factor();
-  // A stand-in for the factor: L = sqrt(diag A), no reordering, so that z = r / diag A, which
-  // is Jacobi's preconditioner, until a factorisation succeeds.
+  // A stand-in for the factor: L = sqrt(|diag A|), no reordering, so that z = r / |diag A|,
+  // Jacobi's preconditioner, until a factorisation succeeds.
   void upload_diagonal_factor(const Eigen::SparseMatrix<double>& A);
 
   mutable OpenClDevice device_;

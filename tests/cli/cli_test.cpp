@@ -16,6 +16,7 @@
 #include "host/data/observation_table.h"
 #include "host/data/point_cloud_table.h"
 #include "host/engine/choose_backend.h"
+#include "host/engine/make_ensemble.h"
 #include "host/scenario/scenario.h"
 #include "requirement.h"
 #include "temp_path.h"
@@ -272,8 +273,9 @@ TEST_F(CliTest, EstimateWritesEstimatesSummaryResidualsAndPlots) {
   const json summary = json::parse(summary_file);
   EXPECT_EQ(summary["backend"], expected.backend);
   EXPECT_EQ(summary["backend_reason"], expected.reason);
-  // Which preconditioner CG ran with: the CPU back end's factors, Jacobi on a device.
-  EXPECT_EQ(summary["preconditioner"], expected.backend == "cpu" ? "factorised" : "jacobi");
+  // Which preconditioner CG ran with: the CPU back end's factors, OpenCL's shared factor on
+  // a CPU device, Jacobi on a GPU.
+  EXPECT_EQ(summary["preconditioner"], preconditioner_used(expected.backend, DeviceOptions{}));
   EXPECT_TRUE(summary["complete"].get<bool>());
   EXPECT_EQ(summary["filter_steps"].get<int>(), 30);
   EXPECT_TRUE(summary["errors"].is_object()) << "truth.csv was in the data folder";

@@ -1,4 +1,5 @@
-// `--backend auto` (host/engine/choose_backend.h): the CPU back end without a GPU or below
+// `--backend auto` (host/engine/choose_backend.h): without a GPU, OpenCL on a CPU device up to
+// kCpuDeviceElements tetrahedra, else the CPU back end; with one, the CPU back end below
 // kGpuPairs element-sigma pairs, OpenCL's GPU before Vulkan's above; a named back end is
 // taken as it is.
 #include "host/engine/choose_backend.h"
@@ -15,8 +16,9 @@ namespace sigmafem {
 namespace {
 
 const GpuPresence kNoGpu{};
-const GpuPresence kBothGpus{"NVIDIA H200", "NVIDIA H200"};
-const GpuPresence kVulkanGpuOnly{"", "AMD Radeon"};
+const GpuPresence kBothGpus{"NVIDIA H200", "NVIDIA H200", ""};
+const GpuPresence kVulkanGpuOnly{"", "AMD Radeon", ""};
+const GpuPresence kPoclOnly{"", "", "pthread-skylake-avx512"};
 
 TEST(ChooseBackend, WithoutAGpuTheCpuBackEnd) {
   for (long long elements : {596LL, 38144LL, 117240LL}) {
@@ -24,6 +26,24 @@ TEST(ChooseBackend, WithoutAGpuTheCpuBackEnd) {
     EXPECT_EQ(d.backend, "cpu") << elements;
     EXPECT_NE(d.reason.find("no GPU"), std::string::npos) << d.reason;
   }
+}
+
+TEST(ChooseBackend, WithoutAGpuOpenClOnTheCpuUpToItsBound) {
+  for (long long elements : {596LL, 4768LL, kCpuDeviceElements}) {
+    const BackendDecision d = choose_backend(kPoclOnly, elements, 4);
+    EXPECT_EQ(d.backend, "opencl") << elements;
+    EXPECT_NE(d.reason.find("CPU device pthread-skylake-avx512"), std::string::npos) << d.reason;
+  }
+  // Above the bound the CPU back end, until the pairs reach kCpuDevicePairs (38144 x 4 on the
+  // CPU back end, 38144 x 16 on OpenCL).
+  for (long long elements : {kCpuDeviceElements + 1, 38144LL}) {
+    const BackendDecision d = choose_backend(kPoclOnly, elements, 4);
+    EXPECT_EQ(d.backend, "cpu") << elements;
+    EXPECT_NE(d.reason.find("no GPU"), std::string::npos) << d.reason;
+  }
+  EXPECT_EQ(choose_backend(kPoclOnly, 38144, 16).backend, "opencl");
+  EXPECT_EQ(choose_backend(kPoclOnly, kCpuDevicePairs / 8, 8).backend, "opencl");
+  EXPECT_EQ(choose_backend(kPoclOnly, kCpuDevicePairs / 8 - 1, 8).backend, "cpu");
 }
 
 TEST(ChooseBackend, AGpuFromEnoughWorkAndOpenClFirst) {
@@ -46,8 +66,11 @@ TEST(ChooseBackend, ANamedBackEndIsTakenAsItIs) {
     EXPECT_EQ(d.backend, name);
     EXPECT_EQ(d.reason, "given");
   }
-  // auto here: whatever this machine has, a box filter (1344 x 4) is below the bound.
-  EXPECT_EQ(resolve_backend("auto", model, 4).backend, "cpu");
+  // auto here: a box filter (1344 x 4) is below the GPU's bound, and OpenCL's on a CPU
+  // device (PoCL) when that is OpenCL's device 0.
+  const GpuPresence here = find_gpus();
+  EXPECT_EQ(resolve_backend("auto", model, 4).backend,
+            here.opencl.empty() && here.vulkan.empty() && !here.opencl_cpu.empty() ? "opencl" : "cpu");
 }
 
 }  // namespace

@@ -1,8 +1,9 @@
-// OpenCL with --preconditioner factorised (OpenClEnsemble, kernels/opencl/conjugate_gradient.cl
-// SF_FACTOR): on a CPU device CG is preconditioned by one sparse Cholesky factor of sigma point
-// 0's system, made on the host and shared by all sigma points. The trajectories follow the CPU
-// back end's as Jacobi's do, in a fraction of Jacobi's iterations, in both of the CPU form's
-// launches (the whole solve in one, an iteration per launch); the GPU form refuses it.
+// OpenCL's shared factor (OpenClEnsemble, kernels/opencl/conjugate_gradient.cl SF_FACTOR; the
+// default on a CPU device): CG is preconditioned by one sparse Cholesky factor of the mean
+// sigma point's system, made on the host and shared by all sigma points. The trajectories
+// follow the CPU back end's as Jacobi's do, in a fraction of Jacobi's iterations, in both of
+// the CPU form's launches (the whole solve in one, an iteration per launch); without a factor
+// the diagonal stands in; the GPU form refuses it.
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -94,6 +95,29 @@ TEST_F(OpenClFactorTest, FollowsTheCpuBackEndInAFractionOfJacobisIterations) {
     std::cout << name << ": largest difference from the CPU back end " << jacobi_error
               << " m with Jacobi, " << factor_error << " m with the factor; iterations "
               << jacobi_iterations << " and " << factor_iterations << "\n";
+  }
+}
+
+// A representative whose system is not positive definite (here a mass damping that makes the
+// implicit-Euler matrix negative definite: A = (1 + h b) M + h (h + a) K with 1 + h b = -1e4)
+// cannot be factorised: its diagonal stands in (z = r / |diag A|, Jacobi's up to the sign of
+// the whole system), and the run goes on where stop 43 stopped with a DeviceError: CG
+// converges in Jacobi's iterations (6 here, measured).
+TEST_F(OpenClFactorTest, WithoutAFactorTheDiagonalStandsIn) {
+  model_.damping.rayleigh_mass = -(1e4 + 1.0) / model_.dt;
+  const Eigen::Vector3d so =
+      scenario_.control.trajectory.position(scenario_.time.dt, scenario_.control.start);
+  OpenClEnsemble jacobi = opencl(Preconditioner::jacobi, SolveLaunch::automatic);
+  jacobi.set_parameters(theta_);
+  const StepReport expected = jacobi.advance(so);
+  OpenClEnsemble stand_in = opencl(Preconditioner::factorised, SolveLaunch::automatic);
+  stand_in.set_parameters(theta_);
+  const StepReport report = stand_in.advance(so);
+  EXPECT_EQ(stand_in.factorisations(), 0) << "the matrix is not positive definite";
+  for (int s = 0; s < kSigmaPoints; ++s) {
+    EXPECT_TRUE(expected.converged[s]) << s;
+    EXPECT_TRUE(report.converged[s]) << s;
+    EXPECT_EQ(report.cg_iterations[s], expected.cg_iterations[s]) << s;
   }
 }
 
