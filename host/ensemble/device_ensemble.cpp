@@ -28,8 +28,9 @@ DeviceEnsemble::DeviceEnsemble(const Model& model, std::vector<int> estimated,
 }
 
 void DeviceEnsemble::check_device_memory(std::size_t real_size, const std::string& name,
-                                         std::size_t memory, std::size_t largest_buffer) const {
-  const EnsembleMemory need = ensemble_memory(nodes_, elements_, S_, real_size);
+                                         std::size_t memory, std::size_t largest_buffer,
+                                         std::size_t factor_nonzeros) const {
+  const EnsembleMemory need = ensemble_memory(nodes_, elements_, S_, real_size, factor_nonzeros);
   if (need.largest > largest_buffer || need.total > memory)
     throw DeviceError(out_of_device_memory_message(need, elements_, S_, name, memory, largest_buffer));
 }

@@ -56,9 +56,9 @@ class DeviceEnsemble : public SimulationEnsemble {
                  int sigma_count, Precision precision, const char* backend, const char* who);
 
   // Throws DeviceError when the ensemble needs more than `memory` bytes, or a buffer larger
-  // than `largest_buffer`, of device `name`.
+  // than `largest_buffer`, of device `name` (with a shared factor's buffers, ensemble_memory).
   void check_device_memory(std::size_t real_size, const std::string& name, std::size_t memory,
-                           std::size_t largest_buffer) const;
+                           std::size_t largest_buffer, std::size_t factor_nonzeros = 0) const;
   // The table of buffers with this back end's sizes (device_buffer_specs).
   // Also takes the model's stiffnesses into ligament_k_ (set_parameters() changes only the
   // estimated ligaments').

@@ -1,6 +1,7 @@
 #include "host/ensemble/device_limits.h"
 
 #include <algorithm>
+#include <cstdint>
 #include <stdexcept>
 
 #include "host/common/input_error.h"
@@ -38,7 +39,8 @@ int cg_partitions(int nodes, int forced) {
   return std::clamp(3 * nodes / kPartitionRows, 1, kMostPartitions);
 }
 
-EnsembleMemory ensemble_memory(int nodes, int elements, int S, std::size_t real_size) {
+EnsembleMemory ensemble_memory(int nodes, int elements, int S, std::size_t real_size,
+                               std::size_t factor_nonzeros) {
   // Per dof and sigma: x, v, dv, rhs, the Jacobi diagonal, r, z, d, q; per element and sigma:
   // the frame (9), the element outputs (12) and diagonals (12).
   const std::size_t dof = 3 * static_cast<std::size_t>(nodes) * S;
@@ -46,6 +48,13 @@ EnsembleMemory ensemble_memory(int nodes, int elements, int S, std::size_t real_
   EnsembleMemory need;
   need.largest = 12 * per_element * real_size;
   need.total = (9 * dof + 33 * per_element) * real_size;
+  if (factor_nonzeros > 0) {
+    // L's values and row indices, its column starts and ordering, a work vector per sigma.
+    const std::size_t rows = 3 * static_cast<std::size_t>(nodes);
+    need.largest = std::max(need.largest, factor_nonzeros * std::max(real_size, sizeof(std::int32_t)));
+    need.total += factor_nonzeros * (real_size + sizeof(std::int32_t)) +
+                  (2 * rows + 1) * sizeof(std::int32_t) + dof * real_size;
+  }
   return need;
 }
 

@@ -33,12 +33,14 @@ constexpr int kPartitionRows = 512;
 constexpr int kMostPartitions = 64;
 int cg_partitions(int nodes, int forced);
 
-// Device memory of an ensemble, in bytes, for `real_size`-byte reals.
+// Device memory of an ensemble, in bytes, for `real_size`-byte reals; with a shared factor of
+// `factor_nonzeros` nonzeros (OpenCL's CPU form), its buffers too.
 struct EnsembleMemory {
   std::size_t total = 0;     // about: all buffers
-  std::size_t largest = 0;   // the largest single buffer (12 per element and sigma point)
+  std::size_t largest = 0;   // the largest single buffer (12 per element and sigma point, or L)
 };
-EnsembleMemory ensemble_memory(int nodes, int elements, int sigma_count, std::size_t real_size);
+EnsembleMemory ensemble_memory(int nodes, int elements, int sigma_count, std::size_t real_size,
+                               std::size_t factor_nonzeros = 0);
 
 // The "out of device memory" message: what the ensemble needs and what `device` has.
 std::string out_of_device_memory_message(const EnsembleMemory& need, int elements,

@@ -33,7 +33,8 @@ OpenClEnsemble::OpenClEnsemble(const Model& model, std::vector<int> estimated,
     : DeviceEnsemble(model, std::move(estimated), std::move(observed), sigma_count,
                      options.precision, "opencl", "OpenClEnsemble"),
       device_(options.device, options.precision) {
-  // Check the memory before asking for it, to say how much is needed.
+  // Check the memory before asking for it, to say how much is needed (the factor's buffers,
+  // when there is one, once it is analysed below).
   const OpenClDeviceInfo& info = device_.info();
   check_device_memory(device_.real_size(), info.name, info.global_memory, info.max_allocation);
 
@@ -77,6 +78,9 @@ OpenClEnsemble::OpenClEnsemble(const Model& model, std::vector<int> estimated,
     factor_ = std::make_unique<FactorisedPreconditioner>();
     const ReferenceSimulation rest(model_);
     factor_->analyse(representative_system(rest.positions(), rest.velocities()));
+    // Again with the factor's buffers (L alone is 125 MB on the 38k liver).
+    check_device_memory(device_.real_size(), info.name, info.global_memory, info.max_allocation,
+                        factor_->nonzeros());
   }
   device_.build_program("-DSF_SIGMA_BLOCK=" + std::to_string(sigma_block_) +
                         " -DSF_ELEMENT_CHUNKS=" + std::to_string(element_chunks_) +

@@ -510,23 +510,14 @@ TEST_P(EnsembleConformance, IterationCapIsReported) {
     device->set_parameters(theta_);
     return device->advance(so(1));
   };
-  // With OpenCL's shared factor and one sigma point, the first step's system is the factor's
-  // own (the mean sigma point is that one): CG converges in one iteration under any cap, so
-  // the cap is checked with Jacobi, and with the factor from S = 4 on.
-  const bool exact_factor = GetParam().backend.preconditioner != Preconditioner::jacobi && S_ == 1;
   Model capped = model_;
   capped.solver.cg_max_iterations = 2;
   const StepReport report = first_step(capped);
   ASSERT_EQ(static_cast<int>(report.converged.size()), S_);
-  if (!exact_factor) {
-    EXPECT_EQ(report.unconverged_count(), S_);
-    for (int s = 0; s < S_; ++s) {
-      EXPECT_EQ(report.cg_iterations[s], 2);
-      EXPECT_GT(report.relative_residual[s], tolerance);
-    }
-  } else {
-    EXPECT_EQ(report.unconverged_count(), 0);
-    EXPECT_EQ(report.cg_iterations[0], 1);
+  EXPECT_EQ(report.unconverged_count(), S_);
+  for (int s = 0; s < S_; ++s) {
+    EXPECT_EQ(report.cg_iterations[s], 2);
+    EXPECT_GT(report.relative_residual[s], tolerance);
   }
 
   // A load whose |b|^2 overflows (in float32 and in float64) made the stop test inf <= inf,
@@ -565,6 +556,13 @@ std::vector<Case> all_cases() {
         // and nothing that depends on the mesh: the liver with S = 4 checks it (on lavapipe
         // each case costs what a VulkanSingle case does, 20 s for the liver's S = 4).
         if (backend.cg_partitions > 0 && (S != 4 || std::string(scenario) != "liver")) continue;
+        // OpenCL's default on a CPU device (its shared factor) changes CG's preconditioner, not
+        // the indexing that S = 1 and 16 check with Jacobi: S = 4 on both meshes (at S = 1 the
+        // factor would be the one sigma point's own system, CG done in one iteration).
+        if (backend.preconditioner != Preconditioner::jacobi && S != 4) continue;
+        // lavapipe's box at S = 16 (45 s of the suite on stop 44's machine) indexes as the
+        // liver at S = 16 does, which stays.
+        if (backend.backend == "vulkan" && S == 16 && std::string(scenario) == "box") continue;
         cases.push_back({backend, scenario, S});
       }
   return cases;

@@ -1,0 +1,41 @@
+// The device back ends' memory estimate (host/ensemble/device_limits.h, checked before any
+// buffer is made): the state, CG and element buffers, and with OpenCL's shared factor its
+// buffers too, so that a factor too large for the device is the "out of device memory"
+// message and not an allocation failure.
+#include "host/ensemble/device_limits.h"
+
+#include <gtest/gtest.h>
+
+#include <cstdint>
+#include <string>
+
+namespace sigmafem {
+namespace {
+
+TEST(EnsembleMemory, CountsTheStateTheElementsAndAFactor) {
+  const int nodes = 100, elements = 300, S = 4;
+  const std::size_t real = sizeof(float);
+  const EnsembleMemory plain = ensemble_memory(nodes, elements, S, real);
+  EXPECT_EQ(plain.total, (9 * 3 * nodes * S + 33 * elements * S) * real);
+  EXPECT_EQ(plain.largest, 12u * elements * S * real);
+
+  // L's values and row indices, its column starts and ordering, a work vector per sigma point.
+  const std::size_t nonzeros = 50000;
+  const EnsembleMemory with_factor = ensemble_memory(nodes, elements, S, real, nonzeros);
+  EXPECT_EQ(with_factor.total - plain.total,
+            nonzeros * (real + sizeof(std::int32_t)) + (2 * 3 * nodes + 1) * sizeof(std::int32_t) +
+                3u * nodes * S * real);
+  EXPECT_EQ(with_factor.largest, nonzeros * real) << "L is the largest buffer here";
+}
+
+TEST(EnsembleMemory, TheMessageSaysWhatIsNeededAndWhatThereIs) {
+  const EnsembleMemory need = ensemble_memory(1000, 5000, 16, sizeof(float), 10'000'000);
+  const std::string message = out_of_device_memory_message(need, 5000, 16, "a small device",
+                                                           std::size_t{64} << 20, std::size_t{16} << 20);
+  EXPECT_NE(message.find("out of device memory"), std::string::npos) << message;
+  EXPECT_NE(message.find(std::to_string(need.total >> 20) + " MiB"), std::string::npos) << message;
+  EXPECT_NE(message.find("a small device has 64 MiB"), std::string::npos) << message;
+}
+
+}  // namespace
+}  // namespace sigmafem
