@@ -331,7 +331,7 @@ void OpenClEnsemble::refresh_factor() {
   if (!factor_->factorise(A)) {
     // A matrix that is not positive definite (a diverged state?) leaves the last factor in
     // place, and the next step tries again.
-    if (!factor_uploaded_ && !diagonal_uploaded_) upload_diagonal_factor(A);
+    if (on_device_ == FactorOnDevice::none) upload_diagonal_factor(A);
     return;
   }
   const Eigen::SparseMatrix<double>& L = factor_->lower();
@@ -340,14 +340,13 @@ void OpenClEnsemble::refresh_factor() {
   // The factor's pattern and ordering are the same at every refresh (the representative's
   // assembly pattern does not change, so neither does the analysis): only the values go down
   // again.
-  if (!factor_uploaded_) {
+  if (on_device_ != FactorOnDevice::factor) {
     write_integers(DeviceBuffer::factor_columns, L.outerIndexPtr(), rows + 1);
     write_integers(DeviceBuffer::factor_rows, L.innerIndexPtr(), nonzeros);
     write_integers(DeviceBuffer::factor_order, factor_->order(), rows);
   }
   write_reals(DeviceBuffer::factor_values, std::vector<double>(L.valuePtr(), L.valuePtr() + nonzeros));
-  factor_uploaded_ = true;
-  diagonal_uploaded_ = false;
+  on_device_ = FactorOnDevice::factor;
 }
 
 void OpenClEnsemble::upload_diagonal_factor(const Eigen::SparseMatrix<double>& A) {
@@ -368,7 +367,7 @@ void OpenClEnsemble::upload_diagonal_factor(const Eigen::SparseMatrix<double>& A
   write_integers(DeviceBuffer::factor_rows, order.data(), order.size());   // row i: i
   write_integers(DeviceBuffer::factor_order, order.data(), order.size());
   write_reals(DeviceBuffer::factor_values, values);
-  diagonal_uploaded_ = true;
+  on_device_ = FactorOnDevice::diagonal;
 }
 
 void OpenClEnsemble::write_integers(DeviceBuffer id, const int* data, std::size_t count) {

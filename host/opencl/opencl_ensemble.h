@@ -101,8 +101,10 @@ class OpenClEnsemble : public DeviceEnsemble {
   // CG's preconditioner on the CPU form (opencl_uses_factor): one sparse Cholesky factor of
   // the representative's system, shared by all (SF_FACTOR); null: Jacobi.
   std::unique_ptr<FactorisedPreconditioner> factor_;
-  bool factor_uploaded_ = false;     // a factor is on the device (its pattern and ordering)
-  bool diagonal_uploaded_ = false;   // the diagonal stand-in is
+  // What the factor's buffers hold: nothing yet, the diagonal stand-in, or a factor (whose
+  // pattern and ordering later refreshes keep).
+  enum class FactorOnDevice { none, diagonal, factor };
+  FactorOnDevice on_device_ = FactorOnDevice::none;
 
   // Mutable: enqueueing a kernel (also from the const read-outs) changes no visible state.
   mutable cl::Kernel k_element_rhs_, k_node_rhs_, k_element_product_, k_node_product_;

@@ -332,10 +332,11 @@ void cg_direction(uint S, uint node_count, int max_iterations, __global const re
  * constant where they are inlined, so their loops have a fixed length. */
 #define SF_BLOCK_MAX SF_SIGMA_BLOCK
 
-/* CG's preconditioner on a CPU: Jacobi, or with SF_FACTOR = 1 a sparse Cholesky factor of one
- * sigma point's system made on the host (FactorisedPreconditioner, the CPU back end's), shared
- * by every sigma point: z = P^T L^-T L^-1 P r, L by columns, the diagonal first in each.
- * The block's sigma points are innermost, so each entry of L is read once for the block. */
+/* CG's preconditioner on a CPU: Jacobi, or with SF_FACTOR = 1 a sparse Cholesky factor of the
+ * mean sigma point's system made on the host (FactorisedPreconditioner, the CPU back end's),
+ * shared by every sigma point: z = P^T L^-T L^-1 P r, L by columns, the diagonal first in each.
+ * The block's sigma points are innermost, so each entry of L is read once for the block; the
+ * un-permuting pass adds r.z to sum_rz (one per sigma point of the block). */
 #if SF_FACTOR
 /* The factor's buffers as the last arguments of the kernels and helpers that use them. */
 #  define SF_FACTOR_ARGUMENTS                                                                \
@@ -346,7 +347,7 @@ void cg_direction(uint S, uint node_count, int max_iterations, __global const re
 
 static inline __attribute__((always_inline)) void sf_block_factor_solve(
     uint first, uint count, uint S, uint rows, __global const real* restrict r,
-    __global real* restrict z SF_FACTOR_ARGUMENTS) {
+    __global real* restrict z, real* restrict sum_rz SF_FACTOR_ARGUMENTS) {
   __global real* restrict y = factor_work;
   for (uint i = 0; i < rows; ++i) {
     size_t from = (size_t)i * S + first;
@@ -379,10 +380,14 @@ static inline __attribute__((always_inline)) void sf_block_factor_solve(
     real diagonal = factor_values[factor_columns[j]];
     for (uint b = 0; b < count; ++b) y[at + b] = (y[at + b] - sum[b]) / diagonal;
   }
-  for (uint i = 0; i < rows; ++i) {
+  for (uint i = 0; i < rows; ++i) { /* z, un-permuted, and r.z in row order */
     size_t to = (size_t)i * S + first;
     size_t from = (size_t)factor_order[i] * S + first;
-    for (uint b = 0; b < count; ++b) z[to + b] = y[from + b];
+    for (uint b = 0; b < count; ++b) {
+      real zi = y[from + b];
+      z[to + b] = zi;
+      sum_rz[b] += r[to + b] * zi;
+    }
   }
 }
 #else
@@ -404,7 +409,7 @@ static inline __attribute__((always_inline)) int sf_block_cg_start(
   real sum_rz[SF_BLOCK_MAX];
   for (uint i = 0; i < count; ++i) sum_bb[i] = sum_rr[i] = sum_rz[i] = (real)0;
 #if SF_FACTOR
-  /* r = b - q and the sums b.b, r.r; z from the factor; d = z and r.z. */
+  /* r = b - q and the sums b.b, r.r; z from the factor, with r.z; d = z. */
   for (uint row = 0; row < rows; ++row) {
     for (uint i = 0; i < count; ++i) {
       size_t at = (size_t)row * S + first + i;
@@ -415,14 +420,12 @@ static inline __attribute__((always_inline)) int sf_block_cg_start(
       sum_rr[i] += ri * ri;
     }
   }
-  sf_block_factor_solve(first, count, S, rows, r, z SF_FACTOR_PASS);
-  for (uint row = 0; row < rows; ++row) {
+  sf_block_factor_solve(first, count, S, rows, r, z, sum_rz SF_FACTOR_PASS);
+  for (uint row = 0; row < rows; ++row)
     for (uint i = 0; i < count; ++i) {
       size_t at = (size_t)row * S + first + i;
       d[at] = z[at];
-      sum_rz[i] += r[at] * z[at];
     }
-  }
 #else
   for (uint row = 0; row < rows; ++row) {
     for (uint i = 0; i < count; ++i) {
@@ -471,7 +474,7 @@ static inline __attribute__((always_inline)) int sf_block_cg_iteration(
     rr_new[i] = rz_new[i] = (real)0;
   }
 #if SF_FACTOR
-  /* x += alpha d, r -= alpha q and r.r; z from the factor; r.z. */
+  /* x += alpha d, r -= alpha q and r.r; z from the factor, with r.z. */
   for (uint row = 0; row < rows; ++row) {
     for (uint i = 0; i < count; ++i) {
       size_t at = (size_t)row * S + first + i;
@@ -481,12 +484,7 @@ static inline __attribute__((always_inline)) int sf_block_cg_iteration(
       rr_new[i] += ri * ri;
     }
   }
-  sf_block_factor_solve(first, count, S, rows, r, z SF_FACTOR_PASS);
-  for (uint row = 0; row < rows; ++row)
-    for (uint i = 0; i < count; ++i) {
-      size_t at = (size_t)row * S + first + i;
-      rz_new[i] += r[at] * z[at];
-    }
+  sf_block_factor_solve(first, count, S, rows, r, z, rz_new SF_FACTOR_PASS);
 #else
   for (uint row = 0; row < rows; ++row) {
     for (uint i = 0; i < count; ++i) {
