@@ -31,7 +31,7 @@ step() {
 # vendor's driver, where there is one, is picked up by the same loader).
 # Vulkan: headers and loader, glslang to compile the shaders at build time, Mesa's lavapipe
 # to run them on any CPU, and the Khronos validation layer that the tests switch on.
-packages="g++ cmake ninja-build pkg-config libeigen3-dev nlohmann-json3-dev libcli11-dev
+packages="g++ cmake ninja-build pkg-config libeigen3-dev libmetis-dev nlohmann-json3-dev libcli11-dev
           libgtest-dev libbenchmark-dev gnuplot-nox
           ocl-icd-opencl-dev opencl-clhpp-headers pocl-opencl-icd
           libvulkan-dev glslang-tools mesa-vulkan-drivers vulkan-validationlayers"

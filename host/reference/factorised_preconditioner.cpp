@@ -1,23 +1,50 @@
 #include "host/reference/factorised_preconditioner.h"
 
 #include <algorithm>
+#include <iostream>   // Eigen's MetisSupport uses std::cerr without including it
+#include <Eigen/MetisSupport>
 
 namespace sigmafem {
 
 bool FactorisedPreconditioner::factorise(const Eigen::SparseMatrix<double>& A) {
-  // The ordering (AMD) and the symbolic analysis depend only on the pattern, and cost 60% of
-  // a numeric factorisation on the liver: made again only when the pattern changes (an
-  // AssemblyPattern keeps it the same from step to step). The numbers are compute()'s.
+  // The ordering and the symbolic analysis depend only on the pattern, and cost more than a
+  // numeric factorisation on the liver: made again only when the pattern changes (an
+  // AssemblyPattern keeps it the same from step to step).
   if (!same_pattern(A)) analyse(A);
-  llt_.factorize(A);
+  llt_.factorize(ordered(A));
   ready_ = llt_.info() == Eigen::Success;
   fresh_ = true;
-  if (ready_) ++factorisations_;
+  if (ready_) {
+    ++factorisations_;
+    supernodes_.assign(lower());
+  }
   return ready_;
 }
 
+Eigen::SparseMatrix<double> FactorisedPreconditioner::ordered(const Eigen::SparseMatrix<double>& A) const {
+  Eigen::SparseMatrix<double> permuted(A.rows(), A.cols());
+  permuted.selfadjointView<Eigen::Lower>() = A.selfadjointView<Eigen::Lower>().twistedBy(order_);
+  return permuted;
+}
+
 void FactorisedPreconditioner::analyse(const Eigen::SparseMatrix<double>& A) {
-  llt_.analyzePattern(A);
+  // Both orderings, analysed (a symbolic factorisation: the factor's column counts), and the
+  // one with fewer entries kept. The orderings give the inverse permutation (Eigen's
+  // SimplicialCholesky does the same), and want the whole symmetric pattern.
+  const Eigen::SparseMatrix<double> whole = A.selfadjointView<Eigen::Lower>();
+  Ordering amd_inverse, metis_inverse;
+  Eigen::AMDOrdering<int>()(whole, amd_inverse);
+  Eigen::MetisOrdering<int>()(whole, metis_inverse);
+  order_ = metis_inverse.inverse();
+  llt_.analyzePattern(ordered(A));
+  const Eigen::Index metis_nonzeros = llt_.matrixL().nestedExpression().nonZeros();
+  order_ = amd_inverse.inverse();
+  llt_.analyzePattern(ordered(A));
+  if (metis_nonzeros < llt_.matrixL().nestedExpression().nonZeros()) {
+    order_ = metis_inverse.inverse();
+    llt_.analyzePattern(ordered(A));
+  }
+  ready_ = false;
   outer_.clear();
   inner_.clear();
   if (A.isCompressed()) {
@@ -35,29 +62,11 @@ bool FactorisedPreconditioner::same_pattern(const Eigen::SparseMatrix<double>& A
 }
 
 void FactorisedPreconditioner::operator()(const Eigen::VectorXd& r, Eigen::VectorXd& z) const {
-  const Eigen::SparseMatrix<double>& L = lower();
-  const int n = static_cast<int>(L.cols());
-  const int* begin = L.outerIndexPtr();   // column j: entries begin[j] (the diagonal) .. begin[j + 1]
-  const int* row = L.innerIndexPtr();
-  const double* value = L.valuePtr();
+  const int n = static_cast<int>(r.size());
   const int* order = this->order();
   Eigen::VectorXd y(n);
   for (int i = 0; i < n; ++i) y[order[i]] = r[i];
-  // L y' = y, column by column: each solved entry is taken out of the rows below it.
-  for (int j = 0; j < n; ++j) {
-    const double solved = y[j] / value[begin[j]];
-    y[j] = solved;
-    for (int k = begin[j] + 1; k < begin[j + 1]; ++k) y[row[k]] -= value[k] * solved;
-  }
-  // L^T x = y', row j of L^T being column j of L, from the last row up.
-  for (int j = n - 1; j >= 0; --j) {
-    double sum[4] = {0.0, 0.0, 0.0, 0.0};
-    int k = begin[j] + 1;
-    for (; k + 3 < begin[j + 1]; k += 4)
-      for (int lane = 0; lane < 4; ++lane) sum[lane] += value[k + lane] * y[row[k + lane]];
-    for (; k < begin[j + 1]; ++k) sum[0] += value[k] * y[row[k]];
-    y[j] = (y[j] - ((sum[0] + sum[1]) + (sum[2] + sum[3]))) / value[begin[j]];
-  }
+  supernodes_.solve(y);
   z.resize(n);
   for (int i = 0; i < n; ++i) z[i] = y[order[i]];
 }
@@ -65,9 +74,8 @@ void FactorisedPreconditioner::operator()(const Eigen::VectorXd& r, Eigen::Vecto
 double FactorisedPreconditioner::bytes() const {
   if (!ready_) return 0.0;
   const double nonzeros = static_cast<double>(llt_.matrixL().nestedExpression().nonZeros());
-  return nonzeros * static_cast<double>(sizeof(double) + sizeof(int));
+  return nonzeros * static_cast<double>(sizeof(double) + sizeof(int)) + supernodes_.bytes();
 }
-
 void FactorisedPreconditioner::record(int most_iterations) {
   last_ = most_iterations;
   if (fresh_) after_ = ready_ ? most_iterations : -1;

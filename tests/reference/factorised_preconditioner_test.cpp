@@ -1,5 +1,5 @@
 // FactorisedPreconditioner (host/reference/factorised_preconditioner.h): CG preconditioned by
-// the factor of the very system converges in one iteration, by the factor of a nearby system
+// the factor of the very system converges in one iteration to the float factor's precision, by the factor of a nearby system
 // (another step's rotations, another stiffness) in a few, to the same answer as Jacobi; a
 // matrix that is not positive definite is refused; and the rule that says when to factorise
 // again.
@@ -50,15 +50,23 @@ class FactorisedPreconditionerTest : public ::testing::Test {
   std::unique_ptr<ReferenceSimulation> simulation_;
 };
 
-TEST_F(FactorisedPreconditionerTest, TheFactorOfTheSystemItselfSolvesItInOneIteration) {
+TEST_F(FactorisedPreconditionerTest, TheFactorOfTheSystemItselfSolvesItToFloatPrecisionInOneIteration) {
   const System system = next_system(*simulation_, 31);
   FactorisedPreconditioner factor;
   ASSERT_TRUE(factor.factorise(simulation_->system_matrix())) << "factorising an SPD matrix";
+  // One solve with the factor: its values are float (relative precision 6e-8), so A z - b is
+  // that times the condition number (~1e3, conjugate_gradient_test.cpp) at most: 1e-4.
+  // Measured: 2e-7. system_matrix() is the matrix the step solves with.
+  Eigen::VectorXd z, Az;
+  factor(system.b, z);
+  system.A->apply(z, Az);
+  EXPECT_LE((Az - system.b).norm(), 1e-4 * system.b.norm());
+  // CG to 1e-12 then takes that one iteration, and at most one more for the float's error.
   Eigen::VectorXd x = Eigen::VectorXd::Zero(system.b.size());
   const CgResult result = preconditioned_conjugate_gradient(*system.A, factor, system.b, x,
                                                             kPcgMaxIterations, kPcgTolerance);
   EXPECT_TRUE(result.converged);
-  EXPECT_EQ(result.iterations, 1) << "system_matrix() is the matrix the step solves with";
+  EXPECT_LE(result.iterations, 2);
 }
 
 TEST_F(FactorisedPreconditionerTest, TheFactorOfANearbySystemNeedsFewIterationsForJacobisAnswer) {
@@ -91,8 +99,7 @@ TEST_F(FactorisedPreconditionerTest, TheFactorOfANearbySystemNeedsFewIterationsF
 TEST_F(FactorisedPreconditionerTest, AFactorMadeAgainKeepsItsOrderingAndHasAFreshFactorsNumbers) {
   // The first factorisation orders the pattern; the second, of another step's matrix with the
   // same pattern, keeps that ordering: its solves are those of a factor made afresh from that
-  // matrix, bit for bit; and they are Eigen's solve() to rounding (the backward substitution
-  // sums in four partial sums, Eigen's in one).
+  // matrix, bit for bit; and they are Eigen's solve() to the float factor's rounding.
   FactorisedPreconditioner factor;
   ASSERT_TRUE(factor.factorise(simulation_->system_matrix()));
   for (int step = 31; step <= 40; ++step) simulation_->step(so(step));
@@ -108,9 +115,10 @@ TEST_F(FactorisedPreconditionerTest, AFactorMadeAgainKeepsItsOrderingAndHasAFres
   EXPECT_EQ(factor.factorisations(), 2);
 
   const Eigen::SimplicialLLT<Eigen::SparseMatrix<double>> eigen(later);
-  // The two orders of addition differ by a few ulps of the sums; the system's condition
-  // number (~1e3, conjugate_gradient_test.cpp) bounds what that does to the solution.
-  EXPECT_LE((z - eigen.solve(r)).norm(), 1e-12 * z.norm());
+  // The factor's values are float (relative precision 6e-8); the system's condition number
+  // (~1e3, conjugate_gradient_test.cpp) bounds what that does to the solution: 1e-4.
+  // Measured: 7e-8.
+  EXPECT_LE((z - eigen.solve(r)).norm(), 1e-4 * z.norm());
 }
 
 TEST(FactorisedPreconditioner, RefusesAMatrixThatIsNotPositiveDefinite) {
