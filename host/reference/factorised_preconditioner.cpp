@@ -45,6 +45,15 @@ void FactorisedPreconditioner::analyse(const Eigen::SparseMatrix<double>& A) {
     llt_.analyzePattern(ordered(A));
   }
   ready_ = false;
+  // The factorisation's multiply-adds: sum_j c_j^2 over L's column counts (analyzePattern
+  // has laid out L's columns), against the 2 nnz(L) of a solve.
+  const Eigen::SparseMatrix<double>& L = lower();
+  double factorisation = 0.0;
+  for (Eigen::Index j = 0; j < L.cols(); ++j) {
+    const double count = static_cast<double>(L.outerIndexPtr()[j + 1] - L.outerIndexPtr()[j]);
+    factorisation += count * count;
+  }
+  factorisation_in_solves_ = factorisation / (2.0 * static_cast<double>(std::max<Eigen::Index>(1, L.nonZeros())));
   outer_.clear();
   inner_.clear();
   if (A.isCompressed()) {
@@ -76,9 +85,14 @@ double FactorisedPreconditioner::bytes() const {
   const double nonzeros = static_cast<double>(llt_.matrixL().nestedExpression().nonZeros());
   return nonzeros * static_cast<double>(sizeof(double) + sizeof(int)) + supernodes_.bytes();
 }
+
 void FactorisedPreconditioner::record(int most_iterations) {
-  last_ = most_iterations;
-  if (fresh_) after_ = ready_ ? most_iterations : -1;
+  if (fresh_) {
+    after_ = ready_ ? most_iterations : -1;
+    excess_iterations_ = 0.0;
+  } else if (after_ >= 0) {
+    excess_iterations_ += std::max(0, most_iterations - after_);
+  }
   fresh_ = false;
 }
 

@@ -133,21 +133,32 @@ TEST(FactorisedPreconditioner, RefusesAMatrixThatIsNotPositiveDefinite) {
   EXPECT_TRUE(factor.due()) << "after a refusal the next step tries again";
 }
 
-TEST(FactorisedPreconditioner, IsDueFirstThenWhenTheIterationsPassTwiceTheFreshOnesPlusTwo) {
-  Eigen::SparseMatrix<double> identity(3, 3);
-  identity.setIdentity();
+TEST(FactorisedPreconditioner, IsDueFirstThenWhenTheExtraIterationsCostAFactorisation) {
+  // A dense 8 x 8 SPD matrix: L's columns hold 8, 7, ..., 1 entries, so a factorisation is
+  // sum c^2 = 204 multiply-adds and a solve 2 * 36 = 72: 2.83 solves.
+  const int n = 8;
+  const Eigen::MatrixXd dense = Eigen::MatrixXd::Constant(n, n, 1.0) + n * Eigen::MatrixXd::Identity(n, n);
+  const Eigen::SparseMatrix<double> A = dense.sparseView();
   FactorisedPreconditioner factor;
   EXPECT_TRUE(factor.due()) << "before the first step";
-  ASSERT_TRUE(factor.factorise(identity));
-  factor.record(3);   // the first step after factorising sets the mark: 2 * 3 + 2 = 8
+  ASSERT_TRUE(factor.factorise(A));
+  EXPECT_NEAR(factor.factorisation_in_solves(), 204.0 / 72.0, 1e-12);
+  factor.record(3);   // the first step after factorising: 3 iterations is what a fresh one takes
   EXPECT_FALSE(factor.due());
-  factor.record(8);
-  EXPECT_FALSE(factor.due()) << "8 iterations: not past the mark";
-  factor.record(9);
-  EXPECT_TRUE(factor.due()) << "9 iterations: past it";
-  ASSERT_TRUE(factor.factorise(identity));
+  factor.record(3);
+  factor.record(2);
+  EXPECT_FALSE(factor.due()) << "no step took more than a fresh factor: nothing to gain";
+  factor.record(4);
+  factor.record(4);
+  EXPECT_FALSE(factor.due()) << "2 extra iterations: less than a factorisation's 2.83";
+  factor.record(4);
+  EXPECT_TRUE(factor.due()) << "3 extra iterations: a factorisation's worth";
+  ASSERT_TRUE(factor.factorise(A));
   factor.record(1);
-  EXPECT_FALSE(factor.due()) << "a new factor sets a new mark (4)";
+  factor.record(3);
+  EXPECT_FALSE(factor.due()) << "a new factor counts afresh from its own first step (2 extra)";
+  factor.record(2);
+  EXPECT_TRUE(factor.due()) << "3 extra iterations";
   EXPECT_EQ(factor.factorisations(), 2);
 }
 
