@@ -21,6 +21,8 @@ struct StepReport {
   std::vector<int> cg_iterations;          // per sigma point
   std::vector<double> relative_residual;   // per sigma point
   std::vector<unsigned> converged;         // per sigma point: 1 converged, 0 hit the cap
+  // Factorisations of CG's preconditioner made in this advance (a back end with factors).
+  int factorisations = 0;
   int unconverged_count() const {
     int n = 0;
     for (unsigned c : converged) n += c == 0u;

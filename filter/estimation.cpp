@@ -100,6 +100,7 @@ EstimationRun run_estimation(Ensemble& ensemble, const EstimationOptions& option
     for (std::size_t s = 0; s < result.ensemble.cg_iterations.size(); ++s)
       step.max_cg_iterations = std::max(step.max_cg_iterations, result.ensemble.cg_iterations[s]);
     step.unconverged_sigma_points = result.ensemble.unconverged_count();
+    step.factorisations = result.ensemble.factorisations;
     recovery.update(step.innovation, step.innovation_std);
     // A change is acted on only where the model explained the data before it (NoiseScaleHistory).
     noise_history.record(result.noise_scale > 1.0);

@@ -83,6 +83,7 @@ struct EstimationStep {
   bool catching_up = false;
   int max_cg_iterations = 0;       // over the sigma points
   int unconverged_sigma_points = 0;
+  int factorisations = 0;          // of CG's preconditioner, in this step's advance
   double seconds = 0.0;            // wall time of the filter step
 };
 

@@ -204,13 +204,14 @@ nlohmann::ordered_json write_estimation_report(const EstimationReport& report, c
   summary["observations"] = report.observations;
   json final_estimates = json::object();
   double max_seconds = 0.0, sum_seconds = 0.0;
-  int max_cg = 0, unconverged = 0;
+  int max_cg = 0, unconverged = 0, factorisations = 0;
   json changes = json::array();
   for (const EstimationStep& step : run.steps) {
     max_seconds = std::max(max_seconds, step.seconds);
     sum_seconds += step.seconds;
     max_cg = std::max(max_cg, step.max_cg_iterations);
     unconverged += step.unconverged_sigma_points;
+    factorisations += step.factorisations;
     if (step.change_detected) changes.push_back(step.step);
   }
   if (!run.steps.empty()) {
@@ -227,7 +228,8 @@ nlohmann::ordered_json write_estimation_report(const EstimationReport& report, c
   summary["timing"] = {{"filter_step_mean_ms", 1e3 * sum_seconds / steps_count},
                        {"filter_step_max_ms", 1e3 * max_seconds},
                        {"total_s", report.total_seconds}};
-  summary["cg"] = {{"max_iterations", max_cg}, {"unconverged_sigma_steps", unconverged}};
+  summary["cg"] = {{"max_iterations", max_cg}, {"unconverged_sigma_steps", unconverged},
+                   {"factorisations", factorisations}};
   summary["changes_detected_at_steps"] = changes;
   summary["catch_up_steps"] = run.catch_up_steps;
   summary["parameter_changes"] = parameter_changes_json(run, report.names);

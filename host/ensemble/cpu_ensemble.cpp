@@ -76,6 +76,7 @@ StepReport CpuEnsemble::advance(const Eigen::Vector3d& so_position) {
   report.cg_iterations.resize(S);
   report.relative_residual.resize(S);
   report.converged.resize(S);
+  const int factorisations_before = factorisations();
   if (preconditioner_ != Preconditioner::jacobi && factors_.empty()) make_factors();
   // A shared factor is made again here, between steps; own ones in each simulation's step.
   if (shared_factor_ && factors_[0]->due()) factors_[0]->factorise(simulations_[0].system_matrix());
@@ -87,6 +88,7 @@ StepReport CpuEnsemble::advance(const Eigen::Vector3d& so_position) {
   });
   if (shared_factor_)
     factors_[0]->record(*std::max_element(report.cg_iterations.begin(), report.cg_iterations.end()));
+  report.factorisations = factorisations() - factorisations_before;
   return report;
 }
 

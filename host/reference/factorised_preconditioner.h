@@ -14,8 +14,8 @@
 // would have bought a new one: never more than twice the best cost, whatever comes). The
 // work is counted in arithmetic, not measured time, so a run's results do not depend on the
 // machine's load. On the 38k liver a factorisation is the work of 320 solves (measured: 3-4 s
-// against 10.6-14 ms a solve); on the liver (596 tetrahedra) of 31, on the box of 55. Solving with it is const and thread-safe: sigma
-// points' threads may share one factor.
+// against 10.6-14 ms a solve); on the liver (596 tetrahedra) of 31, on the box of 55.
+// Solving with it is const and thread-safe: sigma points' threads may share one factor.
 #pragma once
 
 #include <Eigen/Core>

@@ -276,6 +276,13 @@ TEST_F(CliTest, EstimateWritesEstimatesSummaryResidualsAndPlots) {
   // Which preconditioner CG ran with: the CPU back end's factors, OpenCL's shared factor on
   // a CPU device, Jacobi on a GPU.
   EXPECT_EQ(summary["preconditioner"], preconditioner_used(expected.backend, DeviceOptions{}));
+  // And how often it was made: a factor at the first step at least, none with Jacobi.
+  const int factorisations = summary["cg"]["factorisations"].get<int>();
+  if (summary["preconditioner"] == "factorised") {
+    EXPECT_GE(factorisations, 1);
+  } else {
+    EXPECT_EQ(factorisations, 0);
+  }
   EXPECT_TRUE(summary["complete"].get<bool>());
   EXPECT_EQ(summary["filter_steps"].get<int>(), 30);
   EXPECT_TRUE(summary["errors"].is_object()) << "truth.csv was in the data folder";

@@ -169,13 +169,17 @@ TEST_F(CpuEnsembleTest, FactorsFollowJacobiInAFractionOfTheIterations) {
   shared.set_own_factors_budget(0.0);
   CpuEnsemble one_thread(model_, {0, 2}, scenario_.observations.nodes, S, 1, Preconditioner::factorised);
   long jacobi_iterations = 0, own_iterations = 0, shared_iterations = 0;
+  int own_reported = 0;   // the factorisations the step reports say were made
   for (CpuEnsemble* ensemble : {&jacobi, &own, &shared, &one_thread}) ensemble->set_parameters(theta);
   for (int k = 1; k <= kSteps; ++k) {
     for (int it : jacobi.advance(so(k)).cg_iterations) jacobi_iterations += it;
-    for (int it : own.advance(so(k)).cg_iterations) own_iterations += it;
+    const StepReport own_report = own.advance(so(k));
+    for (int it : own_report.cg_iterations) own_iterations += it;
+    own_reported += own_report.factorisations;
     for (int it : shared.advance(so(k)).cg_iterations) shared_iterations += it;
     one_thread.advance(so(k));
   }
+  EXPECT_EQ(own_reported, own.factorisations());
   EXPECT_EQ(jacobi.factorisations(), 0);
   EXPECT_FALSE(own.shares_a_factor()) << "three factors of the box fit the default budget";
   EXPECT_TRUE(shared.shares_a_factor()) << "a zero budget";
