@@ -297,13 +297,9 @@ void OpenClEnsemble::conjugate_gradient() {
 StepReport OpenClEnsemble::advance(const Eigen::Vector3d& so_position) {
   const std::size_t dof = 3 * static_cast<std::size_t>(nodes_) * S_;
   StepReport report;
-  int factorisations = 0;
+  const int factorisations_before = factorisations();
   try {
-    if (factor_ && factor_->due()) {
-      const int before = factor_->factorisations();
-      refresh_factor();
-      factorisations = factor_->factorisations() - before;
-    }
+    if (factor_ && factor_->due()) refresh_factor();
     write_reals(DeviceBuffer::constants, step_constants_.next_step(model_, so_position));
     run(k_element_rhs_, element_items());
     run(k_node_rhs_, static_cast<std::size_t>(nodes_) * S_);
@@ -325,7 +321,7 @@ StepReport OpenClEnsemble::advance(const Eigen::Vector3d& so_position) {
     report = step_report(iterations, converged, from_device_reals(rr_bytes.data(), S_, precision),
                          from_device_reals(bb_bytes.data(), S_, precision));
     if (factor_) factor_->record(*std::max_element(iterations.begin(), iterations.end()));
-    report.factorisations = factorisations;
+    report.factorisations = factorisations() - factorisations_before;
   } catch (const cl::Error& error) {
     throw opencl_failure("advancing the OpenCL ensemble", error);
   }

@@ -9,7 +9,7 @@
 // over contiguous values. The values are float (the sums, and the vector, stay double): a
 // preconditioner only steers CG, whose own tolerance sets the answer; a float factor's solve
 // is within ~1e-7 of the exact one and CG mends that in at most one more iteration. On the
-// 38k liver (7.6 million entries) a solve takes 10-11 ms against 26-36 ms by columns in double.
+// 38k liver (7.6 million entries) a solve takes 10.6-14 ms against 26-36 ms by columns in double.
 #pragma once
 
 #include <Eigen/Core>
