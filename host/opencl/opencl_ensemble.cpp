@@ -88,7 +88,9 @@ OpenClEnsemble::OpenClEnsemble(const Model& model, std::vector<int> estimated,
                         " -DSF_GROUP_SIZE=" + std::to_string(cg_group_) +
                         " -DSF_CG_BLOCK=" + std::to_string(cg_block_) +
                         " -DSF_CG_PARTITIONS=" + std::to_string(cg_partitions_) +
-                        " -DSF_FACTOR=" + std::to_string(factor_ ? 1 : 0));
+                        " -DSF_FACTOR=" + std::to_string(factor_ ? 1 : 0) +
+                        " -DSF_POLAR_FRAMES=" +
+                        std::to_string(model_.material.rotation == ElementRotation::polar ? 1 : 0));
 
   using B = DeviceBuffer;
   try {
@@ -242,8 +244,11 @@ void OpenClEnsemble::run_partitions(cl::Kernel& kernel) const {
   run(kernel, cg_group_ * S_ * cg_partitions_, cg_group_);
 }
 
-std::size_t OpenClEnsemble::element_items() const {
-  return static_cast<std::size_t>(elements_) * (S_ / sigma_block_);
+void OpenClEnsemble::run_elements(cl::Kernel& kernel) const {
+  if (element_chunks_ > 0)
+    run(kernel, static_cast<std::size_t>(element_chunks_), 1);
+  else
+    run(kernel, static_cast<std::size_t>(elements_) * (S_ / sigma_block_));
 }
 
 void OpenClEnsemble::element_product(DeviceBuffer d, DeviceBuffer active) {
@@ -251,9 +256,7 @@ void OpenClEnsemble::element_product(DeviceBuffer d, DeviceBuffer active) {
   k_element_product_.setArg(scalars + buffer_slot(DeviceKernel::element_product, DeviceBuffer::d), buffer(d));
   k_element_product_.setArg(scalars + buffer_slot(DeviceKernel::element_product, DeviceBuffer::active),
                             buffer(active));
-  run(k_element_product_, element_chunks_ > 0 ? static_cast<std::size_t>(element_chunks_)
-                                              : element_items(),
-      element_chunks_ > 0 ? 1 : 0);
+  run_elements(k_element_product_);
 }
 
 void OpenClEnsemble::node_product(DeviceBuffer d) {
@@ -301,7 +304,7 @@ StepReport OpenClEnsemble::advance(const Eigen::Vector3d& so_position) {
   try {
     if (factor_ && factor_->due()) refresh_factor();
     write_reals(DeviceBuffer::constants, step_constants_.next_step(model_, so_position));
-    run(k_element_rhs_, element_items());
+    run_elements(k_element_rhs_);
     run(k_node_rhs_, static_cast<std::size_t>(nodes_) * S_);
     conjugate_gradient();
     run(k_state_update_, dof);

@@ -63,7 +63,7 @@ class OpenClEnsemble : public DeviceEnsemble {
 
   // Enqueue the kernels of one step (kernels/opencl/<file>.cl holds the kernel of the same
   // name; conjugate_gradient() enqueues cg_start and cg_iteration).
-  std::size_t element_items() const;   // work-items of the element kernels
+  void run_elements(cl::Kernel& kernel) const;   // element_rhs, element_product: chunks or items
   void element_product(DeviceBuffer d, DeviceBuffer active);
   void node_product(DeviceBuffer d);   // A d from the element outputs, into q
   void conjugate_gradient();
@@ -84,7 +84,7 @@ class OpenClEnsemble : public DeviceEnsemble {
   bool cg_per_group_ = true;                // SF_CG_PER_GROUP: CG kernels a group per sigma (GPU)
   std::size_t cg_group_ = 64;               // SF_GROUP_SIZE: work-items per sigma point then
   int sigma_block_ = 1;                     // SF_SIGMA_BLOCK: sigma points per element work-item
-  int element_chunks_ = 0;                  // SF_ELEMENT_CHUNKS: element_product's chunks (CPU)
+  int element_chunks_ = 0;                  // SF_ELEMENT_CHUNKS: the element kernels' chunks (CPU)
   bool whole_solve_ = false;                // cg_solve: the whole CG solve in one launch (CPU)
   int cg_block_ = 1;                        // SF_CG_BLOCK: sigma points per CG work-item (CPU)
   int cg_partitions_ = 1;                   // SF_CG_PARTITIONS: CG work-groups per sigma (GPU)

@@ -10,7 +10,8 @@
 
 #define SF_H 0                 /* time step h */
 #define SF_CG_TOLERANCE2 1     /* squared relative CG tolerance */
-#define SF_POLAR_ROTATION 2    /* 1: the elements' polar frames, 0: their QR frames (element.h) */
+#define SF_POLAR_ROTATION 2    /* 1: the elements' polar frames, 0: their QR frames (element.h; Vulkan
+                                  reads it, OpenCL has the method as a build option) */
 #define SF_STEP_CONSTANTS 3
 
 /* Per sigma point, k: */
