@@ -177,15 +177,19 @@ void BM_filter_step(benchmark::State& state, const Backend& backend, const std::
   // The factorisations in the timed steps (CPU back end, OpenCL's shared factor; issue 18),
   // as the steps' reports give them.
   int factorisations = 0;
+  double cg_iterations = 0.0;   // summed over the sigma points and the steps
   for (auto _ : state) {
     state.PauseTiming();
     const Eigen::Vector3d so = observe();
     state.ResumeTiming();
     const RoukfStep result = filter.step(so, y);
     factorisations += result.ensemble.factorisations;
+    for (int n : result.ensemble.cg_iterations) cg_iterations += n;
     benchmark::DoNotOptimize(result);
   }
-  state.counters["factorisations_per_step"] = factorisations / static_cast<double>(state.iterations());
+  const double steps = static_cast<double>(state.iterations());
+  state.counters["factorisations_per_step"] = factorisations / steps;
+  state.counters["cg_iterations"] = cg_iterations / (steps * ensemble->sigma_count());
   state.counters["sigma_points"] = ensemble->sigma_count();
   state.counters["tetrahedra"] = model.element_count();
   state.SetLabel(backend.label + ", " + name + ", simplex");

@@ -370,15 +370,30 @@ static inline __attribute__((always_inline)) void sf_block_factor_solve(
   }
   for (uint j = rows; j-- > 0;) { /* L^T x = y', from the last row up */
     size_t at = (size_t)j * S + first;
+    /* Two partial sums, the entries taken in pairs: one sum's chain of dependent additions
+     * was this loop's time on a small factor (the liver's, in cache). */
     real sum[SF_BLOCK_MAX];
-    for (uint b = 0; b < count; ++b) sum[b] = (real)0;
-    for (int k = factor_columns[j] + 1; k < factor_columns[j + 1]; ++k) {
+    real other_sum[SF_BLOCK_MAX];
+    for (uint b = 0; b < count; ++b) sum[b] = other_sum[b] = (real)0;
+    int k = factor_columns[j] + 1;
+    const int end = factor_columns[j + 1];
+    for (; k + 1 < end; k += 2) {
+      real value = factor_values[k];
+      real other_value = factor_values[k + 1];
+      __global const real* restrict below = y + (size_t)factor_rows[k] * S + first;
+      __global const real* restrict other_below = y + (size_t)factor_rows[k + 1] * S + first;
+      for (uint b = 0; b < count; ++b) {
+        sum[b] += value * below[b];
+        other_sum[b] += other_value * other_below[b];
+      }
+    }
+    if (k < end) {
       real value = factor_values[k];
       __global const real* restrict below = y + (size_t)factor_rows[k] * S + first;
       for (uint b = 0; b < count; ++b) sum[b] += value * below[b];
     }
     real diagonal = factor_values[factor_columns[j]];
-    for (uint b = 0; b < count; ++b) y[at + b] = (y[at + b] - sum[b]) / diagonal;
+    for (uint b = 0; b < count; ++b) y[at + b] = (y[at + b] - (sum[b] + other_sum[b])) / diagonal;
   }
   for (uint i = 0; i < rows; ++i) { /* z, un-permuted, and r.z in row order */
     size_t to = (size_t)i * S + first;
