@@ -51,6 +51,7 @@ std::vector<std::pair<cl::Device, OpenClDeviceInfo>> enumerate() {
       info.type = device_type_name(device.getInfo<CL_DEVICE_TYPE>());
       info.has_fp64 = device.getInfo<CL_DEVICE_EXTENSIONS>().find("cl_khr_fp64") != std::string::npos;
       info.compute_units = device.getInfo<CL_DEVICE_MAX_COMPUTE_UNITS>();
+      info.cache_line = device.getInfo<CL_DEVICE_GLOBAL_MEM_CACHELINE_SIZE>();
       info.global_memory = device.getInfo<CL_DEVICE_GLOBAL_MEM_SIZE>();
       info.max_allocation = device.getInfo<CL_DEVICE_MAX_MEM_ALLOC_SIZE>();
       found.emplace_back(device, info);

@@ -27,6 +27,7 @@ struct OpenClDeviceInfo {
   std::string type;                 // "cpu", "gpu", "accelerator", "other"
   bool has_fp64 = false;            // cl_khr_fp64: --precision double is available
   unsigned compute_units = 0;
+  unsigned cache_line = 0;          // bytes of a global memory cache line (0: not said)
   unsigned long long global_memory = 0;     // bytes
   unsigned long long max_allocation = 0;    // bytes, the largest single buffer
 };

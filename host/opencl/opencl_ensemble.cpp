@@ -55,7 +55,7 @@ OpenClEnsemble::OpenClEnsemble(const Model& model, std::vector<int> estimated,
   // against two launches (several microseconds each on PoCL): up to kWholeSolveWork
   // element-sigma pairs. Measured on PoCL, 2 cores (bench/RESULTS.md): the liver filter step
   // (596 x 4) 4.5 -> 2.3 ms, liver 4768 x 4 38 -> 28 ms; 596 x 16 equal; 4768 x 16 slower
-  // (94 against 79 ms), as one core does what two did.
+  // (94 against 79 ms), as one core did what two did.
   whole_solve_ = !cg_per_group_ &&
                  (options.solve_launch == SolveLaunch::whole_solve ||
                   (options.solve_launch == SolveLaunch::automatic &&
@@ -66,8 +66,21 @@ OpenClEnsemble::OpenClEnsemble(const Model& model, std::vector<int> estimated,
   // kPartitionRows / 64 rows rather than thousands.
   if (cg_per_group_) cg_partitions_ = cg_partitions(nodes_, options.cg_partitions);
   const int units = static_cast<int>(std::max(1u, info.compute_units));
-  cg_block_ = (S_ + units - 1) / units;
-  while (S_ % cg_block_ != 0) --cg_block_;
+  int per_unit = (S_ + units - 1) / units;
+  while (S_ % per_unit != 0) --per_unit;
+  // The CG kernels' blocks work on the ensemble's rows, [row S + s]: blocks that share a
+  // row's cache line write into each other's lines at every row, and two work-items doing so
+  // were slower than one doing both (bench/RESULTS.md, stop 46: the 38k liver's cg_iteration
+  // at S = 4 30 -> 18 ms, the 4768 liver's at S = 16 3.4 -> 2.1 ms). So a block per compute
+  // unit only where each fills whole cache lines (S = 32 and up in float), else one.
+  const unsigned line = info.cache_line > 0 ? info.cache_line : 64;
+  cg_block_ = (per_unit * device_.real_size()) % line == 0 ? per_unit : S_;
+  // cg_solve's blocks work on vectors of their own: a block per compute unit where each has
+  // at least 4 sigma points, else one. Measured on PoCL, 2 cores (stop 46): the liver at S = 16
+  // in two blocks of 8, an ensemble step 2.4-2.7 -> 1.4-1.6 ms (factor); the liver filter
+  // step (S = 4) in two blocks of 2, its solve 0.7 -> 1.8 ms: loops over two sigma points
+  // were not vectorised.
+  solve_block_ = per_unit >= 4 ? per_unit : S_;
   // A factor of the representative's system shared by the sigma points, in the CPU form's
   // CG (the GPU form has Jacobi only); analysed here for its size, made at the first step
   // and again when due.
@@ -87,6 +100,8 @@ OpenClEnsemble::OpenClEnsemble(const Model& model, std::vector<int> estimated,
                         " -DSF_CG_PER_GROUP=" + std::to_string(cg_per_group_ ? 1 : 0) +
                         " -DSF_GROUP_SIZE=" + std::to_string(cg_group_) +
                         " -DSF_CG_BLOCK=" + std::to_string(cg_block_) +
+                        " -DSF_CG_SOLVE_BLOCK=" + std::to_string(solve_block_) +
+                        " -DSF_CG_SOLVE_VECTORS=" + std::to_string(kCgSolveBlockVectors) +
                         " -DSF_CG_PARTITIONS=" + std::to_string(cg_partitions_) +
                         " -DSF_FACTOR=" + std::to_string(factor_ ? 1 : 0) +
                         " -DSF_POLAR_FRAMES=" +
@@ -96,7 +111,10 @@ OpenClEnsemble::OpenClEnsemble(const Model& model, std::vector<int> estimated,
   try {
     // The chunks' copies of K d on a CPU live in the element outputs (element_product.cl).
     const std::size_t dof = 3 * static_cast<std::size_t>(nodes_) * S_;
-    const DeviceBufferSizes sizes{element_chunks_ * dof, cg_partitions_,
+    // cg_solve's blocks keep their own vectors there too (conjugate_gradient.cl).
+    const std::size_t cg_solve_vectors = whole_solve_ && solve_block_ < S_ ? kCgSolveBlockVectors : 0;
+    const DeviceBufferSizes sizes{std::max<std::size_t>(element_chunks_, cg_solve_vectors) * dof,
+                                  cg_partitions_,
                                   factor_ ? factor_->nonzeros() : 0};
     written_.resize(kDeviceBufferCount);
     write_done_.resize(written_.size());
@@ -266,7 +284,7 @@ void OpenClEnsemble::node_product(DeviceBuffer d) {
 
 void OpenClEnsemble::conjugate_gradient() {
   if (whole_solve_) {
-    run(k_cg_solve_, 1, 1);
+    run(k_cg_solve_, static_cast<std::size_t>(S_ / solve_block_), 1);
     return;
   }
   // The warm start's residual (dv holds the last step's velocity change).

@@ -33,6 +33,9 @@ class OpenClEnsemble : public DeviceEnsemble {
  public:
   // Elements x sigma points up to which a CPU device runs the whole CG solve in one launch.
   static constexpr long long kWholeSolveWork = 32768;
+  // The vectors of each block of sigma points in cg_solve (x, b, the inverse diagonal, r, z,
+  // d, q, the copy of K d), kept in element_out (SF_CG_SOLVE_VECTORS).
+  static constexpr std::size_t kCgSolveBlockVectors = 8;
 
   // `estimated`: indices into model.ligaments whose log-stiffness the parameters are;
   // `observed`: the observed points (node indices convert). Throws DeviceError (no device,
@@ -86,6 +89,7 @@ class OpenClEnsemble : public DeviceEnsemble {
   int sigma_block_ = 1;                     // SF_SIGMA_BLOCK: sigma points per element work-item
   int element_chunks_ = 0;                  // SF_ELEMENT_CHUNKS: the element kernels' chunks (CPU)
   bool whole_solve_ = false;                // cg_solve: the whole CG solve in one launch (CPU)
+  int solve_block_ = 1;                     // SF_CG_SOLVE_BLOCK: cg_solve's sigma points per work-item
   int cg_block_ = 1;                        // SF_CG_BLOCK: sigma points per CG work-item (CPU)
   int cg_partitions_ = 1;                   // SF_CG_PARTITIONS: CG work-groups per sigma (GPU)
   std::vector<cl::Buffer> buffers_;         // by DeviceBuffer

@@ -538,14 +538,17 @@ static inline __attribute__((always_inline)) int sf_block_cg_iteration(
 /* q = A d for the block, from the element chunks' copies of K d (element_product.cl, summed
  * in chunk order) and the nodal terms (node_rows.h's row, as node_product's): done here so
  * that the iteration needs no launch of its own for it and finds q in cache. A node's springs
- * and mass are found once for its three rows. */
+ * and mass are found once for its three rows. The step constants and springs are sigma point
+ * first + i's; d, q and the copies are [row * stride + offset + i] (the ensemble's layout:
+ * stride S, offset first; a block's own vectors in cg_solve: stride count, offset 0). */
 static inline __attribute__((always_inline)) void sf_block_node_product(
-    uint first, uint count, uint chunks, uint S, uint node_count, __global const real* restrict c,
+    uint first, uint count, uint chunks, uint S, uint stride, uint offset, uint node_count,
+    __global const real* restrict c,
     __global const int* restrict ligament_offsets, __global const int* restrict ligament_of_node,
     __global const real* restrict ligament_k, __global const real* restrict control_k,
     __global const real* restrict mass, __global const real* restrict d,
     __global const real* restrict element_out, __global real* restrict q) {
-  const size_t copy_size = (size_t)3 * node_count * S;
+  const size_t copy_size = (size_t)3 * node_count * stride;
   /* The block's factors of A (step_constants.h), read once: the same at every node. */
   real stiffness_factor[SF_BLOCK_MAX];
   real young_scale[SF_BLOCK_MAX];
@@ -565,7 +568,7 @@ static inline __attribute__((always_inline)) void sf_block_node_product(
     }
     SF_UNROLL
     for (int k = 0; k < 3; ++k) {
-      size_t row = ((size_t)3 * n + k) * S + first;
+      size_t row = ((size_t)3 * n + k) * stride + offset;
       real sum[SF_BLOCK_MAX];
       for (uint i = 0; i < count; ++i) sum[i] = (real)0;
       for (uint chunk = 0; chunk < chunks; ++chunk)
@@ -587,8 +590,11 @@ __kernel void cg_start(uint S, uint node_count, __global const real* restrict c,
                        SF_FACTOR_ARGUMENTS) {
   uint first = (uint)get_global_id(0) * SF_CG_BLOCK;
   if (first >= S) return;
-  sf_block_cg_start(first, SF_CG_BLOCK, S, 3 * node_count, c, q, b, inverse_diagonal, r, z, d, bb, rr, rz,
-                    active, converged, iterations SF_FACTOR_PASS);
+  /* The vectors' stride S as the constant SF_SIGMA_BLOCK (equal on a CPU): so the compiler
+   * vectorises the rows' loops over the block (stop 46: cg_solve 670-720 -> 600 us a launch
+   * on the liver filter step). */
+  sf_block_cg_start(first, SF_CG_BLOCK, SF_SIGMA_BLOCK, 3 * node_count, c, q, b, inverse_diagonal,
+                    r, z, d, bb, rr, rz, active, converged, iterations SF_FACTOR_PASS);
 }
 
 /* One iteration after element_product: q = A d (sf_block_node_product), then the update. */
@@ -612,18 +618,62 @@ __kernel void cg_iteration(uint S, uint node_count, int max_iterations,
   int any = 0;
   for (uint i = 0; i < SF_CG_BLOCK; ++i) any |= active[first + i] != 0u;
   if (!any) return;
-  sf_block_node_product(first, SF_CG_BLOCK, SF_ELEMENT_CHUNKS, S, node_count, c, ligament_offsets, ligament_of_node, ligament_k,
-                        control_k, mass, d, element_out, q);
-  sf_block_cg_iteration(first, SF_CG_BLOCK, S, 3 * node_count, max_iterations, c, inverse_diagonal, x, r, z,
-                        d, q, bb, rr, rz, active, converged, iterations SF_FACTOR_PASS);
+  sf_block_node_product(first, SF_CG_BLOCK, SF_ELEMENT_CHUNKS, S, SF_SIGMA_BLOCK, first,
+                        node_count, c, ligament_offsets, ligament_of_node, ligament_k, control_k,
+                        mass, d, element_out, q);
+  sf_block_cg_iteration(first, SF_CG_BLOCK, SF_SIGMA_BLOCK, 3 * node_count, max_iterations, c,
+                        inverse_diagonal, x, r, z, d, q, bb, rr, rz, active, converged, iterations
+                        SF_FACTOR_PASS);
 }
 
-/* The whole solve in one launch, for small meshes: one work-item takes every sigma point
- * (a block of S) and does the products itself (one chunk of all the elements into
- * element_out, then q), so a step costs one launch instead of two per iteration. Where a
- * launch costs several microseconds (PoCL) and an iteration's work is tens of them, that
- * is most of the time (the liver filter step). One core only: the host uses it on meshes
- * small enough for that to pay (OpenClEnsemble). */
+/* cg_solve's work for one block (the sigma points first .. first + count - 1): the vectors
+ * b .. copy are [row * stride + i], the per-sigma scalars and flags are given from the
+ * block's first (bb[i] is sigma point first + i's); the step constants, frames and springs
+ * are the ensemble's (sigma point first + i of S). */
+static inline __attribute__((always_inline)) void sf_cg_solve_block(
+    uint first, uint count, uint S, uint stride, uint rows, uint element_count,
+    uint node_count, int max_iterations, __global const real* restrict c,
+    __global const int* restrict nodes, __global const real* restrict rest,
+    __global const real* restrict frames, __global const int* restrict ligament_offsets,
+    __global const int* restrict ligament_of_node, __global const real* restrict ligament_k,
+    __global const real* restrict control_k, __global const real* restrict mass,
+    __global const real* restrict b, __global const real* restrict inverse_diagonal,
+    __global real* restrict x, __global real* restrict r, __global real* restrict z,
+    __global real* restrict d, __global real* restrict q, __global real* restrict copy,
+    __global real* restrict bb, __global real* restrict rr, __global real* restrict rz,
+    __global uint* restrict active, __global uint* restrict converged,
+    __global int* restrict iterations SF_FACTOR_ARGUMENTS) {
+  sf_element_chunk_products(0, element_count, first, count, S, stride, node_count, nodes, rest,
+                            frames, c, x, copy);
+  sf_block_node_product(first, count, 1, S, stride, 0, node_count, c, ligament_offsets,
+                        ligament_of_node, ligament_k, control_k, mass, x, copy, q);
+  int any = sf_block_cg_start(0, count, stride, rows, c, q, b, inverse_diagonal, r, z, d,
+                              bb, rr, rz, active, converged, iterations SF_FACTOR_PASS);
+  while (any) {
+    sf_element_chunk_products(0, element_count, first, count, S, stride, node_count, nodes, rest,
+                              frames, c, d, copy);
+    sf_block_node_product(first, count, 1, S, stride, 0, node_count, c, ligament_offsets,
+                          ligament_of_node, ligament_k, control_k, mass, d, copy, q);
+    any = sf_block_cg_iteration(0, count, stride, rows, max_iterations, c, inverse_diagonal,
+                                x, r, z, d, q, bb, rr, rz, active, converged, iterations
+                                SF_FACTOR_PASS);
+  }
+}
+
+/* The whole solve in one launch, for small meshes: one work-item per block of
+ * SF_CG_SOLVE_BLOCK sigma points (all S, or one block per compute unit) does the products
+ * itself (one chunk of all the elements into its copy of K d, then q), so a step costs one
+ * launch instead of two per iteration. Where a launch costs several microseconds (PoCL) and
+ * an iteration's work is tens of them, that is most of the time (the liver filter step).
+ * With more than one block, each works on its own vectors ([row * SF_CG_SOLVE_BLOCK + i], in
+ * element_out, which the element outputs leave free once node_rhs has read them; its factor
+ * work in factor_work): blocks in the ensemble's layout would write into each other's cache
+ * lines at every row. The host sizes element_out for that (SF_CG_SOLVE_VECTORS), picks the
+ * blocks and uses this kernel on meshes small enough for it to pay (OpenClEnsemble). */
+#ifndef SF_CG_SOLVE_BLOCK
+#  define SF_CG_SOLVE_BLOCK SF_SIGMA_BLOCK
+#endif
+#define SF_CG_SOLVE_BLOCKS (SF_SIGMA_BLOCK / SF_CG_SOLVE_BLOCK)
 __kernel void cg_solve(uint S, uint element_count, uint node_count, int max_iterations,
                        __global const real* restrict c, __global const int* restrict nodes,
                        __global const real* restrict rest, __global const real* restrict frames,
@@ -639,19 +689,48 @@ __kernel void cg_solve(uint S, uint element_count, uint node_count, int max_iter
                        __global real* restrict rz, __global uint* restrict active,
                        __global uint* restrict converged, __global int* restrict iterations
                        SF_FACTOR_ARGUMENTS) {
-  if (get_global_id(0) != 0) return;
+  const uint block = (uint)get_global_id(0);
+  if (block >= SF_CG_SOLVE_BLOCKS) return;
+  const uint first = block * SF_CG_SOLVE_BLOCK;
   const uint rows = 3 * node_count;
-  sf_element_chunk_products(0, element_count, S, node_count, nodes, rest, frames, c, x, element_out);
-  sf_block_node_product(0, SF_SIGMA_BLOCK, 1, S, node_count, c, ligament_offsets, ligament_of_node,
-                        ligament_k, control_k, mass, x, element_out, q);
-  int any = sf_block_cg_start(0, SF_SIGMA_BLOCK, S, rows, c, q, b, inverse_diagonal, r, z, d, bb,
-                              rr, rz, active, converged, iterations SF_FACTOR_PASS);
-  while (any) {
-    sf_element_chunk_products(0, element_count, S, node_count, nodes, rest, frames, c, d, element_out);
-    sf_block_node_product(0, SF_SIGMA_BLOCK, 1, S, node_count, c, ligament_offsets,
-                          ligament_of_node, ligament_k, control_k, mass, d, element_out, q);
-    any = sf_block_cg_iteration(0, SF_SIGMA_BLOCK, S, rows, max_iterations, c, inverse_diagonal,
-                                x, r, z, d, q, bb, rr, rz, active, converged, iterations SF_FACTOR_PASS);
-  }
+#if SF_CG_SOLVE_BLOCKS > 1
+  /* The block's own vectors: x, b, the inverse diagonal, r, z, d, q and its copy of K d. */
+  const size_t size = (size_t)rows * SF_CG_SOLVE_BLOCK;
+  __global real* restrict own = element_out + (size_t)block * SF_CG_SOLVE_VECTORS * size;
+  __global real* restrict own_x = own;
+  __global real* restrict own_b = own + size;
+  __global real* restrict own_inverse_diagonal = own + 2 * size;
+  for (uint row = 0; row < rows; ++row)
+    for (uint i = 0; i < SF_CG_SOLVE_BLOCK; ++i) {
+      const size_t at = (size_t)row * S + first + i;
+      const size_t own_at = (size_t)row * SF_CG_SOLVE_BLOCK + i;
+      own_x[own_at] = x[at];
+      own_b[own_at] = b[at];
+#  if !SF_FACTOR
+      own_inverse_diagonal[own_at] = inverse_diagonal[at];
+#  endif
+    }
+#  if SF_FACTOR
+#    define SF_OWN_FACTOR_PASS , factor_columns, factor_rows, factor_values, factor_order, \
+        factor_work + (size_t)block * size
+#  else
+#    define SF_OWN_FACTOR_PASS
+#  endif
+  sf_cg_solve_block(first, SF_CG_SOLVE_BLOCK, S, SF_CG_SOLVE_BLOCK, rows, element_count, node_count,
+                    max_iterations, c, nodes, rest, frames, ligament_offsets, ligament_of_node,
+                    ligament_k, control_k, mass, own_b, own_inverse_diagonal, own_x,
+                    own + 3 * size, own + 4 * size, own + 5 * size, own + 6 * size,
+                    own + 7 * size, bb + first, rr + first, rz + first, active + first,
+                    converged + first, iterations + first SF_OWN_FACTOR_PASS);
+  for (uint row = 0; row < rows; ++row)
+    for (uint i = 0; i < SF_CG_SOLVE_BLOCK; ++i)
+      x[(size_t)row * S + first + i] = own_x[(size_t)row * SF_CG_SOLVE_BLOCK + i];
+#else
+  /* One block: the ensemble's vectors (SF_SIGMA_BLOCK = S on a CPU, a constant here). */
+  sf_cg_solve_block(0, SF_SIGMA_BLOCK, S, SF_SIGMA_BLOCK, rows, element_count, node_count,
+                    max_iterations, c, nodes, rest, frames, ligament_offsets, ligament_of_node,
+                    ligament_k, control_k, mass, b, inverse_diagonal, x, r, z, d, q, element_out,
+                    bb, rr, rz, active, converged, iterations SF_FACTOR_PASS);
+#endif
 }
 #endif

@@ -23,8 +23,8 @@ __kernel void element_product(uint S, uint element_count, uint node_count,
   uint chunk = (uint)get_global_id(0);
   if (chunk >= SF_ELEMENT_CHUNKS) return;
   sf_element_chunk_products((uint)((ulong)element_count * chunk / SF_ELEMENT_CHUNKS),
-                            (uint)((ulong)element_count * (chunk + 1) / SF_ELEMENT_CHUNKS), S,
-                            node_count, nodes, rest, frames, c, d,
+                            (uint)((ulong)element_count * (chunk + 1) / SF_ELEMENT_CHUNKS), 0,
+                            SF_SIGMA_BLOCK, S, S, node_count, nodes, rest, frames, c, d,
                             element_out + chunk * ((size_t)3 * node_count * S));
 #else
   uint e;
