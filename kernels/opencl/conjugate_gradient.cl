@@ -11,10 +11,12 @@
  *    its dot products in the group (a fixed tree: the same bits every run); on a large mesh
  *    P work-groups per sigma point, each with a partition of its rows, and three launches
  *    for what cg_iteration does in one (SF_CG_PARTITIONS, below);
- *  - a CPU (SF_CG_PER_GROUP = 0): one work-item per block of SF_CG_BLOCK sigma points (S over
- *    the compute units) goes down the rows with the block innermost, on contiguous data:
- *    vectorised, and each cache line read once (one work-item per sigma point read a line per
- *    sigma point, 16 times at S = 16). Dot products are summed in row order.
+ *  - a CPU (SF_CG_PER_GROUP = 0): one work-item per block of SF_CG_BLOCK sigma points goes
+ *    down the rows with the block innermost, on contiguous data: vectorised, and each cache
+ *    line read once (one work-item per sigma point read a line per sigma point, 16 times at
+ *    S = 16). Dot products are summed in row order. The blocks are all S in one, or one per
+ *    compute unit where each fills whole cache lines (OpenClEnsemble: blocks writing into
+ *    one line were slower than one work-item).
  * And on a CPU with a small mesh, the whole solve in one launch (cg_solve, at the end).
  *
  * Per-sigma scalars (arrays of S): bb = b.b, rr = r.r, rz = r.z, active (1 while iterating),
