@@ -629,11 +629,11 @@ __kernel void cg_iteration(uint S, uint node_count, int max_iterations,
 }
 
 /* cg_solve's work for one block (the sigma points first .. first + count - 1): the vectors
- * b .. copy are [row * stride + i], the per-sigma scalars and flags are given from the
- * block's first (bb[i] is sigma point first + i's); the step constants, frames and springs
- * are the ensemble's (sigma point first + i of S). */
+ * b .. copy are [row * count + i] (a block's own, or the ensemble's when the block is all S),
+ * the per-sigma scalars and flags are given from the block's first (bb[i] is sigma point
+ * first + i's); the step constants, frames and springs are the ensemble's (of S). */
 static inline __attribute__((always_inline)) void sf_cg_solve_block(
-    uint first, uint count, uint S, uint stride, uint rows, uint element_count,
+    uint first, uint count, uint S, uint rows, uint element_count,
     uint node_count, int max_iterations, __global const real* restrict c,
     __global const int* restrict nodes, __global const real* restrict rest,
     __global const real* restrict frames, __global const int* restrict ligament_offsets,
@@ -645,18 +645,18 @@ static inline __attribute__((always_inline)) void sf_cg_solve_block(
     __global real* restrict bb, __global real* restrict rr, __global real* restrict rz,
     __global uint* restrict active, __global uint* restrict converged,
     __global int* restrict iterations SF_FACTOR_ARGUMENTS) {
-  sf_element_chunk_products(0, element_count, first, count, S, stride, node_count, nodes, rest,
+  sf_element_chunk_products(0, element_count, first, count, S, count, node_count, nodes, rest,
                             frames, c, x, copy);
-  sf_block_node_product(first, count, 1, S, stride, 0, node_count, c, ligament_offsets,
+  sf_block_node_product(first, count, 1, S, count, 0, node_count, c, ligament_offsets,
                         ligament_of_node, ligament_k, control_k, mass, x, copy, q);
-  int any = sf_block_cg_start(0, count, stride, rows, c, q, b, inverse_diagonal, r, z, d,
+  int any = sf_block_cg_start(0, count, count, rows, c, q, b, inverse_diagonal, r, z, d,
                               bb, rr, rz, active, converged, iterations SF_FACTOR_PASS);
   while (any) {
-    sf_element_chunk_products(0, element_count, first, count, S, stride, node_count, nodes, rest,
+    sf_element_chunk_products(0, element_count, first, count, S, count, node_count, nodes, rest,
                               frames, c, d, copy);
-    sf_block_node_product(first, count, 1, S, stride, 0, node_count, c, ligament_offsets,
+    sf_block_node_product(first, count, 1, S, count, 0, node_count, c, ligament_offsets,
                           ligament_of_node, ligament_k, control_k, mass, d, copy, q);
-    any = sf_block_cg_iteration(0, count, stride, rows, max_iterations, c, inverse_diagonal,
+    any = sf_block_cg_iteration(0, count, count, rows, max_iterations, c, inverse_diagonal,
                                 x, r, z, d, q, bb, rr, rz, active, converged, iterations
                                 SF_FACTOR_PASS);
   }
@@ -718,18 +718,19 @@ __kernel void cg_solve(uint S, uint element_count, uint node_count, int max_iter
 #  else
 #    define SF_OWN_FACTOR_PASS
 #  endif
-  sf_cg_solve_block(first, SF_CG_SOLVE_BLOCK, S, SF_CG_SOLVE_BLOCK, rows, element_count, node_count,
-                    max_iterations, c, nodes, rest, frames, ligament_offsets, ligament_of_node,
+  sf_cg_solve_block(first, SF_CG_SOLVE_BLOCK, S, rows, element_count, node_count, max_iterations,
+                    c, nodes, rest, frames, ligament_offsets, ligament_of_node,
                     ligament_k, control_k, mass, own_b, own_inverse_diagonal, own_x,
                     own + 3 * size, own + 4 * size, own + 5 * size, own + 6 * size,
                     own + 7 * size, bb + first, rr + first, rz + first, active + first,
                     converged + first, iterations + first SF_OWN_FACTOR_PASS);
+#  undef SF_OWN_FACTOR_PASS
   for (uint row = 0; row < rows; ++row)
     for (uint i = 0; i < SF_CG_SOLVE_BLOCK; ++i)
       x[(size_t)row * S + first + i] = own_x[(size_t)row * SF_CG_SOLVE_BLOCK + i];
 #else
   /* One block: the ensemble's vectors (SF_SIGMA_BLOCK = S on a CPU, a constant here). */
-  sf_cg_solve_block(0, SF_SIGMA_BLOCK, S, SF_SIGMA_BLOCK, rows, element_count, node_count,
+  sf_cg_solve_block(0, SF_SIGMA_BLOCK, S, rows, element_count, node_count,
                     max_iterations, c, nodes, rest, frames, ligament_offsets, ligament_of_node,
                     ligament_k, control_k, mass, b, inverse_diagonal, x, r, z, d, q, element_out,
                     bb, rr, rz, active, converged, iterations SF_FACTOR_PASS);
