@@ -22,8 +22,8 @@ __kernel void element_product(uint S, uint element_count, uint node_count,
 #if SF_ELEMENT_CHUNKS > 0
   uint chunk = (uint)get_global_id(0);
   if (chunk >= SF_ELEMENT_CHUNKS) return;
-  sf_element_chunk_products((uint)((ulong)element_count * chunk / SF_ELEMENT_CHUNKS),
-                            (uint)((ulong)element_count * (chunk + 1) / SF_ELEMENT_CHUNKS), 0,
+  sf_element_chunk_products(sf_chunk_start(chunk, element_count),
+                            sf_chunk_start(chunk + 1, element_count), 0,
                             SF_SIGMA_BLOCK, S, S, node_count, nodes, rest, frames, c, d,
                             element_out + chunk * ((size_t)3 * node_count * S));
 #else

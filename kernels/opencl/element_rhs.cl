@@ -89,8 +89,8 @@ __kernel void element_rhs(uint S, uint element_count, __global const int* restri
 #if SF_ELEMENT_CHUNKS > 0
   const uint chunk = (uint)get_global_id(0);
   if (chunk >= SF_ELEMENT_CHUNKS) return;
-  const uint end = (uint)((ulong)element_count * (chunk + 1) / SF_ELEMENT_CHUNKS);
-  for (uint e = (uint)((ulong)element_count * chunk / SF_ELEMENT_CHUNKS); e < end; ++e)
+  const uint end = sf_chunk_start(chunk + 1, element_count);
+  for (uint e = sf_chunk_start(chunk, element_count); e < end; ++e)
     sf_element_rhs_block(e, 0, S, nodes, rest, frames, x, v, c, element_out, element_diagonal);
 #else
   uint e;

@@ -46,4 +46,12 @@ static inline int sf_block_item(size_t gid, uint S, uint count, uint* item, uint
   return 1;
 }
 
+/* The first element of chunk `chunk` of SF_ELEMENT_CHUNKS (chunk SF_ELEMENT_CHUNKS: the end):
+ * the CPU form's element kernels (element_product.cl, element_rhs.cl) take contiguous chunks. */
+#if SF_ELEMENT_CHUNKS > 0
+static inline uint sf_chunk_start(uint chunk, uint element_count) {
+  return (uint)((ulong)element_count * chunk / SF_ELEMENT_CHUNKS);
+}
+#endif
+
 #endif /* SIGMAFEM_ENSEMBLE_LAYOUT_H */
