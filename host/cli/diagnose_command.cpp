@@ -68,6 +68,9 @@ Action add_diagnose_command(CLI::App& app) {
     const Scenario scenario = load_scenario(options->scenario);
     if (!scenario.filter)
       throw InputError("scenario " + scenario.path + ": filter: missing; diagnose needs a filter block");
+    if (!scenario.filter->estimate_regions.empty())
+      throw InputError("scenario " + scenario.path + ": filter.estimate_young_modulus: diagnose estimates "
+                       "ligaments and candidate effects only; use estimate for the regions' moduli");
     const fs::path data(options->data_dir);
     const ObservationTable table = read_observations_csv(
         (data / "observations.csv").string(), static_cast<int>(scenario.observations.observed.size()), scenario.time.dt);
@@ -75,7 +78,7 @@ Action add_diagnose_command(CLI::App& app) {
       throw InputError("observations " + (data / "observations.csv").string() +
                        ": needs at least two rows (the rest state and one step)");
     std::optional<TruthTable> truth;
-    truth = read_optional_truth_csv((data / "truth.csv").string(), scenario.ligament_names(), table.row_count(), std::cerr);
+    truth = read_optional_truth_csv((data / "truth.csv").string(), scenario.truth_names(), table.row_count(), std::cerr);
     DiagnosisReport report;
     report.data_dir = options->data_dir;
     report.out_dir = options->out_dir;

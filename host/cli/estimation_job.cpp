@@ -24,6 +24,7 @@
 #include "host/engine/make_ensemble.h"
 #include "host/engine/surface_cloud_estimation.h"
 #include "host/model/effects.h"
+#include "host/model/estimated_parameters.h"
 #include "host/model/model.h"
 
 namespace sigmafem::cli {
@@ -49,13 +50,14 @@ json run_estimation_job(const Scenario& scenario, const EstimationJob& job) {
   for (Eigen::Index c = 0; c + 2 < table.points.cols(); c += 3)
     table.points.middleCols(c, 3).rowwise() -= offset.transpose();
   std::optional<TruthTable> truth;
-  truth = read_optional_truth_csv((data / "truth.csv").string(), scenario.ligament_names(), table.row_count(), std::cerr);
+  truth = read_optional_truth_csv((data / "truth.csv").string(), scenario.truth_names(), table.row_count(), std::cerr);
+  const EstimatedParameters estimated = estimated_parameters(spec);
 
   EstimationOptions options = estimation_options(scenario);
   const bool outlier_gate = options.roukf.outlier_gate.enabled;   // a cloud's observation takes it over
   if (!job.sigma_points.empty()) options.roukf.sigma_points = parse_sigma_point_set(job.sigma_points);
   const int sigma_count =
-      sigma_point_count(options.roukf.sigma_points, static_cast<int>(spec.estimate.size()));
+      sigma_point_count(options.roukf.sigma_points, estimated.count());
 
   fs::create_directories(job.out_dir);
   const Model model = make_model(scenario);
@@ -71,7 +73,7 @@ json run_estimation_job(const Scenario& scenario, const EstimationJob& job) {
     const std::string cloud_path = (data / "pointcloud.csv").string();
     PointCloudTable cloud_table = read_point_cloud_csv(cloud_path);
     for (PointCloudFrame& frame : cloud_table.frames) frame.points.colwise() -= offset;
-    cloud = make_surface_cloud_estimation(backend.backend, model, scenario.mesh, spec.estimate, sigma_count,
+    cloud = make_surface_cloud_estimation(backend.backend, model, scenario.mesh, estimated, sigma_count,
                                           job.device, cloud_table, scenario.time.dt, table.row_count(), cloud_path,
                                           options.roukf);
     Eigen::Index max_points = 0;
@@ -85,7 +87,7 @@ json run_estimation_job(const Scenario& scenario, const EstimationJob& job) {
     // Frames at their own times (observations.csv's frame_time) are observed then
     // (filter/timed_observation.h); without the column the decorator changes nothing.
     tracked = std::make_unique<TimedObservation>(
-        make_ensemble(backend.backend, model, spec.estimate, scenario.observations.observed, sigma_count, job.device),
+        make_ensemble(backend.backend, model, estimated, scenario.observations.observed, sigma_count, job.device),
         table.frame_shares);
     if (!table.frame_times.empty()) observations["frame_time"] = true;
   }
@@ -114,7 +116,7 @@ json run_estimation_job(const Scenario& scenario, const EstimationJob& job) {
   report.sigma_points = to_string(options.roukf.sigma_points);
   report.outlier_gate = outlier_gate;
   report.sigma_count = sigma_count;
-  for (int l : spec.estimate) report.names.push_back(scenario.ligaments[l].name);
+  report.names = scenario.parameter_names();
   report.truth = truth;
   // The residual diagnostics' lever arms: tracked points only (for a cloud the rows are not
   // the same points from one step to the next, and the report leaves them out).
@@ -136,8 +138,12 @@ void print_estimation_summary(std::ostream& out, const json& summary, const std:
   if (!summary["complete"].get<bool>())
     out << "  INCOMPLETE: " << summary["stop_reason"].get<std::string>() << '\n';
   for (const auto& [name, value] : summary["final"].items()) {
-    std::snprintf(line, sizeof line, "  %-12s %10.2f N/m  +- %.2f (1 std)\n", name.c_str(),
-                  value["stiffness_n_per_m"].get<double>(), value["std_n_per_m"].get<double>());
+    if (value.contains("young_modulus_pa"))
+      std::snprintf(line, sizeof line, "  %-12s %10.0f Pa   +- %.0f (1 std)\n", name.c_str(),
+                    value["young_modulus_pa"].get<double>(), value["std_pa"].get<double>());
+    else
+      std::snprintf(line, sizeof line, "  %-12s %10.2f N/m  +- %.2f (1 std)\n", name.c_str(),
+                    value["stiffness_n_per_m"].get<double>(), value["std_n_per_m"].get<double>());
     out << line;
   }
   if (summary["errors"].is_object()) {
@@ -152,6 +158,18 @@ void print_estimation_summary(std::ostream& out, const json& summary, const std:
                                                 : std::to_string(e["steps_to_follow"].get<int>()) + " steps");
       out << '\n';
     }
+  }
+  if (summary.contains("young_modulus_errors")) {
+    std::string worst;
+    double largest = -1.0;
+    for (const auto& [name, e] : summary["young_modulus_errors"].items())
+      if (std::abs(e["relative_error"].get<double>()) > largest) {
+        largest = std::abs(e["relative_error"].get<double>());
+        worst = name;
+      }
+    std::snprintf(line, sizeof line, "  regions     largest |error| of a Young's modulus %.1f%% (%s) at the last step\n",
+                  100.0 * largest, worst.c_str());
+    out << line;
   }
   if (!summary["outliers_rejected"].is_null())
     out << "  outliers: " << summary["outliers_rejected"].get<int>()

@@ -1,5 +1,6 @@
 #include "host/cli/estimation_report.h"
 
+#include <algorithm>
 #include <cmath>
 #include <filesystem>
 #include <sstream>
@@ -30,6 +31,11 @@ std::optional<Eigen::MatrixXd> truth_at_steps(const TruthTable& truth,
   }
   return values;
 }
+
+namespace {
+// A region's Young's modulus ("E:NAME", Scenario::parameter_names), in Pa, not a stiffness.
+bool is_modulus_name(const std::string& name) { return name.rfind("E:", 0) == 0; }
+}  // namespace
 
 json adaptive_noise_json(const EstimationRun& run) {
   json j;
@@ -90,11 +96,13 @@ void plot_stiffness(const EstimationReport& report, const EstimationRun& run,
     }
     data.rows.push_back(row);
   }
+  const bool moduli = std::any_of(report.names.begin(), report.names.end(), is_modulus_name);
   std::ostringstream script;
-  script << "set output $output\nset title 'Estimated ligament stiffness (" << report.scenario_name
-         << ", " << report.sigma_points << " sigma points): median with +-2 std band"
+  script << "set output $output\nset title 'Estimated " << (moduli ? "parameters" : "ligament stiffness") << " ("
+         << report.scenario_name << ", " << report.sigma_points << " sigma points): median with +-2 std band"
          << (truth ? ", truth dashed" : "") << "'\n"
-         << "set xlabel 'time (s)'\nset ylabel 'stiffness (N/m)'\nset grid\nset key outside right\n"
+         << "set xlabel 'time (s)'\nset ylabel '" << (moduli ? "stiffness (N/m), Young''s modulus E:* (Pa)" : "stiffness (N/m)")
+         << "'\nset grid\nset key outside right\n"
          << "set datafile missing 'nan'\n";
   // With a truth, the first seconds' wide prior would squash the rest of the plot: show up
   // to 2.5 times the largest true stiffness (the estimates start at most 2x off here).
@@ -218,8 +226,9 @@ nlohmann::ordered_json write_estimation_report(const EstimationReport& report, c
     const EstimationStep& last = run.steps.back();
     for (std::size_t j = 0; j < report.names.size(); ++j) {
       const auto jj = static_cast<Eigen::Index>(j);
-      final_estimates[report.names[j]] = {{"stiffness_n_per_m", last.stiffness[jj]},
-                                          {"std_n_per_m", last.stiffness_std[jj]},
+      const bool modulus = is_modulus_name(report.names[j]);
+      final_estimates[report.names[j]] = {{modulus ? "young_modulus_pa" : "stiffness_n_per_m", last.stiffness[jj]},
+                                          {modulus ? "std_pa" : "std_n_per_m", last.stiffness_std[jj]},
                                           {"log_std", last.log_std[jj]}};
     }
   }
@@ -245,10 +254,28 @@ nlohmann::ordered_json write_estimation_report(const EstimationReport& report, c
       estimate.row(static_cast<Eigen::Index>(k)) = run.steps[k].stiffness.transpose();
       std_dev.row(static_cast<Eigen::Index>(k)) = run.steps[k].stiffness_std.transpose();
     }
+    // The ligaments' figures are in N/m; the regions' moduli, after them (Scenario::
+    // parameter_names), get their relative errors at the last step instead.
+    const auto ligaments = static_cast<Eigen::Index>(
+        std::find_if(report.names.begin(), report.names.end(), is_modulus_name) - report.names.begin());
     json errors = json::object();
-    for (const PhaseErrors& phase : error_figures(steps, estimate, std_dev, *truth))
-      errors[phase.name] = phase_json(phase, report.names);
+    if (ligaments > 0) {
+      const std::vector<std::string> ligament_names(report.names.begin(), report.names.begin() + ligaments);
+      for (const PhaseErrors& phase : error_figures(steps, estimate.leftCols(ligaments), std_dev.leftCols(ligaments),
+                                                    truth->leftCols(ligaments)))
+        errors[phase.name] = phase_json(phase, ligament_names);
+    }
     summary["errors"] = errors;
+    if (ligaments < estimate.cols()) {
+      json moduli = json::object();
+      const Eigen::Index last = estimate.rows() - 1;
+      for (Eigen::Index j = ligaments; j < estimate.cols(); ++j)
+        moduli[report.names[static_cast<std::size_t>(j)]] = {
+            {"estimate_pa", estimate(last, j)},
+            {"truth_pa", (*truth)(last, j)},
+            {"relative_error", (estimate(last, j) - (*truth)(last, j)) / (*truth)(last, j)}};
+      summary["young_modulus_errors"] = moduli;
+    }
   } else {
     summary["errors"] = nullptr;
   }

@@ -12,7 +12,7 @@ namespace sigmafem {
 std::vector<std::string> available_backends() { return {"cpu", "opencl", "vulkan"}; }
 
 std::unique_ptr<SimulationEnsemble> make_ensemble(const std::string& backend, const Model& model,
-                                                  const std::vector<int>& estimated,
+                                                  const EstimatedParameters& estimated,
                                                   const ObservedPoints& observed, int sigma_count,
                                                   const DeviceOptions& options) {
   if (backend == "auto")
@@ -47,7 +47,7 @@ std::string preconditioner_used(const std::string& backend, const DeviceOptions&
 }
 
 std::unique_ptr<EffectEnsemble> make_effect_ensemble(const std::string& backend, Model model,
-                                                     std::vector<int> estimated,
+                                                     EstimatedParameters estimated,
                                                      const ObservedPoints& observed, int sigma_count,
                                                      const DeviceOptions& options,
                                                      const std::vector<std::string>& effects) {
@@ -55,7 +55,7 @@ std::unique_ptr<EffectEnsemble> make_effect_ensemble(const std::string& backend,
     const EffectDefinition* definition = find_effect(name);
     // The stiffness is a placeholder: set_parameters gives every sigma point its own.
     if (definition && definition->side == EffectSide::ligament)
-      estimated.push_back(add_extra_ligament(model, name, 0.0));
+      estimated.ligaments.push_back(add_extra_ligament(model, name, 0.0));
   }
   return std::make_unique<EffectEnsemble>(
       make_ensemble(backend, model, estimated, observed, sigma_count, options), effects);

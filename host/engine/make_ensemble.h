@@ -12,6 +12,7 @@
 #include "host/ensemble/effect_ensemble.h"
 #include "host/ensemble/simulation_ensemble.h"
 #include "host/mesh/observed_points.h"
+#include "host/model/estimated_parameters.h"
 #include "host/model/model.h"
 
 namespace sigmafem {
@@ -25,7 +26,7 @@ std::vector<std::string> available_backends();
 // has its shared factor on a CPU device (automatic: there, not on a GPU; factorised on a GPU
 // is a DeviceError), Vulkan refuses factorised with an InputError.
 std::unique_ptr<SimulationEnsemble> make_ensemble(const std::string& backend, const Model& model,
-                                                  const std::vector<int>& estimated,
+                                                  const EstimatedParameters& estimated,
                                                   const ObservedPoints& observed, int sigma_count,
                                                   const DeviceOptions& options = {});
 
@@ -36,7 +37,7 @@ std::string preconditioner_used(const std::string& backend, const DeviceOptions&
 // The ensemble of `model` on `backend` with the candidate `effects` estimated (EffectEnsemble):
 // the ligament of every ligament effect is appended to the model and to `estimated` first.
 std::unique_ptr<EffectEnsemble> make_effect_ensemble(const std::string& backend, Model model,
-                                                     std::vector<int> estimated,
+                                                     EstimatedParameters estimated,
                                                      const ObservedPoints& observed, int sigma_count,
                                                      const DeviceOptions& options,
                                                      const std::vector<std::string>& effects);

@@ -20,7 +20,7 @@ PointCloudOptions take_outlier_gate(RoukfOptions& roukf) {
 }
 
 SurfaceCloudEstimation make_surface_cloud_estimation(const std::string& backend, const Model& model,
-                                                     const Mesh& mesh, const std::vector<int>& estimated,
+                                                     const Mesh& mesh, const EstimatedParameters& estimated,
                                                      int sigma_count, const DeviceOptions& device,
                                                      const PointCloudTable& cloud, double dt, int rows,
                                                      const std::string& path, RoukfOptions& roukf,

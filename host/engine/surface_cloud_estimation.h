@@ -13,6 +13,7 @@
 
 #include "filter/point_cloud_observation.h"
 #include "filter/roukf.h"
+#include "host/model/estimated_parameters.h"
 #include "host/common/device_options.h"
 #include "host/data/point_cloud_table.h"
 #include "host/mesh/mesh.h"
@@ -46,7 +47,7 @@ PointCloudOptions take_outlier_gate(RoukfOptions& roukf);
 // one lies after the last row, or the run's tables (rows x triangles, three of them) would
 // take more than half the machine's memory.
 SurfaceCloudEstimation make_surface_cloud_estimation(const std::string& backend, const Model& model,
-                                                     const Mesh& mesh, const std::vector<int>& estimated,
+                                                     const Mesh& mesh, const EstimatedParameters& estimated,
                                                      int sigma_count, const DeviceOptions& device,
                                                      const PointCloudTable& cloud, double dt, int rows,
                                                      const std::string& path, RoukfOptions& roukf,

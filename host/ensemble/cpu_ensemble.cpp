@@ -16,16 +16,14 @@ constexpr double kOwnFactorsBytes = 1024.0 * 1024.0 * 1024.0;
 
 }  // namespace
 
-CpuEnsemble::CpuEnsemble(const Model& model, std::vector<int> estimated, ObservedPoints observed,
+CpuEnsemble::CpuEnsemble(const Model& model, EstimatedParameters estimated, ObservedPoints observed,
                          int sigma_count, int threads, Preconditioner preconditioner)
     : estimated_(std::move(estimated)),
       observed_(std::move(observed)),
       preconditioner_(preconditioner),
       own_factors_budget_(kOwnFactorsBytes) {
   if (sigma_count < 1) throw std::invalid_argument("CpuEnsemble: need at least one sigma point");
-  for (int l : estimated_)
-    if (l < 0 || l >= static_cast<int>(model.ligaments.size()))
-      throw std::invalid_argument("CpuEnsemble: no ligament " + std::to_string(l));
+  check_estimated_parameters(estimated_, model, "CpuEnsemble");
   check_observed_points(observed_, model.node_count(), "CpuEnsemble");
   ReferenceSimulation first(model);
   // One assembly pattern for all the factors' refreshes, not one per sigma point.
@@ -59,8 +57,15 @@ void CpuEnsemble::set_parameters(const Eigen::MatrixXd& theta) {
   check_parameter_matrix(theta, parameter_count(), sigma_count(), "CpuEnsemble");
   for (int s = 0; s < sigma_count(); ++s) {
     std::vector<double> stiffness = simulations_[s].ligament_stiffness();
-    for (int j = 0; j < parameter_count(); ++j) stiffness[estimated_[j]] = std::exp(theta(j, s));
+    for (std::size_t j = 0; j < estimated_.ligaments.size(); ++j)
+      stiffness[static_cast<std::size_t>(estimated_.ligaments[j])] = std::exp(theta(static_cast<Eigen::Index>(j), s));
     simulations_[s].set_ligament_stiffness(stiffness);
+    if (estimated_.regions.empty()) continue;
+    std::vector<double> modulus;
+    for (const ElasticRegion& region : simulations_[s].model().regions) modulus.push_back(region.young_modulus);
+    for (std::size_t k = 0; k < estimated_.regions.size(); ++k)
+      modulus[static_cast<std::size_t>(estimated_.regions[k])] = std::exp(theta(estimated_.region_row(k), s));
+    simulations_[s].set_region_young_modulus(modulus);
   }
 }
 

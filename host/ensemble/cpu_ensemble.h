@@ -13,8 +13,9 @@
 // point 0's factor. Either way the results do not depend on the thread count; they differ
 // from Jacobi's within the CG tolerance.
 //
-// Parameters: theta = log of the stiffness of the estimated ligaments (in the given order);
-// the other ligaments keep the model's stiffness.
+// Parameters (host/model/estimated_parameters.h): theta = log of the stiffness of the
+// estimated ligaments, then log of the estimated regions' Young's modulus; the others keep
+// the model's values.
 #pragma once
 
 #include <Eigen/Core>
@@ -25,6 +26,7 @@
 #include "host/common/worker_pool.h"
 #include "host/ensemble/simulation_ensemble.h"
 #include "host/mesh/observed_points.h"
+#include "host/model/estimated_parameters.h"
 #include "host/model/model.h"
 #include "host/reference/factorised_preconditioner.h"
 #include "host/reference/reference_simulation.h"
@@ -33,16 +35,16 @@ namespace sigmafem {
 
 class CpuEnsemble : public SimulationEnsemble {
  public:
-  // `estimated`: indices into model.ligaments; `observed`: the observed points (node indices
+  // `estimated`: the ligaments and regions theta holds; `observed`: the observed points (node indices
   // convert); `threads` 0 = cores.
   // Preconditioner::automatic is the factors; the conformance tests, which compare the
   // devices' Jacobi CG with it to the last digits, ask for Jacobi.
-  CpuEnsemble(const Model& model, std::vector<int> estimated, ObservedPoints observed,
+  CpuEnsemble(const Model& model, EstimatedParameters estimated, ObservedPoints observed,
               int sigma_count, int threads = 0,
               Preconditioner preconditioner = Preconditioner::automatic);
 
   int sigma_count() const override { return static_cast<int>(simulations_.size()); }
-  int parameter_count() const override { return static_cast<int>(estimated_.size()); }
+  int parameter_count() const override { return estimated_.count(); }
   int observation_count() const override { return 3 * static_cast<int>(observed_.size()); }
   void set_parameters(const Eigen::MatrixXd& theta) override;
   StepReport advance(const Eigen::Vector3d& so_position) override;
@@ -63,7 +65,7 @@ class CpuEnsemble : public SimulationEnsemble {
 
  private:
   std::vector<ReferenceSimulation> simulations_;
-  std::vector<int> estimated_;
+  EstimatedParameters estimated_;
   ObservedPoints observed_;
   std::unique_ptr<WorkerPool> pool_;   // the threads asked (0: the cores), at most S
   Preconditioner preconditioner_;

@@ -31,7 +31,8 @@ std::vector<DeviceBuffer> by_slot(std::initializer_list<std::pair<int, DeviceBuf
 
 std::vector<DeviceBufferSpec> device_buffer_specs(const Model& model, const ObservedPoints& observed,
                                                   int S, std::size_t step_constant_count,
-                                                  const DeviceBufferSizes& sizes) {
+                                                  const DeviceBufferSizes& sizes,
+                                                  const std::vector<int>& estimated_regions) {
   const int nodes = model.node_count(), elements = model.element_count();
   const int L = static_cast<int>(model.ligaments.size());
   const std::size_t dof = 3 * static_cast<std::size_t>(nodes) * S;
@@ -50,6 +51,9 @@ std::vector<DeviceBufferSpec> device_buffer_specs(const Model& model, const Obse
     element_rest[16 * e + 12] = element.vlambda;
     element_rest[16 * e + 13] = element.vmu;
   }
+  for (std::size_t k = 0; k < estimated_regions.size(); ++k)
+    for (int e : model.regions.at(static_cast<std::size_t>(estimated_regions[k])).elements)
+      element_rest[16 * static_cast<std::size_t>(e) + SF_REST_REGION_SLOT] = static_cast<double>(1 + k);
   const std::vector<int> incidence_offsets = csr_offsets(corners_per_node);
   std::vector<int> incidence(incidence_offsets[nodes]);
   std::vector<int> fill(incidence_offsets.begin(), incidence_offsets.end() - 1);
@@ -224,15 +228,22 @@ int buffer_slot(DeviceKernel kernel, DeviceBuffer buffer) {
   return static_cast<int>(std::find(buffers.begin(), buffers.end(), buffer) - buffers.begin());
 }
 
-void ligament_k_from_theta(const Model& model, const std::vector<int>& estimated,
-                           const Eigen::MatrixXd& theta, int S, std::vector<double>& ligament_k) {
-  for (std::size_t j = 0; j < estimated.size(); ++j) {
-    const int l = estimated[j];
+Eigen::MatrixXd parameters_from_theta(const Model& model, const EstimatedParameters& estimated,
+                                      const Eigen::MatrixXd& theta, int S, std::vector<double>& ligament_k) {
+  for (std::size_t j = 0; j < estimated.ligaments.size(); ++j) {
+    const int l = estimated.ligaments[j];
     const double nodes = static_cast<double>(model.ligaments[l].nodes.size());
     for (int s = 0; s < S; ++s)
       ligament_k[static_cast<std::size_t>(l) * S + s] =
           std::exp(theta(static_cast<Eigen::Index>(j), s)) / nodes;
   }
+  Eigen::MatrixXd scales(static_cast<Eigen::Index>(estimated.regions.size()), S);
+  for (std::size_t k = 0; k < estimated.regions.size(); ++k) {
+    const double model_modulus = model.regions[static_cast<std::size_t>(estimated.regions[k])].young_modulus;
+    for (int s = 0; s < S; ++s)
+      scales(static_cast<Eigen::Index>(k), s) = std::exp(theta(estimated.region_row(k), s)) / model_modulus;
+  }
+  return scales;
 }
 
 RecenteringInputs pack_recentering(const Recentering& r, int S, const char* who) {

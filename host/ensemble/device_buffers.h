@@ -15,6 +15,7 @@
 #include "filter/ensemble.h"
 #include "host/mesh/observed_points.h"
 #include "host/model/model.h"
+#include "host/model/estimated_parameters.h"
 #include "step_constants.h"
 
 namespace sigmafem {
@@ -69,10 +70,12 @@ struct DeviceBufferSizes {
   std::size_t factor_nonzeros = 0;   // of CG's factor, if it has one (0: Jacobi)
 };
 
-// Every buffer of an ensemble of `model` with S sigma points, in DeviceBuffer order.
+// Every buffer of an ensemble of `model` with S sigma points, in DeviceBuffer order. The
+// elements of estimated_regions[k] (indices into model.regions) get region slot 1 + k.
 std::vector<DeviceBufferSpec> device_buffer_specs(const Model& model, const ObservedPoints& observed,
                                                   int S, std::size_t step_constant_count,
-                                                  const DeviceBufferSizes& sizes);
+                                                  const DeviceBufferSizes& sizes,
+                                                  const std::vector<int>& estimated_regions = {});
 
 // The kernels that both back ends have, and Vulkan's two CG binding sets (the start's shaders,
 // the iteration's), and the buffers each takes, in argument/binding order.
@@ -85,10 +88,12 @@ std::vector<DeviceBuffer> with_buffer(std::vector<DeviceBuffer> buffers, DeviceB
 // The index of `buffer` in kernel's list (its argument after the scalars, its binding).
 int buffer_slot(DeviceKernel kernel, DeviceBuffer buffer);
 
-// Writes exp(theta(j, s)) / (nodes of ligament estimated[j]) into ligament_k (p x S theta).
-void ligament_k_from_theta(const Model& model, const std::vector<int>& estimated,
-                           const Eigen::MatrixXd& theta, int sigma_count,
-                           std::vector<double>& ligament_k);
+// Writes exp(theta(j, s)) / (nodes of ligament estimated.ligaments[j]) into ligament_k, and
+// returns the estimated regions' scales exp(theta(region row k, s)) / (model modulus), one
+// row per estimated region (StepConstants::set_region_scales).
+Eigen::MatrixXd parameters_from_theta(const Model& model, const EstimatedParameters& estimated,
+                                      const Eigen::MatrixXd& theta, int sigma_count,
+                                      std::vector<double>& ligament_k);
 
 // The re-centring inputs, packed as the recenter kernels read them: scalars[1 + max p]
 // (alpha, the correction), directions and weights W = C I, each [j S + s]. p is the filter's

@@ -10,7 +10,7 @@
 
 namespace sigmafem {
 
-DeviceEnsemble::DeviceEnsemble(const Model& model, std::vector<int> estimated,
+DeviceEnsemble::DeviceEnsemble(const Model& model, EstimatedParameters estimated,
                                ObservedPoints observed, int sigma_count, Precision precision,
                                const char* backend, const char* who)
     : model_(model),
@@ -21,7 +21,7 @@ DeviceEnsemble::DeviceEnsemble(const Model& model, std::vector<int> estimated,
       elements_(model.element_count()),
       precision_(precision),
       tolerance_(device_cg_tolerance(model, precision)),
-      step_constants_(model, sigma_count, tolerance_),
+      step_constants_(model, sigma_count, tolerance_, static_cast<int>(estimated_.regions.size())),
       backend_(backend),
       who_(who) {
   check_ensemble_arguments(model, estimated_, observed_, S_, who);
@@ -36,7 +36,8 @@ void DeviceEnsemble::check_device_memory(std::size_t real_size, const std::strin
 }
 
 std::vector<DeviceBufferSpec> DeviceEnsemble::buffer_specs(const DeviceBufferSizes& sizes) {
-  std::vector<DeviceBufferSpec> specs = device_buffer_specs(model_, observed_, S_, step_constants_.size(), sizes);
+  std::vector<DeviceBufferSpec> specs =
+      device_buffer_specs(model_, observed_, S_, step_constants_.size(), sizes, estimated_.regions);
   ligament_k_ = specs[static_cast<int>(DeviceBuffer::ligament_k)].reals;
   return specs;
 }
@@ -56,7 +57,7 @@ StepReport DeviceEnsemble::step_report(const std::vector<std::int32_t>& iteratio
 
 void DeviceEnsemble::set_parameters(const Eigen::MatrixXd& theta) {
   check_parameter_matrix(theta, parameter_count(), sigma_count(), who_);
-  ligament_k_from_theta(model_, estimated_, theta, S_, ligament_k_);
+  step_constants_.set_region_scales(parameters_from_theta(model_, estimated_, theta, S_, ligament_k_));
   upload_ligament_k();
   representative_theta_ = theta.rowwise().mean();
 }
@@ -70,9 +71,16 @@ Eigen::SparseMatrix<double> DeviceEnsemble::representative_system(const Eigen::V
                                                                   const Eigen::VectorXd& v) const {
   if (!representative_) representative_ = std::make_unique<ReferenceSimulation>(model_);
   std::vector<double> stiffness = representative_->ligament_stiffness();   // the others: the model's
-  for (Eigen::Index j = 0; j < representative_theta_.size(); ++j)
-    stiffness[static_cast<std::size_t>(estimated_[static_cast<std::size_t>(j)])] = std::exp(representative_theta_[j]);
+  std::vector<double> modulus;
+  for (const ElasticRegion& region : model_.regions) modulus.push_back(region.young_modulus);
+  if (representative_theta_.size() == estimated_.count()) {   // none yet: the model's
+    for (std::size_t j = 0; j < estimated_.ligaments.size(); ++j)
+      stiffness[static_cast<std::size_t>(estimated_.ligaments[j])] = std::exp(representative_theta_[static_cast<Eigen::Index>(j)]);
+    for (std::size_t k = 0; k < estimated_.regions.size(); ++k)
+      modulus[static_cast<std::size_t>(estimated_.regions[k])] = std::exp(representative_theta_[estimated_.region_row(k)]);
+  }
   representative_->set_ligament_stiffness(stiffness);
+  representative_->set_region_young_modulus(modulus);
   representative_->set_physics_effects(representative_effects_);
   representative_->set_state(x, v);
   return representative_->system_matrix();

@@ -21,6 +21,7 @@
 #include "host/ensemble/device_step_constants.h"
 #include "host/ensemble/simulation_ensemble.h"
 #include "host/mesh/observed_points.h"
+#include "host/model/estimated_parameters.h"
 #include "host/model/model.h"
 #include "host/reference/reference_simulation.h"
 
@@ -29,7 +30,7 @@ namespace sigmafem {
 class DeviceEnsemble : public SimulationEnsemble {
  public:
   int sigma_count() const override { return S_; }
-  int parameter_count() const override { return static_cast<int>(estimated_.size()); }
+  int parameter_count() const override { return estimated_.count(); }
   int observation_count() const override { return 3 * static_cast<int>(observed_.size()); }
   // The stiffnesses of the estimated ligaments from theta (p x S), for the next advance().
   void set_parameters(const Eigen::MatrixXd& theta) override;
@@ -52,7 +53,7 @@ class DeviceEnsemble : public SimulationEnsemble {
 
  protected:
   // `backend` ("opencl"), `who` ("OpenClEnsemble", for errors). Checks the arguments.
-  DeviceEnsemble(const Model& model, std::vector<int> estimated, ObservedPoints observed,
+  DeviceEnsemble(const Model& model, EstimatedParameters estimated, ObservedPoints observed,
                  int sigma_count, Precision precision, const char* backend, const char* who);
 
   // Throws DeviceError when the ensemble needs more than `memory` bytes, or a buffer larger
@@ -105,7 +106,7 @@ class DeviceEnsemble : public SimulationEnsemble {
   virtual void run_system_product() = 0;
 
   Model model_;                   // a copy: the ensemble outlives its caller's model
-  std::vector<int> estimated_;
+  EstimatedParameters estimated_;
   ObservedPoints observed_;
   int S_ = 0, nodes_ = 0, elements_ = 0;
   Precision precision_;

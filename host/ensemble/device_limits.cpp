@@ -14,16 +14,14 @@ double device_cg_tolerance(const Model& model, Precision precision) {
                                         : model.solver.cg_tolerance;
 }
 
-void check_ensemble_arguments(const Model& model, const std::vector<int>& estimated,
+void check_ensemble_arguments(const Model& model, const EstimatedParameters& estimated,
                               const ObservedPoints& observed, int S, const char* who) {
   const std::string name(who);
   if (S < 1) throw std::invalid_argument(name + ": need at least one sigma point");
-  if (static_cast<int>(estimated.size()) > kDeviceMaxParameters)
+  if (estimated.count() > kDeviceMaxParameters)
     throw std::invalid_argument(name + ": at most " + std::to_string(kDeviceMaxParameters) +
                                 " estimated parameters");
-  for (int l : estimated)
-    if (l < 0 || l >= static_cast<int>(model.ligaments.size()))
-      throw std::invalid_argument(name + ": no ligament " + std::to_string(l));
+  check_estimated_parameters(estimated, model, name);
   check_observed_points(observed, model.node_count(), who);
   // The kernels give every node of a ligament the same part of its stiffness (one number per
   // ligament and sigma point); the control's parts are per node and need no check.

@@ -9,12 +9,13 @@
 
 #include "host/common/device_options.h"
 #include "host/mesh/observed_points.h"
+#include "host/model/estimated_parameters.h"
 #include "host/model/model.h"
 
 namespace sigmafem {
 
 // Checks an ensemble's arguments: std::invalid_argument naming `who`.
-void check_ensemble_arguments(const Model& model, const std::vector<int>& estimated,
+void check_ensemble_arguments(const Model& model, const EstimatedParameters& estimated,
                               const ObservedPoints& observed, int sigma_count, const char* who);
 
 // The CG tolerance floor of a float32 device ensemble: about ten float32 epsilons (float32

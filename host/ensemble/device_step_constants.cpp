@@ -8,8 +8,9 @@
 
 namespace sigmafem {
 
-StepConstants::StepConstants(const Model& model, int sigma_count, double cg_tolerance)
+StepConstants::StepConstants(const Model& model, int sigma_count, double cg_tolerance, int estimated_regions)
     : physics_(static_cast<std::size_t>(std::max(sigma_count, 0))),
+      region_scales_(Eigen::MatrixXd::Ones(estimated_regions, std::max(sigma_count, 0))),
       so_history_(model.control_start, model.dt),
       cg_tolerance_(cg_tolerance) {}
 
@@ -19,7 +20,15 @@ void StepConstants::set_physics_effects(const std::vector<PhysicsEffects>& effec
   physics_ = effects;
 }
 
-std::size_t StepConstants::size() const { return SF_STEP_CONSTANTS + SF_SIGMA_CONSTANT_COUNT * physics_.size(); }
+void StepConstants::set_region_scales(const Eigen::MatrixXd& scales) {
+  if (scales.rows() != region_scales_.rows() || scales.cols() != region_scales_.cols())
+    throw std::invalid_argument("StepConstants::set_region_scales: expected one row per estimated region, one column per sigma point");
+  region_scales_ = scales;
+}
+
+std::size_t StepConstants::size() const {
+  return SF_STEP_CONSTANTS + (SF_REGION_SCALES + 1 + static_cast<std::size_t>(region_scales_.rows())) * physics_.size();
+}
 
 std::vector<double> StepConstants::next_step(const Model& m, const Eigen::Vector3d& so_position) {
   so_history_.push(so_position);
@@ -49,6 +58,9 @@ std::vector<double> StepConstants::next_step(const Model& m, const Eigen::Vector
     at(SF_STIFFNESS_FACTOR) = h * (h + a);
     at(SF_RAYLEIGH_MASS) = b;
     at(SF_VELOCITY_FACTOR) = h + a;
+    at(SF_REGION_SCALES) = 1.0;   // slot 0: no estimated region
+    for (Eigen::Index k = 0; k < region_scales_.rows(); ++k)
+      at(SF_REGION_SCALES + 1 + static_cast<int>(k)) = region_scales_(k, static_cast<Eigen::Index>(s));
   }
   return c;
 }

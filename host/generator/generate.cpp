@@ -140,8 +140,9 @@ GenerateResult generate(const Scenario& scenario, const GenerateOptions& options
   table.points.resize(steps + 1, 3 * static_cast<Eigen::Index>(observed.size()));
   TruthTable truth;
   truth.comments = comments;
-  for (const Ligament& ligament : scenario.ligaments) truth.names.push_back(ligament.name);
-  truth.stiffness.resize(steps + 1, static_cast<Eigen::Index>(scenario.ligaments.size()));
+  // The ligaments' stiffness (N/m), then each region's Young's modulus (Pa, "E:NAME").
+  truth.names = scenario.truth_names();
+  truth.stiffness.resize(steps + 1, static_cast<Eigen::Index>(truth.names.size()));
   GaussianNoise noise(options.seed);
   // The faults' own stream (GenerateOptions::outliers): the noise above stays the same.
   std::mt19937_64 faults(options.seed ^ 0x9e3779b97f4a7c15ULL);
@@ -258,6 +259,8 @@ GenerateResult generate(const Scenario& scenario, const GenerateOptions& options
     truth.times.push_back(t);
     for (std::size_t l = 0; l < scenario.ligaments.size(); ++l)
       truth.stiffness(k, static_cast<Eigen::Index>(l)) = simulation.ligament_stiffness()[l];   // declared ones
+    for (std::size_t r = 0; r < scenario.regions.size(); ++r)
+      truth.stiffness(k, static_cast<Eigen::Index>(scenario.ligaments.size() + r)) = scenario.regions[r].young_modulus;
     for (int i = 0; i < model.node_count(); ++i)
       result.max_displacement =
           std::max(result.max_displacement,

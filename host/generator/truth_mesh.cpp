@@ -81,6 +81,9 @@ TruthMesh make_truth_mesh(const Scenario& scenario, const TruthMeshOptions& opti
         truth.scenario.mesh = refine_uniform(truth.scenario.mesh);
       orient_and_check(truth.scenario.mesh, "--truth-refine " + std::to_string(*options.refine));
       truth.description = "the scenario's mesh refined " + levels(*options.refine);
+      // Regions are element sets: selected again on the refined elements (by centroid).
+      for (Region& region : truth.scenario.regions)
+        region.elements = select_elements(truth.scenario.mesh, region.selection);
       if (options.spread_springs) {
         const Mesh& fine = truth.scenario.mesh;
         for (const Ligament& ligament : scenario.ligaments)

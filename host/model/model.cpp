@@ -105,6 +105,15 @@ Model make_model(const Scenario& scenario) {
     model.ligaments.push_back({ligament.name, ligament.nodes, ligament.stiffness, {}});
   for (const Ligament& region : scenario.candidate_regions)
     model.candidate_regions.push_back({region.name, region.nodes, 0.0, {}});
+  for (const Region& region : scenario.regions) {
+    // Both Lame terms are proportional to E at a fixed Poisson's ratio.
+    const double scale = region.young_modulus / scenario.material.young_modulus;
+    for (int e : region.elements) {
+      model.elements[static_cast<std::size_t>(e)].vlambda *= scale;
+      model.elements[static_cast<std::size_t>(e)].vmu *= scale;
+    }
+    model.regions.push_back({region.name, region.elements, region.young_modulus});
+  }
   model.control = {"control", scenario.control.nodes, scenario.control.stiffness, {}};
   model.control_start = scenario.control.start;
   // Effects the scenario declares part of the model (the observation-side ones act on the

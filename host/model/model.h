@@ -40,6 +40,14 @@ struct SpringSet {
   }
 };
 
+// A part of the organ with a Young's modulus of its own (Scenario::regions): its elements'
+// Lame terms are the material's scaled by young_modulus / material.young_modulus.
+struct ElasticRegion {
+  std::string name;
+  std::vector<int> elements;
+  double young_modulus = 0.0;           // Pa
+};
+
 struct Model {
   std::vector<Eigen::Vector3d> rest_positions;
   std::vector<ElementRest> elements;
@@ -61,6 +69,9 @@ struct Model {
   double control_scale = 1.0;
   // Surface regions where an unmodelled ligament may be (diagnose's extra_ligament:NAME).
   std::vector<SpringSet> candidate_regions;
+  // Parts with their own Young's modulus, already in their elements' vlambda and vmu; an
+  // ensemble may estimate theirs (host/model/estimated_parameters.h).
+  std::vector<ElasticRegion> regions;
   SpringSet control;                    // each node tied to so(t) + rest - so(0)
   Eigen::Vector3d control_start = Eigen::Vector3d::Zero();   // so(0)
 

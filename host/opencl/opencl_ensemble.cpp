@@ -27,7 +27,7 @@ bool opencl_uses_factor(Preconditioner preconditioner, bool cpu_form) {
          (preconditioner == Preconditioner::automatic && cpu_form);
 }
 
-OpenClEnsemble::OpenClEnsemble(const Model& model, std::vector<int> estimated,
+OpenClEnsemble::OpenClEnsemble(const Model& model, EstimatedParameters estimated,
                                ObservedPoints observed, int sigma_count,
                                const DeviceOptions& options)
     : DeviceEnsemble(model, std::move(estimated), std::move(observed), sigma_count,
@@ -154,7 +154,7 @@ OpenClEnsemble::OpenClEnsemble(const Model& model, std::vector<int> estimated,
     set_arguments(k_observation_gather_, kernel_buffers(DeviceKernel::observation_gather), S,
                   static_cast<cl_uint>(observed_.size()));
     set_arguments(k_recenter_, kernel_buffers(DeviceKernel::recenter), S, rows,
-                  static_cast<cl_uint>(estimated_.size()));
+                  static_cast<cl_uint>(estimated_.count()));
     // The CG kernels' buffers (conjugate_gradient.cl).
     // The factor's buffers, last, where the CPU form's CG has them (SF_FACTOR).
     const std::vector<DeviceBuffer> factor =

@@ -40,7 +40,7 @@ class OpenClEnsemble : public DeviceEnsemble {
   // `estimated`: indices into model.ligaments whose log-stiffness the parameters are;
   // `observed`: the observed points (node indices convert). Throws DeviceError (no device,
   // build failure, too little memory).
-  OpenClEnsemble(const Model& model, std::vector<int> estimated, ObservedPoints observed,
+  OpenClEnsemble(const Model& model, EstimatedParameters estimated, ObservedPoints observed,
                  int sigma_count, const DeviceOptions& options);
   ~OpenClEnsemble() override;   // waits for the writes still reading their host copies
 

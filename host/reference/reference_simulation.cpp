@@ -24,6 +24,34 @@ ReferenceSimulation::ReferenceSimulation(Model model)
   base_d0_ = model_.ligament_d0;
   base_so_lag_ = model_.so_lag;
   base_control_scale_ = model_.control_scale;
+  for (const ElementRest& element : model_.elements) base_lame_.emplace_back(element.vlambda, element.vmu);
+  element_region_.assign(model_.elements.size(), -1);
+  for (std::size_t r = 0; r < model_.regions.size(); ++r)
+    for (int e : model_.regions[r].elements) element_region_.at(static_cast<std::size_t>(e)) = static_cast<int>(r);
+  region_scale_.assign(model_.regions.size(), 1.0);
+}
+
+void ReferenceSimulation::update_element_moduli() {
+  // Scaled from the model's values each time, so that no rounding accumulates over steps.
+  for (std::size_t e = 0; e < model_.elements.size(); ++e) {
+    const int r = element_region_[e];
+    const double scale = young_scale_ * (r < 0 ? 1.0 : region_scale_[static_cast<std::size_t>(r)]);
+    model_.elements[e].vlambda = scale * lambda_scale_ * base_lame_[e][0];
+    model_.elements[e].vmu = scale * base_lame_[e][1];
+  }
+}
+
+void ReferenceSimulation::set_region_young_modulus(const std::vector<double>& modulus) {
+  if (modulus.size() != model_.regions.size())
+    throw std::invalid_argument("set_region_young_modulus: expected " + std::to_string(model_.regions.size()) +
+                                " values, got " + std::to_string(modulus.size()));
+  bool changed = false;
+  for (std::size_t r = 0; r < modulus.size(); ++r) {
+    const double scale = modulus[r] / model_.regions[r].young_modulus;
+    changed = changed || scale != region_scale_[r];
+    region_scale_[r] = scale;
+  }
+  if (changed) update_element_moduli();
 }
 
 void ReferenceSimulation::set_physics_effects(const PhysicsEffects& effects) {
@@ -34,15 +62,9 @@ void ReferenceSimulation::set_physics_effects(const PhysicsEffects& effects) {
   model_.so_lag = base_so_lag_ + effects.time_lag;
   model_.control_scale = base_control_scale_ * effects.control_scale;
   if (effects.young_scale == young_scale_ && effects.lambda_scale == lambda_scale_) return;
-  if (base_lame_.empty())
-    for (const ElementRest& element : model_.elements) base_lame_.emplace_back(element.vlambda, element.vmu);
-  // Scaled from the model's values each time, so that no rounding accumulates over steps.
-  for (std::size_t e = 0; e < model_.elements.size(); ++e) {
-    model_.elements[e].vlambda = effects.young_scale * effects.lambda_scale * base_lame_[e][0];
-    model_.elements[e].vmu = effects.young_scale * base_lame_[e][1];
-  }
   young_scale_ = effects.young_scale;
   lambda_scale_ = effects.lambda_scale;
+  update_element_moduli();
 }
 
 void ReferenceSimulation::set_ligament_stiffness(const std::vector<double>& stiffness) {

@@ -54,6 +54,10 @@ class ReferenceSimulation {
   // share it (CpuEnsemble makes it once, before copying the simulation per sigma point).
   const AssemblyPattern& assembly_pattern() const;
 
+  // Young's modulus (Pa) of each of the model's regions (Model::regions, in order); their
+  // model values restore.
+  void set_region_young_modulus(const std::vector<double>& modulus);
+
   // Physics effects on top of the model given at construction (diagnose estimates them per
   // sigma point); PhysicsEffects{} restores the model.
   void set_physics_effects(const PhysicsEffects& effects);
@@ -87,8 +91,13 @@ class ReferenceSimulation {
   Eigen::VectorXd dv_;                 // last velocity change: the CG warm start
   std::vector<Frame> frames_;
   Eigen::Vector3d base_gravity_;
+  // The elements' Lame terms are the model's scaled by the young_scale and lambda_scale
+  // effects and by their region's modulus over its model value (update_element_moduli).
   std::vector<Eigen::Vector2d> base_lame_;   // per element: vlambda, vmu of the model
+  std::vector<int> element_region_;          // per element: index into model.regions, or -1
+  std::vector<double> region_scale_;         // per region
   double young_scale_ = 1.0, lambda_scale_ = 1.0;
+  void update_element_moduli();
   Damping base_damping_;
   double base_d0_ = 0.0, base_so_lag_ = 0.0, base_control_scale_ = 1.0;
   SoHistory so_history_;                     // for the lag (Model::so_lag)

@@ -18,6 +18,12 @@ std::vector<std::string> Scenario::ligament_names() const {
   return names;
 }
 
+std::vector<std::string> Scenario::truth_names() const {
+  std::vector<std::string> names = ligament_names();
+  for (const Region& region : regions) names.push_back(young_modulus_parameter_name(region.name));
+  return names;
+}
+
 int Scenario::ligament_index(const std::string& ligament_name) const {
   for (size_t i = 0; i < ligaments.size(); ++i) {
     if (ligaments[i].name == ligament_name) return static_cast<int>(i);
@@ -29,6 +35,22 @@ int Scenario::candidate_region_index(const std::string& region_name) const {
   for (size_t i = 0; i < candidate_regions.size(); ++i)
     if (candidate_regions[i].name == region_name) return static_cast<int>(i);
   return -1;
+}
+
+int Scenario::region_index(const std::string& region_name) const {
+  for (size_t i = 0; i < regions.size(); ++i)
+    if (regions[i].name == region_name) return static_cast<int>(i);
+  return -1;
+}
+
+std::string young_modulus_parameter_name(const std::string& region_name) { return "E:" + region_name; }
+
+std::vector<std::string> Scenario::parameter_names() const {
+  std::vector<std::string> names;
+  if (!filter) return names;
+  for (int l : filter->estimate) names.push_back(ligaments[static_cast<size_t>(l)].name);
+  for (int r : filter->estimate_regions) names.push_back(young_modulus_parameter_name(regions[static_cast<size_t>(r)].name));
+  return names;
 }
 
 std::string Scenario::effect_region_problem(const std::string& effect_name) const {

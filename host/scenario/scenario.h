@@ -76,6 +76,17 @@ struct Ligament {
   NodeSetSpec selection = {};
 };
 
+// A part of the organ with a Young's modulus of its own (a tumour is stiffer; issue 19), which
+// the filter may estimate (filter.estimate_young_modulus). Its elements are those whose rest
+// centroid lies in the selection (near + radius, or box; `selection` keeps how it was
+// written, so that scenario_on_mesh can select again on another mesh).
+struct Region {
+  std::string name;
+  std::vector<int> elements;        // sorted, unique, never empty
+  double young_modulus = 0.0;       // Pa: the truth's (generate) and the model's until estimated
+  NodeSetSpec selection = {};
+};
+
 // The SO trajectory so(t). so(0) is the centroid of the control nodes' rest positions.
 struct Trajectory {
   enum class Type { linear, waypoints, file };
@@ -170,6 +181,10 @@ struct OutlierGateSpec {
 struct FilterSpec {
   std::vector<int> estimate;        // indices into Scenario::ligaments
   std::vector<double> initial_stiffness;   // median prior stiffness per estimated ligament
+  // Regions whose Young's modulus the filter estimates (indices into Scenario::regions), after
+  // the ligaments in the parameter vector, and their prior medians (Pa).
+  std::vector<int> estimate_regions;
+  std::vector<double> initial_young_modulus;
   double initial_log_std = 1.0;
   double parameter_drift_log_std = 0.0;
   double observation_std = 0.0;
@@ -200,6 +215,8 @@ struct Scenario {
   // Surface regions where `diagnose` tries an unmodelled ligament (extra_ligament:NAME); the
   // stiffness field is unused.
   std::vector<Ligament> candidate_regions;
+  // Parts with their own Young's modulus (`regions`); the other elements have the material's.
+  std::vector<Region> regions;
   Control control;
   std::vector<Event> events;        // sorted by time
   Observations observations;
@@ -213,8 +230,15 @@ struct Scenario {
   int ligament_index(const std::string& name) const;
   // The ligaments' names, in order.
   std::vector<std::string> ligament_names() const;
+  // The columns of generate's truth.csv: the ligaments' names, then "E:REGION" per region.
+  std::vector<std::string> truth_names() const;
   // Index of the candidate region called `name`, or -1.
   int candidate_region_index(const std::string& name) const;
+  // Index of the region (`regions`) called `name`, or -1.
+  int region_index(const std::string& name) const;
+  // The names of the estimated parameters, in the filter's order: the ligaments', then
+  // "E:REGION" for each estimated Young's modulus (the columns of estimates.csv and truth.csv).
+  std::vector<std::string> parameter_names() const;
   // "" when the region of a regional effect (FAMILY:REGION) is one of candidate_regions,
   // else what is wrong, naming the regions there are.
   std::string effect_region_problem(const std::string& effect_name) const;
@@ -231,6 +255,10 @@ constexpr double kSelectionSlack = 1e-9;  // m
 std::vector<int> select_nodes_near(const Mesh& mesh, const Eigen::Vector3d& near, double radius);
 std::vector<int> select_nodes_in_box(const Mesh& mesh, const Eigen::Vector3d& min,
                                      const Eigen::Vector3d& max);
+// The tetrahedra whose centroid a `near` or `box` selection holds (regions), sorted.
+std::vector<int> select_elements(const Mesh& mesh, const NodeSetSpec& selection);
+// The name of region `name`'s Young's modulus as a parameter: "E:NAME".
+std::string young_modulus_parameter_name(const std::string& region_name);
 
 // Reads and checks a scenario file. Throws InputError with "scenario FILE: FIELD: problem"
 // for an unknown field, a wrong type, a missing file, a ligament or node index that does not

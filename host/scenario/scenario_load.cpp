@@ -79,6 +79,40 @@ std::vector<int> node_indices(const Checker& c, const json& value, const std::st
   return nodes;
 }
 
+// A `select` object: near + radius, or box {min, max}, checked into `spec` (kind near or box).
+// `asked` says what was selected and `advice` what to enlarge, for an empty-set message.
+void read_select(const Checker& c, const json& select, const std::string& select_path, NodeSetSpec& spec,
+                 std::string& asked, std::string& advice) {
+  c.check_object(select, select_path, {"near", "radius", "box"}, {});
+  const bool has_sphere = select.contains("near") || select.contains("radius");
+  const bool has_box = select.contains("box");
+  c.require(!(has_sphere && has_box), select_path,
+            "give either \"near\" + \"radius\" or \"box\", not both");
+  c.require(has_sphere || has_box, select_path,
+            "empty selection: give \"near\" + \"radius\" or \"box\": {\"min\", \"max\"}");
+  if (has_sphere) {
+    c.check_object(select, select_path, {"near", "radius"}, {"near", "radius"});
+    spec.near = c.vector3(select.at("near"), child(select_path, "near"));
+    spec.radius = c.number(select.at("radius"), child(select_path, "radius"));
+    c.positive(spec.radius, child(select_path, "radius"));
+    spec.kind = NodeSetSpec::Kind::near;
+    asked = "near " + message_point(spec.near) + ", radius " + message_number(spec.radius) + " m";
+    advice = "radius";
+  } else {
+    const std::string box_path = child(select_path, "box");
+    const json& box = select.at("box");
+    c.check_object(box, box_path, {"min", "max"}, {"min", "max"});
+    spec.min = c.vector3(box.at("min"), child(box_path, "min"));
+    spec.max = c.vector3(box.at("max"), child(box_path, "max"));
+    c.require((spec.min.array() <= spec.max.array()).all(), box_path,
+              "min " + message_point(spec.min) + " exceeds max " + message_point(spec.max) +
+                  " in some coordinate");
+    spec.kind = NodeSetSpec::Kind::box;
+    asked = "box min " + message_point(spec.min) + ", max " + message_point(spec.max) + " m";
+    advice = "the box";
+  }
+}
+
 // The node set of a ligament or of the control: `nodes` or `select` (near + radius, or box),
 // in the transformed frame. Returns sorted, unique indices; an empty set is an error. `spec`
 // gets how the set was written.
@@ -101,42 +135,10 @@ std::vector<int> node_set(const Checker& c, const json& owner, const std::string
     asked = "\"nodes\" is an empty list";
     advice = "list at least one node";
   } else {
-    const std::string select_path = child(path, "select");
-    const json& select = owner.at("select");
-    c.check_object(select, select_path, {"near", "radius", "box"}, {});
-    const bool has_sphere = select.contains("near") || select.contains("radius");
-    const bool has_box = select.contains("box");
-    c.require(!(has_sphere && has_box), select_path,
-              "give either \"near\" + \"radius\" or \"box\", not both");
-    c.require(has_sphere || has_box, select_path,
-              "empty selection: give \"near\" + \"radius\" or \"box\": {\"min\", \"max\"}");
-    if (has_sphere) {
-      c.check_object(select, select_path, {"near", "radius"}, {"near", "radius"});
-      const Eigen::Vector3d near = c.vector3(select.at("near"), child(select_path, "near"));
-      const double radius = c.number(select.at("radius"), child(select_path, "radius"));
-      c.positive(radius, child(select_path, "radius"));
-      nodes = select_nodes_near(mesh, near, radius);
-      spec.kind = NodeSetSpec::Kind::near;
-      spec.near = near;
-      spec.radius = radius;
-      asked = "near " + message_point(near) + ", radius " + message_number(radius) + " m";
-      advice = "enlarge radius or list nodes";
-    } else {
-      const std::string box_path = child(select_path, "box");
-      const json& box = select.at("box");
-      c.check_object(box, box_path, {"min", "max"}, {"min", "max"});
-      const Eigen::Vector3d min = c.vector3(box.at("min"), child(box_path, "min"));
-      const Eigen::Vector3d max = c.vector3(box.at("max"), child(box_path, "max"));
-      c.require((min.array() <= max.array()).all(), box_path,
-                "min " + message_point(min) + " exceeds max " + message_point(max) +
-                    " in some coordinate");
-      nodes = select_nodes_in_box(mesh, min, max);
-      spec.kind = NodeSetSpec::Kind::box;
-      spec.min = min;
-      spec.max = max;
-      asked = "box min " + message_point(min) + ", max " + message_point(max) + " m";
-      advice = "enlarge the box or list nodes";
-    }
+    read_select(c, owner.at("select"), child(path, "select"), spec, asked, advice);
+    nodes = spec.kind == NodeSetSpec::Kind::near ? select_nodes_near(mesh, spec.near, spec.radius)
+                                                 : select_nodes_in_box(mesh, spec.min, spec.max);
+    advice = "enlarge " + advice + " or list nodes";
     // With a mesh scale set, a selection written in file units is the usual cause.
     advice += " (selections are in metres, after mesh scale and translate)";
   }
@@ -310,6 +312,48 @@ void read_ligaments(const Checker& c, const json& root, Scenario& s) {
     ligament.stiffness = c.number(item.at("stiffness"), child(path, "stiffness"));
     c.non_negative(ligament.stiffness, child(path, "stiffness"));
     s.ligaments.push_back(std::move(ligament));
+  }
+}
+
+// regions: [{"name", "select", "young_modulus"?}], parts of the organ with a Young's modulus of
+// their own (default the material's); each holds the tetrahedra whose centroid its selection
+// holds, and no tetrahedron may be in two. Read after the material.
+void read_regions(const Checker& c, const json& root, Scenario& s) {
+  if (!root.contains("regions")) return;
+  const json& regions = c.array(root.at("regions"), "regions");
+  std::vector<int> region_of(static_cast<size_t>(s.mesh.tetrahedron_count()), -1);
+  for (size_t i = 0; i < regions.size(); ++i) {
+    const json& item = regions[i];
+    std::string path = element("regions", i);
+    if (item.is_object() && item.contains("name") && item.at("name").is_string())
+      path += " " + in_quotes(item.at("name").get<std::string>());
+    c.check_object(item, path, {"name", "select", "young_modulus"}, {"name", "select"});
+    Region region;
+    region.name = c.string(item.at("name"), child(path, "name"));
+    c.require(valid_name(region.name), child(path, "name"),
+              "not a usable name: it must be non-empty, without commas, quotes, control "
+              "characters or edge spaces (it becomes a CSV column header)");
+    c.require(s.region_index(region.name) < 0, child(path, "name"),
+              "duplicate region name (also regions[" + std::to_string(s.region_index(region.name)) +
+                  "]); names must be unique");
+    std::string asked, advice;
+    region.selection.field = path;
+    read_select(c, item.at("select"), child(path, "select"), region.selection, asked, advice);
+    region.elements = select_elements(s.mesh, region.selection);
+    c.require(!region.elements.empty(), child(path, "select"),
+              "holds the centroid of no tetrahedron (" + asked + "); enlarge " + advice +
+                  " (selections are in metres, after mesh scale and translate)");
+    for (int e : region.elements) {
+      const int other = region_of[static_cast<size_t>(e)];
+      if (other >= 0)
+        c.fail(child(path, "select"), "tetrahedron " + std::to_string(e) + " is also in regions[" +
+                                          std::to_string(other) + "] " + in_quotes(s.regions[static_cast<size_t>(other)].name) +
+                                          "; a tetrahedron has one Young's modulus, so regions must not overlap");
+      region_of[static_cast<size_t>(e)] = static_cast<int>(i);
+    }
+    region.young_modulus = c.number_or(item, path, "young_modulus", s.material.young_modulus);
+    c.positive(region.young_modulus, child(path, "young_modulus"));
+    s.regions.push_back(std::move(region));
   }
 }
 
@@ -525,17 +569,51 @@ void read_windowed_test(const Checker& c, const json& object, const std::string&
   }
 }
 
+// filter.estimate_young_modulus (region names) and filter.initial_young_modulus (Pa, one each).
+void read_estimated_regions(const Checker& c, const json& filter, const Scenario& s, FilterSpec& spec) {
+  const bool has_names = filter.contains("estimate_young_modulus");
+  c.require(has_names == filter.contains("initial_young_modulus"), has_names ? "filter" : "filter.initial_young_modulus",
+            has_names ? "estimate_young_modulus needs initial_young_modulus, the prior median (Pa) of each"
+                      : "given without estimate_young_modulus, the regions it is the prior of");
+  if (!has_names) return;
+  const json& names = c.array(filter.at("estimate_young_modulus"), "filter.estimate_young_modulus");
+  for (size_t i = 0; i < names.size(); ++i) {
+    const std::string path = element("filter.estimate_young_modulus", i);
+    const std::string name = c.string(names[i], path);
+    const int index = s.region_index(name);
+    std::string known;
+    for (const Region& region : s.regions) known += (known.empty() ? "" : ", ") + region.name;
+    c.require(index >= 0, path,
+              "no region " + in_quotes(name) + " (regions: " + (known.empty() ? "none declared" : known) + ")");
+    c.require(std::find(spec.estimate_regions.begin(), spec.estimate_regions.end(), index) ==
+                  spec.estimate_regions.end(),
+              path, "region " + in_quotes(name) + " is listed twice");
+    spec.estimate_regions.push_back(index);
+  }
+  const json& initial = c.array(filter.at("initial_young_modulus"), "filter.initial_young_modulus");
+  c.require(initial.size() == names.size(), "filter.initial_young_modulus",
+            std::to_string(initial.size()) + " values for " + std::to_string(names.size()) +
+                " regions; give one per name in filter.estimate_young_modulus, same order");
+  for (size_t i = 0; i < initial.size(); ++i) {
+    const std::string path = element("filter.initial_young_modulus", i);
+    const double E = c.number(initial[i], path);
+    c.positive(E, path);   // the filter works on its log
+    spec.initial_young_modulus.push_back(E);
+  }
+}
+
 void read_filter(const Checker& c, const json& root, Scenario& s) {
   if (!root.contains("filter")) return;
   const json& filter = root.at("filter");
   c.check_object(filter, "filter",
-                 {"estimate", "initial_stiffness", "initial_log_std", "parameter_drift_log_std",
-                  "observation_std", "sigma_points", "change_detection", "adaptive_noise",
-                  "outlier_gate"},
+                 {"estimate", "initial_stiffness", "estimate_young_modulus", "initial_young_modulus",
+                  "initial_log_std", "parameter_drift_log_std", "observation_std", "sigma_points",
+                  "change_detection", "adaptive_noise", "outlier_gate"},
                  {"estimate", "initial_stiffness", "observation_std"});
   FilterSpec spec;
   const json& estimate = c.array(filter.at("estimate"), "filter.estimate");
-  c.require(!estimate.empty(), "filter.estimate", "empty: name at least one ligament to estimate");
+  c.require(!estimate.empty() || filter.contains("estimate_young_modulus"), "filter.estimate",
+            "empty: name at least one ligament (or region, in estimate_young_modulus) to estimate");
   for (size_t i = 0; i < estimate.size(); ++i) {
     const std::string path = element("filter.estimate", i);
     const int index = ligament_by_name(c, s.ligaments, estimate[i], path);
@@ -555,6 +633,7 @@ void read_filter(const Checker& c, const json& root, Scenario& s) {
     c.positive(k, path);
     spec.initial_stiffness.push_back(k);
   }
+  read_estimated_regions(c, filter, s, spec);
   spec.initial_log_std = c.number_or(filter, "filter", "initial_log_std", spec.initial_log_std);
   c.positive(spec.initial_log_std, "filter.initial_log_std");
   spec.parameter_drift_log_std =
@@ -670,7 +749,7 @@ Scenario load_scenario(const std::string& path) {
             "this program reads " + in_quotes(kFormat) + ", found " + in_quotes(s.format));
   c.check_object(root, "",
                  {"format", "name", "description", "mesh", "material", "damping", "gravity", "time",
-                  "solver", "ligaments", "candidate_regions", "control", "events", "observations",
+                  "solver", "ligaments", "regions", "candidate_regions", "control", "events", "observations",
                   "filter", "output", "effects"},
                  {"format", "mesh", "material", "time", "control"});
 
@@ -685,6 +764,7 @@ Scenario load_scenario(const std::string& path) {
   read_mesh_section(c, root, path, s);
   read_physics(c, root, s);
   read_ligaments(c, root, s);
+  read_regions(c, root, s);
   read_control(c, root, path, s);
   read_candidate_regions(c, root, s);
   read_events(c, root, s);

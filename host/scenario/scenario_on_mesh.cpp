@@ -121,6 +121,13 @@ Scenario scenario_on_mesh(const Scenario& scenario, Mesh mesh, const std::string
   s.control.nodes = resolver.resolve(s.control.selection, s.control.nodes);
   for (Ligament& region : s.candidate_regions) region.nodes = resolver.resolve(region.selection, region.nodes);
   resolve_automatic_regions(scenario, resolver, s);
+  // A region is selected again by element centroids: on a finer mesh its border follows the
+  // finer elements, as a real inclusion's would not follow the model's.
+  for (Region& region : s.regions) {
+    region.elements = select_elements(s.mesh, region.selection);
+    if (region.elements.empty())
+      throw InputError(source + ": " + region.selection.field + ": holds the centroid of no tetrahedron of this mesh");
+  }
   // The observed points are located on the other mesh by the caller (host/generator/truth_mesh.h).
   s.observations.nodes.clear();
   s.observations.points.clear();

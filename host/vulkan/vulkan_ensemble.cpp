@@ -17,7 +17,7 @@ std::uint32_t groups_for(std::size_t items) {
 
 }  // namespace
 
-VulkanEnsemble::VulkanEnsemble(const Model& model, std::vector<int> estimated,
+VulkanEnsemble::VulkanEnsemble(const Model& model, EstimatedParameters estimated,
                                ObservedPoints observed, int sigma_count,
                                const DeviceOptions& options)
     : DeviceEnsemble(model, std::move(estimated), std::move(observed), sigma_count,

@@ -32,7 +32,7 @@ class VulkanEnsemble : public DeviceEnsemble {
   // `estimated`: indices into model.ligaments whose log-stiffness the parameters are;
   // `observed`: the observed points (node indices convert). Throws DeviceError (no device,
   // shader failure, too little memory).
-  VulkanEnsemble(const Model& model, std::vector<int> estimated, ObservedPoints observed,
+  VulkanEnsemble(const Model& model, EstimatedParameters estimated, ObservedPoints observed,
                  int sigma_count, const DeviceOptions& options);
 
   StepReport advance(const Eigen::Vector3d& so_position) override;

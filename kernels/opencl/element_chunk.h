@@ -26,6 +26,7 @@ static inline __attribute__((always_inline)) void sf_element_chunk_products(
     real vmu;
     uint corner_nodes[4];
     SF_LOAD_ELEMENT(rest, nodes, e, grad, vlambda, vmu, corner_nodes)
+    const uint region = SF_REGION_SCALES + SF_REGION_SLOT(rest, e);
     /* The products of all sigma points first, then the additions, each a loop over the
      * sigma points on contiguous data: the compiler vectorises both (with the additions in
      * the first loop it could not, not knowing that the corners' nodes differ). */
@@ -36,7 +37,9 @@ static inline __attribute__((always_inline)) void sf_element_chunk_products(
       real product[12];
       SF_LOAD_FRAME(frames, e, first + s, S, frame)
       SF_GATHER_CORNERS(d, corner_nodes, s, stride, corner)
-      sf_element_product(frame, grad, vlambda * lambda_scale[s], vmu, corner, product);
+      const real region_scale = SF_SIGMA_CONSTANT(c, region, first + s, S);
+      sf_element_product(frame, grad, vlambda * lambda_scale[s] * region_scale, vmu * region_scale, corner,
+                         product);
       SF_UNROLL
       for (int i = 0; i < 12; ++i) products[i][s] = product[i];
     }

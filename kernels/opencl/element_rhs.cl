@@ -40,7 +40,9 @@ static inline __attribute__((always_inline)) void sf_element_rhs_block(
 #endif
   for (uint b = 0; b < SF_SIGMA_BLOCK; ++b) {
     const uint s = first + b;
-    const real sigma_lambda = vlambda * SF_SIGMA_CONSTANT(c, SF_LAMBDA_SCALE, s, S);
+    real sigma_lambda;
+    real sigma_mu;
+    SF_SIGMA_LAME(rest, c, e, s, S, vlambda, vmu, sigma_lambda, sigma_mu)
     real frame[9];
     real corner[12];
     real force[12];
@@ -51,16 +53,16 @@ static inline __attribute__((always_inline)) void sf_element_rhs_block(
 #else
     sf_element_frame(corner, frame);
 #endif
-    sf_element_force(frame, grad, sigma_lambda, vmu, corner, force);
+    sf_element_force(frame, grad, sigma_lambda, sigma_mu, corner, force);
     SF_GATHER_CORNERS(v, corner_nodes, s, S, corner)
-    sf_element_product(frame, grad, sigma_lambda, vmu, corner, product);
+    sf_element_product(frame, grad, sigma_lambda, sigma_mu, corner, product);
     SF_UNROLL
     for (int i = 0; i < 12; ++i)
       block_rhs[i][b] = force[i] - SF_SIGMA_CONSTANT(c, SF_VELOCITY_FACTOR, s, S) * product[i];
     SF_UNROLL
     for (int i = 0; i < 9; ++i) block_frames[i][b] = frame[i];
 #if !SF_FACTOR /* the Jacobi diagonal, which a factor does not need */
-    sf_element_diagonal(frame, grad, sigma_lambda, vmu, product);
+    sf_element_diagonal(frame, grad, sigma_lambda, sigma_mu, product);
     SF_UNROLL
     for (int i = 0; i < 12; ++i) block_diagonal[i][b] = product[i];
 #endif

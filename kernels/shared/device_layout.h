@@ -13,8 +13,10 @@
 
 #include "dialect.h"
 
-/* The element rest state, 16 numbers per element: grad[12], vlambda, vmu, two unused. */
+/* The element rest state, 16 numbers per element: grad[12], vlambda, vmu, the element's region
+ * slot (step_constants.h, SF_REGION_SCALES; a small integer held as a real), one unused. */
 #define SF_REST_STRIDE 16u
+#define SF_REST_REGION_SLOT 14u
 
 /* The index helpers of the element kernels, over the buffers of the layout above. */
 /* Element e's rest state (element.h's grad[12], vlambda, vmu) and its four nodes (uint). */
@@ -24,6 +26,16 @@
   vlambda = rest[SF_INDEX(e) * SF_REST_STRIDE + 12u];                                  \
   vmu = rest[SF_INDEX(e) * SF_REST_STRIDE + 13u];                                      \
   SF_UNROLL for (uint c_ = 0u; c_ < 4u; ++c_) corner_nodes[c_] = SF_UINT(nodes[4u * (e) + c_]);
+/* Element e's region slot (step_constants.h, SF_REGION_SCALES). */
+#define SF_REGION_SLOT(rest, e) SF_UINT(rest[SF_INDEX(e) * SF_REST_STRIDE + SF_REST_REGION_SLOT])
+/* Sigma point s's Lame terms of element e from its rest state's vlambda and vmu: lambda times
+ * the sigma point's lambda_scale, both times its scale of the element's region slot. */
+#define SF_SIGMA_LAME(rest, c, e, s, S, vlambda, vmu, sigma_lambda, sigma_mu)                 \
+  {                                                                                           \
+    SF_REAL region_ = SF_SIGMA_CONSTANT(c, SF_REGION_SCALES + SF_REGION_SLOT(rest, e), s, S); \
+    sigma_lambda = vlambda * SF_SIGMA_CONSTANT(c, SF_LAMBDA_SCALE, s, S) * region_;           \
+    sigma_mu = vmu * region_;                                                                 \
+  }
 /* A per-dof buffer's values at an element's four corners for sigma point s. */
 #define SF_GATHER_CORNERS(v, corner_nodes, s, S, out)                                \
   SF_UNROLL for (uint c_ = 0u; c_ < 4u; ++c_)                                          \

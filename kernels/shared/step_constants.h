@@ -25,10 +25,15 @@
 #define SF_VELOCITY_FACTOR 11    /* h + a */
 #define SF_LAMBDA_SCALE 12       /* multiplies the elements' Lame lambda (lambda_scale; mu kept) */
 #define SF_SIGMA_CONSTANT_COUNT 13
+/* Then, from k = SF_REGION_SCALES, one per region slot: what multiplies both Lame terms of the
+ * elements whose rest state names that slot (device_layout.h, SF_REST_REGION_SLOT): slot 0,
+ * always 1, for the elements of no estimated region; slot 1 + r for estimated region r, its
+ * sigma point's Young's modulus over the model's (issue 19). */
+#define SF_REGION_SCALES SF_SIGMA_CONSTANT_COUNT
 
 /* The most parameters a device ensemble estimates (the re-centring's arrays, recenter.h;
  * the host's kDeviceMaxParameters). */
-#define SF_MAX_PARAMETERS 16
+#define SF_MAX_PARAMETERS 64
 
 /* Constant k of sigma point s, with S sigma points, in the buffer c. */
 #define SF_SIGMA_CONSTANT(c, k, s, S) ((c)[SF_STEP_CONSTANTS + (k) * (S) + (s)])

@@ -28,12 +28,14 @@ void main() {
   real vmu;
   uint corner_nodes[4];
   SF_LOAD_ELEMENT(rest, nodes, e, grad, vlambda, vmu, corner_nodes)
-  vlambda *= SF_SIGMA_CONSTANT(c, SF_LAMBDA_SCALE, s, S);
+  real sigma_lambda;
+  real sigma_mu;
+  SF_SIGMA_LAME(rest, c, e, s, S, vlambda, vmu, sigma_lambda, sigma_mu)
   real frame[9];
   real corner[12];
   real product[12];
   SF_LOAD_FRAME(frames, e, s, S, frame)
   SF_GATHER_CORNERS(d, corner_nodes, s, S, corner)
-  sf_element_product(frame, grad, vlambda, vmu, corner, product);
+  sf_element_product(frame, grad, sigma_lambda, sigma_mu, corner, product);
   SF_STORE_CORNERS(element_out, e, s, S, product)
 }

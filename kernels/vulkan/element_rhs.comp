@@ -30,7 +30,9 @@ void main() {
   real vmu;
   uint corner_nodes[4];
   SF_LOAD_ELEMENT(rest, nodes, e, grad, vlambda, vmu, corner_nodes)
-  vlambda *= SF_SIGMA_CONSTANT(c, SF_LAMBDA_SCALE, s, S);
+  real sigma_lambda;
+  real sigma_mu;
+  SF_SIGMA_LAME(rest, c, e, s, S, vlambda, vmu, sigma_lambda, sigma_mu)
   real frame[9];
   real corner[12];
   real force[12];
@@ -38,11 +40,11 @@ void main() {
   SF_GATHER_CORNERS(x, corner_nodes, s, S, corner)
   sf_element_rotation(grad, corner, c[SF_POLAR_ROTATION], frame);
   SF_STORE_FRAME(frames, e, s, S, frame)
-  sf_element_force(frame, grad, vlambda, vmu, corner, force);
+  sf_element_force(frame, grad, sigma_lambda, sigma_mu, corner, force);
   SF_GATHER_CORNERS(v, corner_nodes, s, S, corner)
-  sf_element_product(frame, grad, vlambda, vmu, corner, product);
+  sf_element_product(frame, grad, sigma_lambda, sigma_mu, corner, product);
   for (uint i = 0u; i < 12u; ++i) force[i] -= SF_SIGMA_CONSTANT(c, SF_VELOCITY_FACTOR, s, S) * product[i];
   SF_STORE_CORNERS(element_out, e, s, S, force)
-  sf_element_diagonal(frame, grad, vlambda, vmu, product);
+  sf_element_diagonal(frame, grad, sigma_lambda, sigma_mu, product);
   SF_STORE_CORNERS(element_diagonal, e, s, S, product)
 }

@@ -108,7 +108,7 @@ TEST_F(DeviceBuffersTest, TheEstimatedLigamentsShareOutTheirStiffnessPerNode) {
   const std::vector<double> before = ligament_k;
   Eigen::MatrixXd theta(1, S);
   theta << std::log(120.0), std::log(480.0);
-  ligament_k_from_theta(model_, {1}, theta, S, ligament_k);
+  EXPECT_EQ(parameters_from_theta(model_, {1}, theta, S, ligament_k).rows(), 0);
   const double nodes = static_cast<double>(model_.ligaments[1].nodes.size());
   EXPECT_NEAR(ligament_k[1 * S + 0], 120.0 / nodes, 1e-12);
   EXPECT_NEAR(ligament_k[1 * S + 1], 480.0 / nodes, 1e-12);
@@ -116,6 +116,26 @@ TEST_F(DeviceBuffersTest, TheEstimatedLigamentsShareOutTheirStiffnessPerNode) {
   EXPECT_EQ(ligament_k[0], before[0]);
   EXPECT_EQ(ligament_k[2 * S + 1], before[2 * S + 1]);
   EXPECT_NEAR(before[0], model_.ligaments[0].stiffness / static_cast<double>(model_.ligaments[0].nodes.size()), 1e-12);
+}
+
+// A region's elements name its slot in their rest state (slot 0: no estimated region), and
+// theta's region rows become the scales of the model's modulus the kernels multiply by.
+TEST_F(DeviceBuffersTest, AnEstimatedRegionsElementsNameItsSlotAndTakeTheirScale) {
+  Model model = model_;
+  model.regions.push_back({"unestimated", {0, 1}, 5000.0});
+  model.regions.push_back({"tumour", {2, 7}, 2000.0});
+  const int S = 2;
+  const std::vector<double> rest =
+      spec(device_buffer_specs(model, scenario_.observations.observed, S, 1, {}, {1}), DeviceBuffer::element_rest).reals;
+  for (int e : {0, 1, 3, 8}) EXPECT_EQ(rest[16 * e + SF_REST_REGION_SLOT], 0.0) << e;
+  for (int e : {2, 7}) EXPECT_EQ(rest[16 * e + SF_REST_REGION_SLOT], 1.0) << e;
+  std::vector<double> ligament_k(static_cast<std::size_t>(model.ligaments.size()) * S, 0.0);
+  Eigen::MatrixXd theta(2, S);
+  theta << std::log(100.0), std::log(200.0), std::log(3000.0), std::log(10000.0);
+  const Eigen::MatrixXd scales = parameters_from_theta(model, EstimatedParameters({0}, {1}), theta, S, ligament_k);
+  ASSERT_EQ(scales.rows(), 1);
+  EXPECT_NEAR(scales(0, 0), 1.5, 1e-12);
+  EXPECT_NEAR(scales(0, 1), 5.0, 1e-12);
 }
 
 }  // namespace

@@ -1,0 +1,147 @@
+// regions (docs/FORMATS.md, issue 19): parts of the organ with a Young's modulus of their own,
+// selected by element centroids; the model scales their elements' Lame terms; the filter may
+// estimate their moduli after the ligaments (filter.estimate_young_modulus); bad values are
+// named.
+#include <gtest/gtest.h>
+
+#include <nlohmann/json.hpp>
+#include <set>
+
+#include "host/common/input_error.h"
+#include "host/engine/estimation_options.h"
+#include "host/mesh/mesh.h"
+#include "host/model/model.h"
+#include "host/scenario/scenario.h"
+#include "host/scenario/scenario_on_mesh.h"
+#include "temp_path.h"
+
+namespace sigmafem {
+namespace {
+
+using nlohmann::json;
+
+class RegionsTest : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    dir_.copy(std::string(SIGMAFEM_SOURCE_DIR) + "/scenarios/box.msh", "box.msh");
+    scenario_ = json::parse(R"({
+      "format": "sigmafem-scenario/1",
+      "mesh": {"file": "box.msh"},
+      "material": {"young_modulus": 5000, "poisson_ratio": 0.45, "density": 1000},
+      "time": {"dt": 0.01, "steps": 10},
+      "ligaments": [{"name": "corner_a", "select": {"near": [0, 0, 0], "radius": 0.035}, "stiffness": 150}],
+      "regions": [
+        {"name": "left", "select": {"box": {"min": [-1, -1, -1], "max": [0.1, 1, 1]}}, "young_modulus": 25000},
+        {"name": "middle", "select": {"box": {"min": [0.1, -1, -1], "max": [0.2, 1, 1]}}}
+      ],
+      "control": {"select": {"near": [0.3, 0.075, 0.075], "radius": 0.032}, "stiffness": 10000,
+                  "trajectory": {"type": "linear", "velocity": [0.004, 0.002, 0.001]}},
+      "observations": {"nodes": [1, 2]},
+      "filter": {"estimate": ["corner_a"], "initial_stiffness": [300],
+                 "estimate_young_modulus": ["middle", "left"], "initial_young_modulus": [4000, 6000],
+                 "observation_std": 0.001}
+    })");
+  }
+  Scenario load(const json& scenario) const { return load_scenario(dir_.write("case.json", scenario.dump(2))); }
+  std::string error_of(const json& scenario) const {
+    try {
+      load(scenario);
+    } catch (const InputError& e) {
+      return e.what();
+    }
+    return "(loaded)";
+  }
+  test::TempDir dir_;
+  json scenario_;
+};
+
+Eigen::Vector3d centroid(const Mesh& mesh, int e) {
+  Eigen::Vector3d c = Eigen::Vector3d::Zero();
+  for (int node : mesh.tetrahedra[static_cast<std::size_t>(e)]) c += 0.25 * mesh.nodes[static_cast<std::size_t>(node)];
+  return c;
+}
+
+TEST_F(RegionsTest, ARegionHoldsTheElementsWhoseCentroidItsSelectionHolds) {
+  const Scenario s = load(scenario_);
+  ASSERT_EQ(s.regions.size(), 2u);
+  EXPECT_EQ(s.regions[0].young_modulus, 25000.0);
+  EXPECT_EQ(s.regions[1].young_modulus, 5000.0) << "left out: the material's";
+  const std::set<int> left(s.regions[0].elements.begin(), s.regions[0].elements.end());
+  const std::set<int> middle(s.regions[1].elements.begin(), s.regions[1].elements.end());
+  ASSERT_FALSE(left.empty());
+  ASSERT_FALSE(middle.empty());
+  for (int e = 0; e < s.mesh.tetrahedron_count(); ++e) {
+    const double x = centroid(s.mesh, e).x();
+    EXPECT_EQ(left.count(e) == 1, x <= 0.1 + kSelectionSlack) << e;
+    EXPECT_EQ(middle.count(e) == 1, x >= 0.1 - kSelectionSlack && x <= 0.2 + kSelectionSlack) << e;
+  }
+}
+
+TEST_F(RegionsTest, TheModelScalesItsRegionsLameTermsByTheirModulus) {
+  const Scenario s = load(scenario_);
+  json plain = scenario_;
+  plain.erase("regions");
+  plain["filter"].erase("estimate_young_modulus");
+  plain["filter"].erase("initial_young_modulus");
+  const Model with = make_model(s), without = make_model(load(plain));
+  const std::set<int> left(s.regions[0].elements.begin(), s.regions[0].elements.end());
+  for (int e = 0; e < with.element_count(); ++e) {
+    const double scale = left.count(e) ? 5.0 : 1.0;
+    EXPECT_DOUBLE_EQ(with.elements[e].vlambda, scale * without.elements[e].vlambda) << e;
+    EXPECT_DOUBLE_EQ(with.elements[e].vmu, scale * without.elements[e].vmu) << e;
+  }
+  ASSERT_EQ(with.regions.size(), 2u);
+  EXPECT_EQ(with.regions[0].name, "left");
+  EXPECT_EQ(with.regions[0].young_modulus, 25000.0);
+}
+
+TEST_F(RegionsTest, TheFilterEstimatesTheModuliAfterTheLigaments) {
+  const Scenario s = load(scenario_);
+  EXPECT_EQ(s.filter->estimate_regions, (std::vector<int>{1, 0}));
+  EXPECT_EQ(s.parameter_names(), (std::vector<std::string>{"corner_a", "E:middle", "E:left"}));
+  EXPECT_EQ(s.truth_names(), (std::vector<std::string>{"corner_a", "E:left", "E:middle"}));
+  const EstimationOptions options = estimation_options(s);
+  ASSERT_EQ(options.roukf.initial_theta.size(), 3);
+  EXPECT_DOUBLE_EQ(options.roukf.initial_theta[1], std::log(4000.0));
+  EXPECT_DOUBLE_EQ(options.roukf.initial_theta[2], std::log(6000.0));
+  EXPECT_EQ(options.stiffness_count, 1) << "a modulus is no stiffness to check against N/m bounds";
+}
+
+TEST_F(RegionsTest, OnAFinerMeshTheRegionsAreSelectedAgain) {
+  const Scenario s = load(scenario_);
+  const Scenario fine = scenario_on_mesh(s, refine_uniform(s.mesh), "refined");
+  ASSERT_EQ(fine.regions.size(), 2u);
+  for (int e : fine.regions[0].elements) EXPECT_LE(centroid(fine.mesh, e).x(), 0.1 + kSelectionSlack);
+  // About the same volume: 8 children per element, the border moved by less than an element.
+  const double ratio = static_cast<double>(fine.regions[0].elements.size()) / (8.0 * static_cast<double>(s.regions[0].elements.size()));
+  EXPECT_NEAR(ratio, 1.0, 0.25);
+}
+
+TEST_F(RegionsTest, BadRegionsAreNamed) {
+  json overlap = scenario_;
+  overlap["regions"][1]["select"]["box"]["min"][0] = 0.05;
+  EXPECT_NE(error_of(overlap).find("also in regions[0] \"left\""), std::string::npos) << error_of(overlap);
+  json empty = scenario_;
+  empty["regions"][1]["select"] = json::parse(R"({"near": [5, 5, 5], "radius": 0.01})");
+  EXPECT_NE(error_of(empty).find("regions[1] \"middle\".select: holds the centroid of no tetrahedron"), std::string::npos)
+      << error_of(empty);
+  json soft = scenario_;
+  soft["regions"][0]["young_modulus"] = 0;
+  EXPECT_NE(error_of(soft).find("young_modulus"), std::string::npos) << error_of(soft);
+  json twice = scenario_;
+  twice["regions"][1]["name"] = "left";
+  EXPECT_NE(error_of(twice).find("duplicate region name"), std::string::npos) << error_of(twice);
+  json unknown = scenario_;
+  unknown["filter"]["estimate_young_modulus"][0] = "tumour";
+  EXPECT_NE(error_of(unknown).find("no region \"tumour\" (regions: left, middle)"), std::string::npos)
+      << error_of(unknown);
+  json counts = scenario_;
+  counts["filter"]["initial_young_modulus"] = json::array({4000});
+  EXPECT_NE(error_of(counts).find("1 values for 2 regions"), std::string::npos) << error_of(counts);
+  json no_prior = scenario_;
+  no_prior["filter"].erase("initial_young_modulus");
+  EXPECT_NE(error_of(no_prior).find("needs initial_young_modulus"), std::string::npos) << error_of(no_prior);
+}
+
+}  // namespace
+}  // namespace sigmafem
