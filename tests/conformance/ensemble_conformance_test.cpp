@@ -40,6 +40,7 @@
 #include "host/scenario/scenario.h"
 #include "host/vulkan/vulkan_device.h"
 #include "requirement.h"
+#include "step_constants.h"
 
 namespace sigmafem {
 namespace {
@@ -768,6 +769,77 @@ std::vector<BackendCase> region_cases() {
 }
 
 INSTANTIATE_TEST_SUITE_P(Backends, RegionConformance, ::testing::ValuesIn(region_cases()), backend_case_name);
+
+// Issue 19's largest parameter vector on every back end: the liver's 3 ligaments and 61
+// regions (elements e with e % 61 = r), p = 64, S = 65 (simplex), each sigma point with its
+// own moduli; 3 steps, a re-centring with 64 directions (the recenter kernels' arrays are
+// SF_MAX_PARAMETERS = 64 long), 3 more; every sigma point's positions against the CPU
+// reference's doing the same, within the trajectory tolerance.
+class SixtyFourParameters : public ::testing::TestWithParam<BackendCase> {};
+
+TEST_P(SixtyFourParameters, TheLargestEnsembleFollowsTheReference) {
+  const BackendCase& backend = GetParam();
+  const std::string why = unavailable(backend);
+  if (!why.empty()) SIGMAFEM_MISSING(why);
+  Scenario scenario = conformance_scenario("liver");
+  constexpr int kRegions = 61;
+  for (int r = 0; r < kRegions; ++r) {
+    Region region;
+    region.name = "r" + std::to_string(r);
+    for (int e = r; e < scenario.mesh.tetrahedron_count(); e += kRegions) region.elements.push_back(e);
+    region.young_modulus = scenario.material.young_modulus;
+    scenario.regions.push_back(region);
+  }
+  const Model model = make_model(scenario);
+  std::vector<int> regions(kRegions);
+  for (int r = 0; r < kRegions; ++r) regions[static_cast<std::size_t>(r)] = r;
+  const EstimatedParameters estimated(scenario.filter->estimate, regions);
+  const int p = estimated.count(), S = p + 1;
+  ASSERT_EQ(p, SF_MAX_PARAMETERS);
+  Eigen::MatrixXd theta(p, S);
+  theta.topRows(3) = sigma_theta(model, scenario.filter->estimate, S);
+  for (int s = 0; s < S; ++s)
+    for (int k = 0; k < kRegions; ++k)
+      theta(estimated.region_row(static_cast<std::size_t>(k)), s) =
+          std::log(scenario.material.young_modulus * std::pow(2.0, std::sin(0.7 * s + 1.9 * k)));
+  Recentering r;
+  r.alpha = 1.0 / S;
+  r.directions = Eigen::MatrixXd::Zero(p, S);
+  for (int s = 0; s < S; ++s)
+    for (int j = 0; j < p; ++j) r.directions(j, s) = std::sin(2.0 * s + j);
+  for (int j = 0; j < p; ++j) r.directions.row(j).array() -= r.directions.row(j).mean();
+  r.correction = Eigen::VectorXd::LinSpaced(p, -0.3, 0.4);
+  r.factor = Eigen::MatrixXd::Identity(p, p) * 0.8;
+  r.factor(0, p - 1) = 0.1;
+  auto device = make_ensemble(backend.backend, model, estimated, scenario.observations.observed, S,
+                              device_options(backend));
+  CpuEnsemble reference(model, estimated, scenario.observations.observed, S, 0, Preconditioner::jacobi);
+  for (Ensemble* ensemble : {static_cast<Ensemble*>(device.get()), static_cast<Ensemble*>(&reference)}) {
+    ensemble->set_parameters(theta);
+    for (int k = 1; k <= 6; ++k) {
+      if (k == 4) ensemble->recenter(r);
+      ASSERT_EQ(ensemble->advance(so_position(scenario, k)).unconverged_count(), 0) << "step " << k;
+    }
+  }
+  auto* on_device = dynamic_cast<DeviceEnsemble*>(device.get());
+  ASSERT_NE(on_device, nullptr);
+  double largest = 0.0;
+  for (int s = 0; s < S; ++s)
+    largest = std::max(largest, (on_device->positions(s) - reference.simulation(s).positions()).cwiseAbs().maxCoeff());
+  std::cout << backend.name << ": p = " << p << ", S = " << S << ", largest position difference " << largest << " m\n";
+  EXPECT_LT(largest, backend.precision == Precision::single ? 1e-6 : 3e-13);
+}
+
+// One case per back end, float32 (the indexing is that of any precision; RegionConformance
+// runs the region scales through every element form).
+std::vector<BackendCase> sixty_four_cases() {
+  std::vector<BackendCase> cases;
+  for (const BackendCase& c : backend_cases())
+    if (c.name == "OpenClSingle" || c.name == "VulkanSingle") cases.push_back(c);
+  return cases;
+}
+
+INSTANTIATE_TEST_SUITE_P(Backends, SixtyFourParameters, ::testing::ValuesIn(sixty_four_cases()), backend_case_name);
 
 // Vulkan against OpenCL: the same 60 steps with the cut on the box, S = 4, observed
 // positions compared at every step. Each back end is within the trajectory tolerance of the
