@@ -68,9 +68,11 @@ Action add_diagnose_command(CLI::App& app) {
     const Scenario scenario = load_scenario(options->scenario);
     if (!scenario.filter)
       throw InputError("scenario " + scenario.path + ": filter: missing; diagnose needs a filter block");
-    if (!scenario.filter->estimate_regions.empty())
-      throw InputError("scenario " + scenario.path + ": filter.estimate_young_modulus: diagnose estimates "
-                       "ligaments and candidate effects only; use estimate for the regions' moduli");
+    if (!scenario.filter->estimate_regions.empty() || !scenario.filter->estimate_springs.empty())
+      throw InputError("scenario " + scenario.path + ": filter." +
+                       (scenario.filter->estimate_springs.empty() ? "estimate_young_modulus" : "estimate_springs") +
+                       ": diagnose estimates whole ligaments and candidate effects only; use estimate for the "
+                       "fields (regions' moduli, ligaments per spring)");
     const fs::path data(options->data_dir);
     const ObservationTable table = read_observations_csv(
         (data / "observations.csv").string(), static_cast<int>(scenario.observations.observed.size()), scenario.time.dt);

@@ -51,16 +51,15 @@ json run_estimation_job(const Scenario& scenario, const EstimationJob& job) {
     table.points.middleCols(c, 3).rowwise() -= offset.transpose();
   std::optional<TruthTable> truth;
   truth = read_optional_truth_csv((data / "truth.csv").string(), scenario.truth_names(), table.row_count(), std::cerr);
-  const EstimatedParameters estimated = estimated_parameters(spec);
+  Model model = make_model(scenario);
+  const EstimatedParameters estimated = estimated_parameters(spec, model);   // splits the springs estimated alone
 
   EstimationOptions options = estimation_options(scenario);
   const bool outlier_gate = options.roukf.outlier_gate.enabled;   // a cloud's observation takes it over
   if (!job.sigma_points.empty()) options.roukf.sigma_points = parse_sigma_point_set(job.sigma_points);
-  const int sigma_count =
-      sigma_point_count(options.roukf.sigma_points, estimated.count());
+  const int sigma_count = sigma_point_count(options.roukf.sigma_points, estimated.count());
 
   fs::create_directories(job.out_dir);
-  const Model model = make_model(scenario);
   const BackendDecision backend = resolve_backend(job.backend, model, sigma_count);
   if (job.out) *job.out << "backend: " << backend.backend << " (" << backend.reason << ")\n" << std::flush;
   // A surface cloud (observations.surface_cloud): the ensemble observes the surface's nodes

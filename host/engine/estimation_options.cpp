@@ -8,15 +8,17 @@ EstimationOptions estimation_options(const Scenario& scenario) {
   const FilterSpec& spec = *scenario.filter;
   EstimationOptions options;
   options.roukf.sigma_points = parse_sigma_point_set(spec.sigma_points);
-  // Ligaments' log-stiffness, then regions' log Young's modulus (host/model/estimated_parameters.h).
-  const Eigen::Index ligaments = static_cast<Eigen::Index>(spec.estimate.size());
-  options.roukf.initial_theta.resize(ligaments + static_cast<Eigen::Index>(spec.estimate_regions.size()));
-  for (Eigen::Index j = 0; j < ligaments; ++j)
-    options.roukf.initial_theta[j] = std::log(spec.initial_stiffness[static_cast<std::size_t>(j)]);
-  for (std::size_t k = 0; k < spec.estimate_regions.size(); ++k)
-    options.roukf.initial_theta[ligaments + static_cast<Eigen::Index>(k)] = std::log(spec.initial_young_modulus[k]);
+  // Ligaments' log-stiffness, then their springs', then regions' log Young's modulus
+  // (Scenario::parameter_names).
+  std::vector<double> prior(spec.initial_stiffness);
+  for (std::size_t i = 0; i < spec.estimate_springs.size(); ++i)
+    prior.insert(prior.end(), scenario.ligaments[static_cast<std::size_t>(spec.estimate_springs[i])].nodes.size(),
+                 spec.initial_spring_stiffness[i]);
   // Only the stiffnesses are checked against the stiffness range.
-  options.stiffness_count = static_cast<int>(ligaments);
+  options.stiffness_count = static_cast<int>(prior.size());
+  prior.insert(prior.end(), spec.initial_young_modulus.begin(), spec.initial_young_modulus.end());
+  options.roukf.initial_theta.resize(static_cast<Eigen::Index>(prior.size()));
+  for (std::size_t j = 0; j < prior.size(); ++j) options.roukf.initial_theta[static_cast<Eigen::Index>(j)] = std::log(prior[j]);
   options.roukf.initial_log_std = spec.initial_log_std;
   options.roukf.parameter_drift_log_std = spec.parameter_drift_log_std;
   options.roukf.observation_std = spec.observation_std;

@@ -259,8 +259,13 @@ GenerateResult generate(const Scenario& scenario, const GenerateOptions& options
     truth.times.push_back(t);
     for (std::size_t l = 0; l < scenario.ligaments.size(); ++l)
       truth.stiffness(k, static_cast<Eigen::Index>(l)) = simulation.ligament_stiffness()[l];   // declared ones
-    for (std::size_t r = 0; r < scenario.regions.size(); ++r)
-      truth.stiffness(k, static_cast<Eigen::Index>(scenario.ligaments.size() + r)) = scenario.regions[r].young_modulus;
+    auto column = static_cast<Eigen::Index>(scenario.ligaments.size());
+    if (scenario.filter)   // each spring the filter estimates on its own: its part of its ligament
+      for (int l : scenario.filter->estimate_springs)
+        for (std::size_t j = 0; j < scenario.ligaments[static_cast<std::size_t>(l)].nodes.size(); ++j)
+          truth.stiffness(k, column++) = model.ligaments[static_cast<std::size_t>(l)].node_part(
+              j, simulation.ligament_stiffness()[static_cast<std::size_t>(l)]);
+    for (const Region& region : scenario.regions) truth.stiffness(k, column++) = region.young_modulus;
     for (int i = 0; i < model.node_count(); ++i)
       result.max_displacement =
           std::max(result.max_displacement,

@@ -4,6 +4,20 @@
 
 namespace sigmafem {
 
+EstimatedParameters estimated_parameters(const FilterSpec& spec, Model& model) {
+  EstimatedParameters estimated(spec.estimate, spec.estimate_regions);
+  for (int l : spec.estimate_springs) {
+    const SpringSet whole = model.ligaments.at(static_cast<std::size_t>(l));   // a copy: the list grows
+    for (std::size_t k = 0; k < whole.nodes.size(); ++k) {
+      estimated.ligaments.push_back(static_cast<int>(model.ligaments.size()));
+      model.ligaments.push_back({spring_parameter_name(whole.name, whole.nodes[k]), {whole.nodes[k]},
+                                 whole.node_part(k, whole.stiffness), {}});
+    }
+    model.ligaments[static_cast<std::size_t>(l)].stiffness = 0.0;   // its springs hold its nodes now
+  }
+  return estimated;
+}
+
 void check_estimated_parameters(const EstimatedParameters& estimated, const Model& model, const std::string& who) {
   for (int l : estimated.ligaments)
     if (l < 0 || l >= static_cast<int>(model.ligaments.size()))

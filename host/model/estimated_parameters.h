@@ -1,6 +1,7 @@
 // EstimatedParameters: which of a model's quantities an ensemble's parameter vector theta holds,
-// in its row order: the log-stiffness (N/m) of each listed ligament, then the log of each
-// listed region's Young's modulus (Pa; Model::regions, issue 19). The filter's algebra sees p
+// in its row order: the log-stiffness (N/m) of each listed ligament (a whole ligament, or one
+// spring of one split per spring), then the log of each listed region's Young's modulus (Pa;
+// Model::regions, issue 19). The filter's algebra sees p
 // numbers and knows nothing of which is which.
 #pragma once
 
@@ -27,10 +28,12 @@ struct EstimatedParameters {
   int region_row(std::size_t k) const { return static_cast<int>(ligaments.size() + k); }
 };
 
-// What a scenario's filter block estimates (FilterSpec::estimate, estimate_regions).
-inline EstimatedParameters estimated_parameters(const FilterSpec& spec) {
-  return EstimatedParameters(spec.estimate, spec.estimate_regions);
-}
+// What a scenario's filter block estimates, in Scenario::parameter_names' order: the
+// ligaments of spec.estimate, then each spring of spec.estimate_springs, then the regions.
+// Each ligament estimated per spring is split in `model` (made from that scenario): a
+// ligament of one node per spring ("LIGAMENT@NODE", its part of the stiffness) is appended,
+// and the whole one keeps its nodes at zero stiffness.
+EstimatedParameters estimated_parameters(const FilterSpec& spec, Model& model);
 
 // Throws std::invalid_argument naming `who` for an index `model` does not have.
 void check_estimated_parameters(const EstimatedParameters& estimated, const Model& model, const std::string& who);

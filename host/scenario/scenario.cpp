@@ -20,6 +20,10 @@ std::vector<std::string> Scenario::ligament_names() const {
 
 std::vector<std::string> Scenario::truth_names() const {
   std::vector<std::string> names = ligament_names();
+  if (filter)
+    for (int l : filter->estimate_springs)
+      for (int node : ligaments[static_cast<size_t>(l)].nodes)
+        names.push_back(spring_parameter_name(ligaments[static_cast<size_t>(l)].name, node));
   for (const Region& region : regions) names.push_back(young_modulus_parameter_name(region.name));
   return names;
 }
@@ -45,10 +49,17 @@ int Scenario::region_index(const std::string& region_name) const {
 
 std::string young_modulus_parameter_name(const std::string& region_name) { return "E:" + region_name; }
 
+std::string spring_parameter_name(const std::string& ligament, int node) {
+  return ligament + "@" + std::to_string(node);
+}
+
 std::vector<std::string> Scenario::parameter_names() const {
   std::vector<std::string> names;
   if (!filter) return names;
   for (int l : filter->estimate) names.push_back(ligaments[static_cast<size_t>(l)].name);
+  for (int l : filter->estimate_springs)
+    for (int node : ligaments[static_cast<size_t>(l)].nodes)
+      names.push_back(spring_parameter_name(ligaments[static_cast<size_t>(l)].name, node));
   for (int r : filter->estimate_regions) names.push_back(young_modulus_parameter_name(regions[static_cast<size_t>(r)].name));
   return names;
 }

@@ -181,8 +181,13 @@ struct OutlierGateSpec {
 struct FilterSpec {
   std::vector<int> estimate;        // indices into Scenario::ligaments
   std::vector<double> initial_stiffness;   // median prior stiffness per estimated ligament
+  // Ligaments whose every spring (node) the filter estimates on its own (indices into
+  // Scenario::ligaments, none of them in `estimate`), after the ligaments, and the prior
+  // median of each of their springs (N/m).
+  std::vector<int> estimate_springs;
+  std::vector<double> initial_spring_stiffness;
   // Regions whose Young's modulus the filter estimates (indices into Scenario::regions), after
-  // the ligaments in the parameter vector, and their prior medians (Pa).
+  // the springs in the parameter vector, and their prior medians (Pa).
   std::vector<int> estimate_regions;
   std::vector<double> initial_young_modulus;
   double initial_log_std = 1.0;
@@ -230,14 +235,16 @@ struct Scenario {
   int ligament_index(const std::string& name) const;
   // The ligaments' names, in order.
   std::vector<std::string> ligament_names() const;
-  // The columns of generate's truth.csv: the ligaments' names, then "E:REGION" per region.
+  // The columns of generate's truth.csv: the ligaments' names, then "LIGAMENT@NODE" for each
+  // spring the filter estimates on its own, then "E:REGION" per region.
   std::vector<std::string> truth_names() const;
   // Index of the candidate region called `name`, or -1.
   int candidate_region_index(const std::string& name) const;
   // Index of the region (`regions`) called `name`, or -1.
   int region_index(const std::string& name) const;
   // The names of the estimated parameters, in the filter's order: the ligaments', then
-  // "E:REGION" for each estimated Young's modulus (the columns of estimates.csv and truth.csv).
+  // "LIGAMENT@NODE" for each spring of estimate_springs, then "E:REGION" for each estimated
+  // Young's modulus (the columns of estimates.csv and truth.csv).
   std::vector<std::string> parameter_names() const;
   // "" when the region of a regional effect (FAMILY:REGION) is one of candidate_regions,
   // else what is wrong, naming the regions there are.
@@ -257,6 +264,8 @@ std::vector<int> select_nodes_in_box(const Mesh& mesh, const Eigen::Vector3d& mi
                                      const Eigen::Vector3d& max);
 // The tetrahedra whose centroid a `near` or `box` selection holds (regions), sorted.
 std::vector<int> select_elements(const Mesh& mesh, const NodeSetSpec& selection);
+// The name of node `node`'s spring of ligament `ligament` as a parameter: "LIGAMENT@NODE".
+std::string spring_parameter_name(const std::string& ligament, int node);
 // The name of region `name`'s Young's modulus as a parameter: "E:NAME".
 std::string young_modulus_parameter_name(const std::string& region_name);
 

@@ -569,6 +569,39 @@ void read_windowed_test(const Checker& c, const json& object, const std::string&
   }
 }
 
+// filter.estimate_springs (ligament names, not in filter.estimate) and
+// filter.initial_spring_stiffness (N/m per spring, one per ligament).
+void read_estimated_springs(const Checker& c, const json& filter, const Scenario& s, FilterSpec& spec) {
+  const bool has_names = filter.contains("estimate_springs");
+  c.require(has_names == filter.contains("initial_spring_stiffness"),
+            has_names ? "filter" : "filter.initial_spring_stiffness",
+            has_names ? "estimate_springs needs initial_spring_stiffness, the prior median (N/m) of each spring"
+                      : "given without estimate_springs, the ligaments it is the prior of");
+  if (!has_names) return;
+  const json& names = c.array(filter.at("estimate_springs"), "filter.estimate_springs");
+  for (size_t i = 0; i < names.size(); ++i) {
+    const std::string path = element("filter.estimate_springs", i);
+    const int index = ligament_by_name(c, s.ligaments, names[i], path);
+    const std::string& name = s.ligaments[static_cast<size_t>(index)].name;
+    c.require(std::find(spec.estimate.begin(), spec.estimate.end(), index) == spec.estimate.end(), path,
+              "ligament " + in_quotes(name) + " is also in filter.estimate: estimate it whole or per spring, not both");
+    c.require(std::find(spec.estimate_springs.begin(), spec.estimate_springs.end(), index) ==
+                  spec.estimate_springs.end(),
+              path, "ligament " + in_quotes(name) + " is listed twice");
+    spec.estimate_springs.push_back(index);
+  }
+  const json& initial = c.array(filter.at("initial_spring_stiffness"), "filter.initial_spring_stiffness");
+  c.require(initial.size() == names.size(), "filter.initial_spring_stiffness",
+            std::to_string(initial.size()) + " values for " + std::to_string(names.size()) +
+                " ligaments; give one per name in filter.estimate_springs, same order");
+  for (size_t i = 0; i < initial.size(); ++i) {
+    const std::string path = element("filter.initial_spring_stiffness", i);
+    const double k = c.number(initial[i], path);
+    c.positive(k, path);   // the filter works on its log
+    spec.initial_spring_stiffness.push_back(k);
+  }
+}
+
 // filter.estimate_young_modulus (region names) and filter.initial_young_modulus (Pa, one each).
 void read_estimated_regions(const Checker& c, const json& filter, const Scenario& s, FilterSpec& spec) {
   const bool has_names = filter.contains("estimate_young_modulus");
@@ -606,14 +639,17 @@ void read_filter(const Checker& c, const json& root, Scenario& s) {
   if (!root.contains("filter")) return;
   const json& filter = root.at("filter");
   c.check_object(filter, "filter",
-                 {"estimate", "initial_stiffness", "estimate_young_modulus", "initial_young_modulus",
+                 {"estimate", "initial_stiffness", "estimate_springs", "initial_spring_stiffness",
+                  "estimate_young_modulus", "initial_young_modulus",
                   "initial_log_std", "parameter_drift_log_std", "observation_std", "sigma_points",
                   "change_detection", "adaptive_noise", "outlier_gate"},
                  {"estimate", "initial_stiffness", "observation_std"});
   FilterSpec spec;
   const json& estimate = c.array(filter.at("estimate"), "filter.estimate");
-  c.require(!estimate.empty() || filter.contains("estimate_young_modulus"), "filter.estimate",
-            "empty: name at least one ligament (or region, in estimate_young_modulus) to estimate");
+  c.require(!estimate.empty() || filter.contains("estimate_springs") || filter.contains("estimate_young_modulus"),
+            "filter.estimate",
+            "empty: name at least one ligament (or ligament per spring, in estimate_springs, or region, in "
+            "estimate_young_modulus) to estimate");
   for (size_t i = 0; i < estimate.size(); ++i) {
     const std::string path = element("filter.estimate", i);
     const int index = ligament_by_name(c, s.ligaments, estimate[i], path);
@@ -633,6 +669,7 @@ void read_filter(const Checker& c, const json& root, Scenario& s) {
     c.positive(k, path);
     spec.initial_stiffness.push_back(k);
   }
+  read_estimated_springs(c, filter, s, spec);
   read_estimated_regions(c, filter, s, spec);
   spec.initial_log_std = c.number_or(filter, "filter", "initial_log_std", spec.initial_log_std);
   c.positive(spec.initial_log_std, "filter.initial_log_std");

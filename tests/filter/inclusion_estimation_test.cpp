@@ -44,8 +44,9 @@ void expect_inclusion_found(const std::string& backend, const std::string& inclu
   const Scenario s = inclusion_scenario(inclusion);
   const ObservationTable data = test::generated_observations(s);
   const EstimationOptions options = estimation_options(s);
-  const EstimatedParameters estimated = estimated_parameters(*s.filter);
-  auto ensemble = make_ensemble(backend, make_model(s), estimated, s.observations.observed,
+  Model model = make_model(s);
+  const EstimatedParameters estimated = estimated_parameters(*s.filter, model);
+  auto ensemble = make_ensemble(backend, model, estimated, s.observations.observed,
                                 sigma_point_count(options.roukf.sigma_points, estimated.count()));
   const EstimationRun run = run_estimation(*ensemble, options, data.times, data.so, data.points, {});
   ASSERT_TRUE(run.complete) << run.stop_reason;

@@ -1,7 +1,8 @@
-// regions (docs/FORMATS.md, issue 19): parts of the organ with a Young's modulus of their own,
-// selected by element centroids; the model scales their elements' Lame terms; the filter may
-// estimate their moduli after the ligaments (filter.estimate_young_modulus); bad values are
-// named.
+// Parameter fields (docs/FORMATS.md, issue 19). regions: parts of the organ with a Young's
+// modulus of their own, selected by element centroids; the model scales their elements' Lame
+// terms; the filter may estimate their moduli after the ligaments (filter.estimate_young_modulus).
+// filter.estimate_springs: a ligament estimated spring by spring, split in the estimation's
+// model. Bad values are named.
 #include <gtest/gtest.h>
 
 #include <nlohmann/json.hpp>
@@ -10,6 +11,7 @@
 #include "host/common/input_error.h"
 #include "host/engine/estimation_options.h"
 #include "host/mesh/mesh.h"
+#include "host/model/estimated_parameters.h"
 #include "host/model/model.h"
 #include "host/scenario/scenario.h"
 #include "host/scenario/scenario_on_mesh.h"
@@ -20,7 +22,7 @@ namespace {
 
 using nlohmann::json;
 
-class RegionsTest : public ::testing::Test {
+class ParameterFieldsTest : public ::testing::Test {
  protected:
   void SetUp() override {
     dir_.copy(std::string(SIGMAFEM_SOURCE_DIR) + "/scenarios/box.msh", "box.msh");
@@ -61,7 +63,7 @@ Eigen::Vector3d centroid(const Mesh& mesh, int e) {
   return c;
 }
 
-TEST_F(RegionsTest, ARegionHoldsTheElementsWhoseCentroidItsSelectionHolds) {
+TEST_F(ParameterFieldsTest, ARegionHoldsTheElementsWhoseCentroidItsSelectionHolds) {
   const Scenario s = load(scenario_);
   ASSERT_EQ(s.regions.size(), 2u);
   EXPECT_EQ(s.regions[0].young_modulus, 25000.0);
@@ -77,7 +79,7 @@ TEST_F(RegionsTest, ARegionHoldsTheElementsWhoseCentroidItsSelectionHolds) {
   }
 }
 
-TEST_F(RegionsTest, TheModelScalesItsRegionsLameTermsByTheirModulus) {
+TEST_F(ParameterFieldsTest, TheModelScalesItsRegionsLameTermsByTheirModulus) {
   const Scenario s = load(scenario_);
   json plain = scenario_;
   plain.erase("regions");
@@ -95,7 +97,7 @@ TEST_F(RegionsTest, TheModelScalesItsRegionsLameTermsByTheirModulus) {
   EXPECT_EQ(with.regions[0].young_modulus, 25000.0);
 }
 
-TEST_F(RegionsTest, TheFilterEstimatesTheModuliAfterTheLigaments) {
+TEST_F(ParameterFieldsTest, TheFilterEstimatesTheModuliAfterTheLigaments) {
   const Scenario s = load(scenario_);
   EXPECT_EQ(s.filter->estimate_regions, (std::vector<int>{1, 0}));
   EXPECT_EQ(s.parameter_names(), (std::vector<std::string>{"corner_a", "E:middle", "E:left"}));
@@ -107,7 +109,7 @@ TEST_F(RegionsTest, TheFilterEstimatesTheModuliAfterTheLigaments) {
   EXPECT_EQ(options.stiffness_count, 1) << "a modulus is no stiffness to check against N/m bounds";
 }
 
-TEST_F(RegionsTest, OnAFinerMeshTheRegionsAreSelectedAgain) {
+TEST_F(ParameterFieldsTest, OnAFinerMeshTheRegionsAreSelectedAgain) {
   const Scenario s = load(scenario_);
   const Scenario fine = scenario_on_mesh(s, refine_uniform(s.mesh), "refined");
   ASSERT_EQ(fine.regions.size(), 2u);
@@ -117,7 +119,7 @@ TEST_F(RegionsTest, OnAFinerMeshTheRegionsAreSelectedAgain) {
   EXPECT_NEAR(ratio, 1.0, 0.25);
 }
 
-TEST_F(RegionsTest, BadRegionsAreNamed) {
+TEST_F(ParameterFieldsTest, BadRegionsAreNamed) {
   json overlap = scenario_;
   overlap["regions"][1]["select"]["box"]["min"][0] = 0.05;
   EXPECT_NE(error_of(overlap).find("also in regions[0] \"left\""), std::string::npos) << error_of(overlap);
@@ -141,6 +143,35 @@ TEST_F(RegionsTest, BadRegionsAreNamed) {
   json no_prior = scenario_;
   no_prior["filter"].erase("initial_young_modulus");
   EXPECT_NE(error_of(no_prior).find("needs initial_young_modulus"), std::string::npos) << error_of(no_prior);
+}
+
+TEST_F(ParameterFieldsTest, ALigamentEstimatedPerSpringIsSplitInTheModel) {
+  json with_springs = scenario_;
+  with_springs["ligaments"].push_back(json::parse(R"({"name": "far", "nodes": [3, 5], "stiffness": 80})"));
+  with_springs["filter"]["estimate_springs"] = json::array({"far"});
+  with_springs["filter"]["initial_spring_stiffness"] = json::array({30});
+  const Scenario s = load(with_springs);
+  EXPECT_EQ(s.parameter_names(), (std::vector<std::string>{"corner_a", "far@3", "far@5", "E:middle", "E:left"}));
+  EXPECT_EQ(s.truth_names(), (std::vector<std::string>{"corner_a", "far", "far@3", "far@5", "E:left", "E:middle"}));
+  const EstimationOptions options = estimation_options(s);
+  ASSERT_EQ(options.roukf.initial_theta.size(), 5);
+  EXPECT_DOUBLE_EQ(options.roukf.initial_theta[2], std::log(30.0));
+  EXPECT_EQ(options.stiffness_count, 3);
+  Model model = make_model(s);
+  const EstimatedParameters estimated = estimated_parameters(*s.filter, model);
+  EXPECT_EQ(estimated.ligaments, (std::vector<int>{0, 2, 3}));
+  ASSERT_EQ(model.ligaments.size(), 4u);
+  EXPECT_EQ(model.ligaments[1].stiffness, 0.0);
+  EXPECT_EQ(model.ligaments[2].name, "far@3");
+  EXPECT_EQ(model.ligaments[2].nodes, (std::vector<int>{3}));
+  EXPECT_EQ(model.ligaments[3].stiffness, 40.0) << "its part of the ligament";
+  json both = with_springs;
+  both["filter"]["estimate"] = json::array({"corner_a", "far"});
+  both["filter"]["initial_stiffness"] = json::array({300, 80});
+  EXPECT_NE(error_of(both).find("also in filter.estimate"), std::string::npos) << error_of(both);
+  json no_prior = with_springs;
+  no_prior["filter"].erase("initial_spring_stiffness");
+  EXPECT_NE(error_of(no_prior).find("needs initial_spring_stiffness"), std::string::npos) << error_of(no_prior);
 }
 
 }  // namespace
