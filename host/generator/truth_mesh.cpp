@@ -83,7 +83,7 @@ TruthMesh make_truth_mesh(const Scenario& scenario, const TruthMeshOptions& opti
       truth.description = "the scenario's mesh refined " + levels(*options.refine);
       // Regions are element sets: selected again on the refined elements (by centroid).
       for (Region& region : truth.scenario.regions)
-        region.elements = select_elements(truth.scenario.mesh, region.selection);
+        region.elements = region_elements(truth.scenario.mesh, region);
       if (options.spread_springs) {
         const Mesh& fine = truth.scenario.mesh;
         for (const Ligament& ligament : scenario.ligaments)

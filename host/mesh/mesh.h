@@ -21,6 +21,9 @@ inline constexpr int kTetrahedronEdges[6][2] = {{0, 1}, {0, 2}, {0, 3}, {1, 2}, 
 struct Mesh {
   std::vector<Eigen::Vector3d> nodes;            // positions, metres once transformed
   std::vector<std::array<int, 4>> tetrahedra;    // 0-based node indices, positively oriented
+  // Per tetrahedron, the label the file gives it (Gmsh: its physical group; 0 when it has
+  // none), for regions selected by label; empty when the reader keeps none (VTK).
+  std::vector<int> labels;
   int node_count() const { return static_cast<int>(nodes.size()); }
   int tetrahedron_count() const { return static_cast<int>(tetrahedra.size()); }
 };
@@ -68,7 +71,7 @@ BoundarySurface boundary_surface(const Mesh& mesh);
 
 // Uniform refinement: each tetrahedron into eight (edge midpoints added as new nodes after
 // the old ones, old nodes keep their indices; the interior octahedron split along its
-// shortest diagonal). All children positively oriented.
+// shortest diagonal). All children positively oriented, each with its parent's label.
 Mesh refine_uniform(const Mesh& mesh);
 
 }  // namespace sigmafem

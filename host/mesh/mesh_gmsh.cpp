@@ -2,8 +2,10 @@
 //
 // What the three formats have in common, and what this reader relies on:
 //   - the file is a sequence of sections "$Name ... $EndName"; only the nodes and elements
-//     sections are read, every other one ($PhysicalNames, $Entities, $Periodic, $NodeData...)
-//     is skipped whole;
+//     sections are read (and 4.1's $Entities, for the volumes' physical groups), every other
+//     one ($PhysicalNames, $Periodic, $NodeData...) is skipped whole;
+//   - each tetrahedron keeps its physical group as its label (Mesh::labels; 0 without one):
+//     1.0's reg-phys, 2.x's first tag, 4.1's volume entity's first physical tag;
 //   - nodes carry ids (tags) that need not be 1..n nor contiguous (liver2.msh uses 2..1393),
 //     so elements are mapped by id; a node's index in the Mesh is its position in the file;
 //   - one node or element per line, as Gmsh and meshio write them. The reader is line based
@@ -15,7 +17,9 @@
 //   2.x  $MeshFormat / version file-type data-size / $EndMeshFormat
 //        $Nodes / n / id x y z ... / $EndNodes
 //        $Elements / n / id type n-tags tags... node-ids... / $EndElements
-//   4.1  $Nodes / n-blocks n-nodes min-tag max-tag
+//   4.1  $Entities / n-points n-curves n-surfaces n-volumes / a line per entity; a volume's:
+//          tag min-x min-y min-z max-x max-y max-z n-physical physical-tags... n-surfaces ...
+//        $Nodes / n-blocks n-nodes min-tag max-tag
 //          per block: entity-dim entity-tag parametric n / n tag lines / n lines "x y z [u v w]"
 //        $Elements / n-blocks n-elements min-tag max-tag
 //          per block: entity-dim entity-tag type n / n lines "tag node-ids..."
@@ -113,9 +117,37 @@ class GmshReader {
         read_elements_v1_v2();
       }
       expect_end(v1 ? "$ENDELM" : "$EndElements", name);
+    } else if (name == "$Entities" && version_ == GmshVersion::v41) {
+      read_entities_v41();
+      expect_end("$EndEntities", name);
     } else {
       skip_section(name);
     }
+  }
+
+  // The volumes' first physical tags (the labels of their elements); points, curves and
+  // surfaces are skipped a line each.
+  void read_entities_v41() {
+    const std::vector<std::string_view> counts = next_fields("\"n-points n-curves n-surfaces n-volumes\"");
+    if (counts.size() != 4)
+      in_.fail("expected \"n-points n-curves n-surfaces n-volumes\", found " + std::to_string(counts.size()) + " fields");
+    long long lower = 0;
+    for (int k = 0; k < 3; ++k) lower += parse_integer_in(counts[k], 0, kMaxMeshCount, in_, "an entity count");
+    const long long volumes = parse_integer_in(counts[3], 0, kMaxMeshCount, in_, "the volume count");
+    for (long long i = 0; i < lower; ++i) in_.require_line("an entity line");
+    for (long long i = 0; i < volumes; ++i) {
+      const std::vector<std::string_view> fields = next_fields("a volume entity line");
+      if (fields.size() < 8)
+        in_.fail("expected a volume entity \"tag min-x min-y min-z max-x max-y max-z n-physical ...\", found " +
+                 std::to_string(fields.size()) + " fields");
+      const long long tag = parse_integer(fields[0], in_, "a volume tag");
+      const long long physical = parse_integer_in(fields[7], 0, kMaxMeshCount, in_, "the physical tag count");
+      volume_label_[tag] = physical > 0 && fields.size() > 8 ? label_of(fields[8]) : 0;
+    }
+  }
+
+  int label_of(std::string_view field) {
+    return static_cast<int>(parse_integer_in(field, -kMaxMeshCount, kMaxMeshCount, in_, "a physical tag"));
   }
 
   // A section we do not need: skip to its "$End<Name>" (Gmsh 1.0 writes "$END<NAME>").
@@ -221,7 +253,9 @@ class GmshReader {
       const long long id = parse_integer(fields[0], in_, "an element id");
       const long long type = parse_integer(fields[1], in_, "an element type");
       std::size_t first_node = 0;
+      int label = 0;
       if (v1) {
+        label = label_of(fields[2]);
         const long long n = parse_integer_in(fields[4], 0, kMaxMeshCount, in_, "the node count");
         if (fields.size() != fixed + static_cast<std::size_t>(n)) {
           in_.fail("element " + std::to_string(id) + " says it has " + std::to_string(n) +
@@ -235,8 +269,9 @@ class GmshReader {
                    " tags, the line is shorter");
         }
         first_node = fixed + static_cast<std::size_t>(tags);
+        if (tags > 0) label = label_of(fields[3]);
       }
-      add_element(id, type, fields, first_node);
+      add_element(id, type, fields, first_node, label);
     }
   }
 
@@ -258,6 +293,8 @@ class GmshReader {
                  std::to_string(block.size()) + " fields");
       }
       const long long type = parse_integer(block[2], in_, "an element type");
+      const auto volume = volume_label_.find(parse_integer(block[1], in_, "an entity tag"));
+      const int label = volume == volume_label_.end() ? 0 : volume->second;
       const long long count =
           parse_integer_in(block[3], 0, total - read, in_, "the block's element count");
       for (long long i = 0; i < count; ++i) {
@@ -266,7 +303,7 @@ class GmshReader {
           in_.fail("expected an element line \"tag node-tags...\", found " +
                    std::to_string(fields.size()) + " fields");
         }
-        add_element(parse_integer(fields[0], in_, "an element tag"), type, fields, 1);
+        add_element(parse_integer(fields[0], in_, "an element tag"), type, fields, 1, label);
       }
       read += count;
     }
@@ -279,7 +316,7 @@ class GmshReader {
   // Checks that every node id of the element exists (whatever its type: a triangle naming a
   // missing node means the file is broken), keeps tetrahedra, counts the rest.
   void add_element(long long id, long long type, const std::vector<std::string_view>& fields,
-                   std::size_t first_node) {
+                   std::size_t first_node, int label) {
     std::vector<int> nodes;
     nodes.reserve(fields.size() - first_node);
     for (std::size_t k = first_node; k < fields.size(); ++k) {
@@ -303,6 +340,7 @@ class GmshReader {
       in_.fail("more than " + std::to_string(kMaxMeshCount) + " tetrahedra");
     }
     mesh_.tetrahedra.push_back({nodes[0], nodes[1], nodes[2], nodes[3]});
+    mesh_.labels.push_back(label);
   }
 
   // ---- helpers ----------------------------------------------------------------------------
@@ -364,6 +402,7 @@ class GmshReader {
   GmshVersion version_ = GmshVersion::v2;
   Mesh mesh_;
   std::unordered_map<long long, int> node_index_;  // file id -> 0-based index in file order
+  std::unordered_map<long long, int> volume_label_;  // 4.1: volume entity tag -> its first physical tag
   bool have_nodes_ = false;
   bool have_elements_ = false;
   long long other_elements_ = 0;

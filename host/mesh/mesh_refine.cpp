@@ -80,6 +80,8 @@ Mesh refine_uniform(const Mesh& mesh) {
   }
 
   refined.tetrahedra.reserve(8 * mesh.tetrahedra.size());
+  if (!mesh.labels.empty())
+    for (int label : mesh.labels) refined.labels.insert(refined.labels.end(), 8, label);   // the children's order below
   for (int e = 0; e < mesh.tetrahedron_count(); ++e) {
     std::array<int, 10> local;
     for (int k = 0; k < 4; ++k) local[k] = mesh.tetrahedra[e][k];

@@ -46,4 +46,12 @@ std::vector<int> select_elements(const Mesh& mesh, const NodeSetSpec& selection)
   return selected;
 }
 
+std::vector<int> region_elements(const Mesh& mesh, const Region& region) {
+  if (!region.label) return select_elements(mesh, region.selection);
+  std::vector<int> elements;
+  for (std::size_t e = 0; e < mesh.labels.size(); ++e)
+    if (mesh.labels[e] == *region.label) elements.push_back(static_cast<int>(e));
+  return elements;
+}
+
 }  // namespace sigmafem

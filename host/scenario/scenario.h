@@ -78,13 +78,15 @@ struct Ligament {
 
 // A part of the organ with a Young's modulus of its own (a tumour is stiffer; issue 19), which
 // the filter may estimate (filter.estimate_young_modulus). Its elements are those whose rest
-// centroid lies in the selection (near + radius, or box; `selection` keeps how it was
-// written, so that scenario_on_mesh can select again on another mesh).
+// centroid lies in the selection (near + radius, or box), or those the mesh file labels
+// `label` (a Gmsh physical group); `selection` and `label` keep how it was written, so that
+// scenario_on_mesh can select again on another mesh (region_elements).
 struct Region {
   std::string name;
   std::vector<int> elements;        // sorted, unique, never empty
   double young_modulus = 0.0;       // Pa: the truth's (generate) and the model's until estimated
   NodeSetSpec selection = {};
+  std::optional<int> label;         // set: by label, `selection` unused but for its field
 };
 
 // The SO trajectory so(t). so(0) is the centroid of the control nodes' rest positions.
@@ -264,6 +266,9 @@ std::vector<int> select_nodes_in_box(const Mesh& mesh, const Eigen::Vector3d& mi
                                      const Eigen::Vector3d& max);
 // The tetrahedra whose centroid a `near` or `box` selection holds (regions), sorted.
 std::vector<int> select_elements(const Mesh& mesh, const NodeSetSpec& selection);
+// A region's tetrahedra on `mesh`: by its label (none when the mesh has no labels) or by
+// its selection.
+std::vector<int> region_elements(const Mesh& mesh, const Region& region);
 // The name of node `node`'s spring of ligament `ligament` as a parameter: "LIGAMENT@NODE".
 std::string spring_parameter_name(const std::string& ligament, int node);
 // The name of region `name`'s Young's modulus as a parameter: "E:NAME".

@@ -327,7 +327,7 @@ void read_regions(const Checker& c, const json& root, Scenario& s) {
     std::string path = element("regions", i);
     if (item.is_object() && item.contains("name") && item.at("name").is_string())
       path += " " + in_quotes(item.at("name").get<std::string>());
-    c.check_object(item, path, {"name", "select", "young_modulus"}, {"name", "select"});
+    c.check_object(item, path, {"name", "select", "label", "young_modulus"}, {"name"});
     Region region;
     region.name = c.string(item.at("name"), child(path, "name"));
     c.require(valid_name(region.name), child(path, "name"),
@@ -336,17 +336,32 @@ void read_regions(const Checker& c, const json& root, Scenario& s) {
     c.require(s.region_index(region.name) < 0, child(path, "name"),
               "duplicate region name (also regions[" + std::to_string(s.region_index(region.name)) +
                   "]); names must be unique");
-    std::string asked, advice;
+    c.require(item.contains("select") != item.contains("label"), path,
+              "give either \"select\" (by element centroids) or \"label\" (a physical group of the mesh file)");
     region.selection.field = path;
-    read_select(c, item.at("select"), child(path, "select"), region.selection, asked, advice);
-    region.elements = select_elements(s.mesh, region.selection);
-    c.require(!region.elements.empty(), child(path, "select"),
-              "holds the centroid of no tetrahedron (" + asked + "); enlarge " + advice +
-                  " (selections are in metres, after mesh scale and translate)");
+    if (item.contains("label")) {
+      region.label = c.integer(item.at("label"), child(path, "label"));
+      c.require(!s.mesh.labels.empty(), child(path, "label"),
+                "mesh " + s.mesh_spec.file + " labels no element (Gmsh files do, by physical group; VTK files do not)");
+      region.elements = region_elements(s.mesh, region);
+      std::set<int> labels(s.mesh.labels.begin(), s.mesh.labels.end());
+      std::string known;
+      for (int label : labels) known += (known.empty() ? "" : ", ") + std::to_string(label);
+      c.require(!region.elements.empty(), child(path, "label"),
+                "no tetrahedron of mesh " + s.mesh_spec.file + " has label " + std::to_string(*region.label) +
+                    " (its labels: " + known + ")");
+    } else {
+      std::string asked, advice;
+      read_select(c, item.at("select"), child(path, "select"), region.selection, asked, advice);
+      region.elements = region_elements(s.mesh, region);
+      c.require(!region.elements.empty(), child(path, "select"),
+                "holds the centroid of no tetrahedron (" + asked + "); enlarge " + advice +
+                    " (selections are in metres, after mesh scale and translate)");
+    }
     for (int e : region.elements) {
       const int other = region_of[static_cast<size_t>(e)];
       if (other >= 0)
-        c.fail(child(path, "select"), "tetrahedron " + std::to_string(e) + " is also in regions[" +
+        c.fail(child(path, region.label ? "label" : "select"), "tetrahedron " + std::to_string(e) + " is also in regions[" +
                                           std::to_string(other) + "] " + in_quotes(s.regions[static_cast<size_t>(other)].name) +
                                           "; a tetrahedron has one Young's modulus, so regions must not overlap");
       region_of[static_cast<size_t>(e)] = static_cast<int>(i);

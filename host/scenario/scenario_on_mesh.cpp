@@ -124,9 +124,11 @@ Scenario scenario_on_mesh(const Scenario& scenario, Mesh mesh, const std::string
   // A region is selected again by element centroids: on a finer mesh its border follows the
   // finer elements, as a real inclusion's would not follow the model's.
   for (Region& region : s.regions) {
-    region.elements = select_elements(s.mesh, region.selection);
+    region.elements = region_elements(s.mesh, region);
     if (region.elements.empty())
-      throw InputError(source + ": " + region.selection.field + ": holds the centroid of no tetrahedron of this mesh");
+      throw InputError(source + ": " + region.selection.field + ": " +
+                       (region.label ? "no tetrahedron of this mesh has label " + std::to_string(*region.label)
+                                     : std::string("holds the centroid of no tetrahedron of this mesh")));
   }
   // The observed points are located on the other mesh by the caller (host/generator/truth_mesh.h).
   s.observations.nodes.clear();

@@ -48,6 +48,26 @@ TEST(GmshReader, MinimalFilesOfEachVersionRead) {
   }
 }
 
+// Each tetrahedron's physical group becomes its label (regions by label, issue 19): 1.0's
+// reg-phys, 2.x's first tag (0 without tags), 4.1's volume entity's first physical tag from
+// $Entities (0 for a volume without one); refinement gives the children their parent's.
+TEST(GmshReader, PhysicalGroupsBecomeLabels) {
+  EXPECT_EQ(read_text(std::string("$NOD\n4\n1 0 0 0\n2 1 0 0\n3 0 1 0\n4 0 0 1\n$ENDNOD\n"
+                                  "$ELM\n1\n1 4 7 1 4 1 2 3 4\n$ENDELM\n")).labels,
+            std::vector<int>{7});
+  EXPECT_EQ(read_text(kHeader22 + kNodes22 + "$Elements\n1\n1 4 2 5 1 1 2 3 4\n$EndElements\n").labels,
+            std::vector<int>{5});
+  EXPECT_EQ(read_text(kHeader22 + kNodes22 + "$Elements\n1\n1 4 0 1 2 3 4\n$EndElements\n").labels,
+            std::vector<int>{0});
+  const std::string entities = "$Entities\n1 0 0 2\n1 0 0 0 0\n1 0 0 0 1 1 1 1 9 0\n2 0 0 0 1 1 1 0 0\n$EndEntities\n";
+  EXPECT_EQ(read_text(kHeader41 + entities + kNodes41 + kElements41).labels, std::vector<int>{9});
+  EXPECT_EQ(read_text(kHeader41 + entities + kNodes41 + replace(kElements41, "3 1 4 1", "3 2 4 1")).labels,
+            std::vector<int>{0});
+  EXPECT_EQ(read_text(kHeader41 + kNodes41 + kElements41).labels, std::vector<int>{0}) << "no $Entities";
+  Mesh labelled = read_text(kHeader22 + kNodes22 + "$Elements\n1\n1 4 2 5 1 1 2 3 4\n$EndElements\n");
+  EXPECT_EQ(refine_uniform(labelled).labels, std::vector<int>(8, 5));
+}
+
 TEST(GmshReader, UnusedNodesAreKeptSoIndicesStayThoseOfTheFile) {
   const Mesh mesh =
       read_text(kHeader22 + "$Nodes\n5\n1 0 0 0\n2 1 0 0\n50 9 9 9\n3 0 1 0\n4 0 0 1\n$EndNodes\n" +

@@ -5,7 +5,9 @@
 // model. Bad values are named.
 #include <gtest/gtest.h>
 
+#include <fstream>
 #include <nlohmann/json.hpp>
+#include <sstream>
 #include <set>
 
 #include "host/common/input_error.h"
@@ -143,6 +145,45 @@ TEST_F(ParameterFieldsTest, BadRegionsAreNamed) {
   json no_prior = scenario_;
   no_prior["filter"].erase("initial_young_modulus");
   EXPECT_NE(error_of(no_prior).find("needs initial_young_modulus"), std::string::npos) << error_of(no_prior);
+}
+
+// A region by label: the tetrahedra of one physical group of the mesh file (box.msh with the
+// even element ids' physical tag made 2).
+TEST_F(ParameterFieldsTest, ARegionByLabelHoldsThatPhysicalGroup) {
+  std::ifstream in(std::string(SIGMAFEM_SOURCE_DIR) + "/scenarios/box.msh");
+  std::string line, text;
+  int relabelled = 0;
+  bool elements = false;
+  while (std::getline(in, line)) {
+    if (line == "$Elements") elements = true;
+    std::istringstream in_line(line);
+    std::vector<std::string> fields;
+    for (std::string field; in_line >> field;) fields.push_back(field);
+    // "id 4 n-tags physical ...": a tetrahedron with tags.
+    if (elements && fields.size() > 4 && fields[1] == "4" && fields[2] != "0" && std::stoll(fields[0]) % 2 == 0) {
+      fields[3] = "2";
+      line.clear();
+      for (const std::string& field : fields) line += (line.empty() ? "" : " ") + field;
+      ++relabelled;
+    }
+    text += line + "\n";
+  }
+  dir_.write("box.msh", text);
+  json labelled = scenario_;
+  labelled["regions"] = json::parse(R"([{"name": "even", "label": 2, "young_modulus": 10000}])");
+  labelled["filter"]["estimate_young_modulus"] = json::array({"even"});
+  labelled["filter"]["initial_young_modulus"] = json::array({5000});
+  const Scenario s = load(labelled);
+  ASSERT_EQ(s.regions.size(), 1u);
+  EXPECT_EQ(static_cast<int>(s.regions[0].elements.size()), relabelled);
+  for (int e : s.regions[0].elements) EXPECT_EQ(s.mesh.labels[static_cast<std::size_t>(e)], 2);
+  json missing = labelled;
+  missing["regions"][0]["label"] = 3;
+  EXPECT_NE(error_of(missing).find("no tetrahedron of mesh box.msh has label 3 (its labels: 1, 2)"), std::string::npos)
+      << error_of(missing);
+  json both = labelled;
+  both["regions"][0]["select"] = json::parse(R"({"near": [0, 0, 0], "radius": 0.1})");
+  EXPECT_NE(error_of(both).find("either \"select\""), std::string::npos) << error_of(both);
 }
 
 TEST_F(ParameterFieldsTest, ALigamentEstimatedPerSpringIsSplitInTheModel) {
