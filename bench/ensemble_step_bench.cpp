@@ -18,6 +18,7 @@
 #include "host/engine/surface_cloud_estimation.h"
 #include "host/ensemble/cpu_ensemble.h"
 #include "host/generator/surface_cloud_sampler.h"
+#include "host/model/estimated_parameters.h"
 #include "host/model/model.h"
 #include "host/reference/reference_simulation.h"
 
@@ -141,23 +142,12 @@ void BM_ensemble_step(benchmark::State& state, const Backend& backend, const std
   state.SetLabel(backend.label);
 }
 
-// One whole filter step: re-centre, advance, gather, correct (the truth is simulated beside
-// it, outside the timing, to give the observations).
-void BM_filter_step(benchmark::State& state, const Backend& backend, const std::string& name) {
-  const Scenario& s = bench::scenario(name, 0);
-  const Model model = make_model(s);
-  RoukfOptions options = estimation_options(s).roukf;
+// Times whole filter steps of `ensemble` on `s`: re-centre, advance, gather, correct (the
+// truth, `model` simulated beside it outside the timing, gives the observations).
+void time_filter_steps(benchmark::State& state, Ensemble& ensemble, const Scenario& s, const Model& model,
+                       RoukfOptions options) {
   options.sigma_points = SigmaPointSet::simplex;
-  std::unique_ptr<Ensemble> ensemble;
-  try {
-    ensemble = make_bench_ensemble(
-        backend, s, model,
-        sigma_point_count(SigmaPointSet::simplex, static_cast<int>(s.filter->estimate.size())));
-  } catch (const std::exception& e) {
-    state.SkipWithError(e.what());
-    return;
-  }
-  Roukf filter(options, *ensemble);
+  Roukf filter(options, ensemble);
   ReferenceSimulation truth(model);
   Eigen::VectorXd y(3 * static_cast<Eigen::Index>(s.observations.observed.size()));
   int step = 0;
@@ -189,10 +179,56 @@ void BM_filter_step(benchmark::State& state, const Backend& backend, const std::
   }
   const double steps = static_cast<double>(state.iterations());
   state.counters["factorisations_per_step"] = factorisations / steps;
-  state.counters["cg_iterations"] = cg_iterations / (steps * ensemble->sigma_count());
-  state.counters["sigma_points"] = ensemble->sigma_count();
+  state.counters["cg_iterations"] = cg_iterations / (steps * ensemble.sigma_count());
+  state.counters["sigma_points"] = ensemble.sigma_count();
+  state.counters["parameters"] = ensemble.parameter_count();
   state.counters["tetrahedra"] = model.element_count();
+}
+
+// One whole filter step on scenario `name` (simplex sigma points).
+void BM_filter_step(benchmark::State& state, const Backend& backend, const std::string& name) {
+  const Scenario& s = bench::scenario(name, 0);
+  const Model model = make_model(s);
+  std::unique_ptr<Ensemble> ensemble;
+  try {
+    ensemble = make_bench_ensemble(
+        backend, s, model,
+        sigma_point_count(SigmaPointSet::simplex, static_cast<int>(s.filter->estimate.size())));
+  } catch (const std::exception& e) {
+    state.SkipWithError(e.what());
+    return;
+  }
+  time_filter_steps(state, *ensemble, s, model, estimation_options(s).roukf);
   state.SetLabel(backend.label + ", " + name + ", simplex");
+}
+
+// A filter step against the parameter count p = range(0) (issue 19: S = p + 1, simplex): the
+// liver's 3 ligaments and the Young's moduli of p - 3 regions (the elements e with
+// e % (p - 3) = r), the truth at the model's moduli.
+void BM_filter_step_parameters(benchmark::State& state, const Backend& backend) {
+  const int p = static_cast<int>(state.range(0));
+  Scenario s = bench::scenario("liver", 0);
+  const int regions = p - 3;
+  for (int r = 0; r < regions; ++r) {
+    Region region;
+    region.name = "r" + std::to_string(r);
+    for (int e = r; e < s.mesh.tetrahedron_count(); e += regions) region.elements.push_back(e);
+    region.young_modulus = s.material.young_modulus;
+    s.regions.push_back(region);
+    s.filter->estimate_regions.push_back(r);
+    s.filter->initial_young_modulus.push_back(2.0 * s.material.young_modulus);
+  }
+  Model model = make_model(s);
+  const EstimatedParameters estimated = estimated_parameters(*s.filter, model);
+  std::unique_ptr<Ensemble> ensemble;
+  try {
+    ensemble = make_ensemble(backend.name, model, estimated, s.observations.observed, p + 1, device_options(backend));
+  } catch (const std::exception& e) {
+    state.SkipWithError(e.what());
+    return;
+  }
+  time_filter_steps(state, *ensemble, s, model, estimation_options(s).roukf);
+  state.SetLabel(backend.label + ", liver, " + std::to_string(regions) + " region moduli, simplex");
 }
 
 // A surface cloud of `points` points per frame (issue 15: the observation of 1000 points under
@@ -388,6 +424,13 @@ BENCHMARK_CAPTURE(BM_filter_step, cpu_shared, kCpuShared, std::string("liver"))
     ->Unit(benchmark::kMillisecond)->UseRealTime();
 BENCHMARK_CAPTURE(BM_filter_step, cpu_jacobi, kCpuJacobi, std::string("liver"))
     ->Unit(benchmark::kMillisecond)->UseRealTime();
+// Against the parameter count (issue 19): S = 4 to 65.
+BENCHMARK_CAPTURE(BM_filter_step_parameters, opencl_factorised, kOpenClFactorised)
+    ->Arg(3)->Arg(8)->Arg(16)->Arg(32)->Arg(64)->Unit(benchmark::kMillisecond)->UseRealTime();
+BENCHMARK_CAPTURE(BM_filter_step_parameters, cpu, kCpu)
+    ->Arg(3)->Arg(8)->Arg(16)->Arg(32)->Arg(64)->Unit(benchmark::kMillisecond)->UseRealTime();
+BENCHMARK_CAPTURE(BM_filter_step_parameters, vulkan, kVulkan)
+    ->Arg(3)->Arg(16)->Arg(64)->Unit(benchmark::kMillisecond)->UseRealTime();
 // The same steps observing a surface cloud of 1000 points instead, and that observation alone.
 BENCHMARK_CAPTURE(BM_cloud_filter_step, opencl, kOpenCl)->Arg(1000)->Unit(benchmark::kMillisecond)->UseRealTime();
 BENCHMARK_CAPTURE(BM_cloud_filter_step, vulkan, kVulkan)->Arg(1000)->Unit(benchmark::kMillisecond)->UseRealTime();

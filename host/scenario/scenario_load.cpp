@@ -584,15 +584,38 @@ void read_windowed_test(const Checker& c, const json& object, const std::string&
   }
 }
 
+// Whether the filter lists `names_key` (parameters estimated beyond the whole ligaments);
+// `priors_key`, their prior medians, comes with it or not at all.
+bool has_estimated_list(const Checker& c, const json& filter, const std::string& names_key,
+                        const std::string& priors_key, const std::string& of_each) {
+  const bool has_names = filter.contains(names_key);
+  c.require(has_names == filter.contains(priors_key), has_names ? "filter" : "filter." + priors_key,
+            has_names ? names_key + " needs " + priors_key + ", the prior median of each " + of_each
+                      : "given without " + names_key + ", the list it is the prior of");
+  return has_names;
+}
+
+// filter.PRIORS_KEY: one prior median > 0 per name of filter.NAMES_KEY (`count`, `what`).
+std::vector<double> read_prior_medians(const Checker& c, const json& filter, const std::string& priors_key,
+                                       const std::string& names_key, std::size_t count, const std::string& what) {
+  const std::string path = "filter." + priors_key;
+  const json& initial = c.array(filter.at(priors_key), path);
+  c.require(initial.size() == count, path,
+            std::to_string(initial.size()) + " values for " + std::to_string(count) + " " + what +
+                "; give one per name in filter." + names_key + ", same order");
+  std::vector<double> medians;
+  for (size_t i = 0; i < initial.size(); ++i) {
+    const double value = c.number(initial[i], element(path, i));
+    c.positive(value, element(path, i));   // the filter works on its log
+    medians.push_back(value);
+  }
+  return medians;
+}
+
 // filter.estimate_springs (ligament names, not in filter.estimate) and
 // filter.initial_spring_stiffness (N/m per spring, one per ligament).
 void read_estimated_springs(const Checker& c, const json& filter, const Scenario& s, FilterSpec& spec) {
-  const bool has_names = filter.contains("estimate_springs");
-  c.require(has_names == filter.contains("initial_spring_stiffness"),
-            has_names ? "filter" : "filter.initial_spring_stiffness",
-            has_names ? "estimate_springs needs initial_spring_stiffness, the prior median (N/m) of each spring"
-                      : "given without estimate_springs, the ligaments it is the prior of");
-  if (!has_names) return;
+  if (!has_estimated_list(c, filter, "estimate_springs", "initial_spring_stiffness", "spring (N/m)")) return;
   const json& names = c.array(filter.at("estimate_springs"), "filter.estimate_springs");
   for (size_t i = 0; i < names.size(); ++i) {
     const std::string path = element("filter.estimate_springs", i);
@@ -605,25 +628,13 @@ void read_estimated_springs(const Checker& c, const json& filter, const Scenario
               path, "ligament " + in_quotes(name) + " is listed twice");
     spec.estimate_springs.push_back(index);
   }
-  const json& initial = c.array(filter.at("initial_spring_stiffness"), "filter.initial_spring_stiffness");
-  c.require(initial.size() == names.size(), "filter.initial_spring_stiffness",
-            std::to_string(initial.size()) + " values for " + std::to_string(names.size()) +
-                " ligaments; give one per name in filter.estimate_springs, same order");
-  for (size_t i = 0; i < initial.size(); ++i) {
-    const std::string path = element("filter.initial_spring_stiffness", i);
-    const double k = c.number(initial[i], path);
-    c.positive(k, path);   // the filter works on its log
-    spec.initial_spring_stiffness.push_back(k);
-  }
+  spec.initial_spring_stiffness =
+      read_prior_medians(c, filter, "initial_spring_stiffness", "estimate_springs", names.size(), "ligaments");
 }
 
 // filter.estimate_young_modulus (region names) and filter.initial_young_modulus (Pa, one each).
 void read_estimated_regions(const Checker& c, const json& filter, const Scenario& s, FilterSpec& spec) {
-  const bool has_names = filter.contains("estimate_young_modulus");
-  c.require(has_names == filter.contains("initial_young_modulus"), has_names ? "filter" : "filter.initial_young_modulus",
-            has_names ? "estimate_young_modulus needs initial_young_modulus, the prior median (Pa) of each"
-                      : "given without estimate_young_modulus, the regions it is the prior of");
-  if (!has_names) return;
+  if (!has_estimated_list(c, filter, "estimate_young_modulus", "initial_young_modulus", "region (Pa)")) return;
   const json& names = c.array(filter.at("estimate_young_modulus"), "filter.estimate_young_modulus");
   for (size_t i = 0; i < names.size(); ++i) {
     const std::string path = element("filter.estimate_young_modulus", i);
@@ -638,16 +649,8 @@ void read_estimated_regions(const Checker& c, const json& filter, const Scenario
               path, "region " + in_quotes(name) + " is listed twice");
     spec.estimate_regions.push_back(index);
   }
-  const json& initial = c.array(filter.at("initial_young_modulus"), "filter.initial_young_modulus");
-  c.require(initial.size() == names.size(), "filter.initial_young_modulus",
-            std::to_string(initial.size()) + " values for " + std::to_string(names.size()) +
-                " regions; give one per name in filter.estimate_young_modulus, same order");
-  for (size_t i = 0; i < initial.size(); ++i) {
-    const std::string path = element("filter.initial_young_modulus", i);
-    const double E = c.number(initial[i], path);
-    c.positive(E, path);   // the filter works on its log
-    spec.initial_young_modulus.push_back(E);
-  }
+  spec.initial_young_modulus =
+      read_prior_medians(c, filter, "initial_young_modulus", "estimate_young_modulus", names.size(), "regions");
 }
 
 void read_filter(const Checker& c, const json& root, Scenario& s) {
@@ -673,17 +676,8 @@ void read_filter(const Checker& c, const json& root, Scenario& s) {
         "ligament " + in_quotes(s.ligaments[static_cast<size_t>(index)].name) + " is listed twice");
     spec.estimate.push_back(index);
   }
-  const json& initial = c.array(filter.at("initial_stiffness"), "filter.initial_stiffness");
-  c.require(initial.size() == estimate.size(), "filter.initial_stiffness",
-            std::to_string(initial.size()) + " values for " + std::to_string(estimate.size()) +
-                " estimated ligaments; give one per name in filter.estimate, same order");
-  for (size_t i = 0; i < initial.size(); ++i) {
-    const std::string path = element("filter.initial_stiffness", i);
-    const double k = c.number(initial[i], path);
-    // The filter works on log-stiffness: the prior median must be positive.
-    c.positive(k, path);
-    spec.initial_stiffness.push_back(k);
-  }
+  spec.initial_stiffness =
+      read_prior_medians(c, filter, "initial_stiffness", "estimate", estimate.size(), "estimated ligaments");
   read_estimated_springs(c, filter, s, spec);
   read_estimated_regions(c, filter, s, spec);
   spec.initial_log_std = c.number_or(filter, "filter", "initial_log_std", spec.initial_log_std);
