@@ -56,16 +56,10 @@ int CpuEnsemble::factorisations() const {
 void CpuEnsemble::set_parameters(const Eigen::MatrixXd& theta) {
   check_parameter_matrix(theta, parameter_count(), sigma_count(), "CpuEnsemble");
   for (int s = 0; s < sigma_count(); ++s) {
-    std::vector<double> stiffness = simulations_[s].ligament_stiffness();
-    for (std::size_t j = 0; j < estimated_.ligaments.size(); ++j)
-      stiffness[static_cast<std::size_t>(estimated_.ligaments[j])] = std::exp(theta(static_cast<Eigen::Index>(j), s));
+    std::vector<double> stiffness = simulations_[s].ligament_stiffness(), moduli;
+    apply_parameters(simulations_[s].model(), estimated_, theta.col(s), stiffness, moduli);
     simulations_[s].set_ligament_stiffness(stiffness);
-    if (estimated_.regions.empty()) continue;
-    std::vector<double> modulus;
-    for (const ElasticRegion& region : simulations_[s].model().regions) modulus.push_back(region.young_modulus);
-    for (std::size_t k = 0; k < estimated_.regions.size(); ++k)
-      modulus[static_cast<std::size_t>(estimated_.regions[k])] = std::exp(theta(estimated_.region_row(k), s));
-    simulations_[s].set_region_young_modulus(modulus);
+    simulations_[s].set_region_young_modulus(moduli);
   }
 }
 

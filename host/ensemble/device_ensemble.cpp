@@ -70,17 +70,13 @@ void DeviceEnsemble::set_physics_effects(const std::vector<PhysicsEffects>& effe
 Eigen::SparseMatrix<double> DeviceEnsemble::representative_system(const Eigen::VectorXd& x,
                                                                   const Eigen::VectorXd& v) const {
   if (!representative_) representative_ = std::make_unique<ReferenceSimulation>(model_);
-  std::vector<double> stiffness = representative_->ligament_stiffness();   // the others: the model's
-  std::vector<double> modulus;
-  for (const ElasticRegion& region : model_.regions) modulus.push_back(region.young_modulus);
-  if (representative_theta_.size() == estimated_.count()) {   // none yet: the model's
-    for (std::size_t j = 0; j < estimated_.ligaments.size(); ++j)
-      stiffness[static_cast<std::size_t>(estimated_.ligaments[j])] = std::exp(representative_theta_[static_cast<Eigen::Index>(j)]);
-    for (std::size_t k = 0; k < estimated_.regions.size(); ++k)
-      modulus[static_cast<std::size_t>(estimated_.regions[k])] = std::exp(representative_theta_[estimated_.region_row(k)]);
-  }
+  // Before set_parameters the model's values (representative_theta_ still empty).
+  std::vector<double> stiffness = representative_->ligament_stiffness(), moduli;
+  for (const ElasticRegion& region : model_.regions) moduli.push_back(region.young_modulus);
+  if (representative_theta_.size() == estimated_.count())
+    apply_parameters(model_, estimated_, representative_theta_, stiffness, moduli);
   representative_->set_ligament_stiffness(stiffness);
-  representative_->set_region_young_modulus(modulus);
+  representative_->set_region_young_modulus(moduli);
   representative_->set_physics_effects(representative_effects_);
   representative_->set_state(x, v);
   return representative_->system_matrix();

@@ -1,5 +1,6 @@
 #include "host/model/estimated_parameters.h"
 
+#include <cmath>
 #include <stdexcept>
 
 namespace sigmafem {
@@ -16,6 +17,16 @@ EstimatedParameters estimated_parameters(const FilterSpec& spec, Model& model) {
     model.ligaments[static_cast<std::size_t>(l)].stiffness = 0.0;   // its springs hold its nodes now
   }
   return estimated;
+}
+
+void apply_parameters(const Model& model, const EstimatedParameters& estimated, const Eigen::VectorXd& theta,
+                      std::vector<double>& stiffness, std::vector<double>& young_moduli) {
+  for (std::size_t j = 0; j < estimated.ligaments.size(); ++j)
+    stiffness.at(static_cast<std::size_t>(estimated.ligaments[j])) = std::exp(theta[static_cast<Eigen::Index>(j)]);
+  young_moduli.clear();
+  for (const ElasticRegion& region : model.regions) young_moduli.push_back(region.young_modulus);
+  for (std::size_t k = 0; k < estimated.regions.size(); ++k)
+    young_moduli[static_cast<std::size_t>(estimated.regions[k])] = std::exp(theta[estimated.region_row(k)]);
 }
 
 void check_estimated_parameters(const EstimatedParameters& estimated, const Model& model, const std::string& who) {

@@ -5,6 +5,7 @@
 // numbers and knows nothing of which is which.
 #pragma once
 
+#include <Eigen/Core>
 #include <initializer_list>
 #include <string>
 #include <vector>
@@ -34,6 +35,11 @@ struct EstimatedParameters {
 // ligament of one node per spring ("LIGAMENT@NODE", its part of the stiffness) is appended,
 // and the whole one keeps its nodes at zero stiffness.
 EstimatedParameters estimated_parameters(const FilterSpec& spec, Model& model);
+
+// One parameter vector `theta` (p) applied to all of `model`'s ligaments and regions: the
+// estimated ones exp(theta), the others `stiffness` (as given) and the model's moduli (Pa).
+void apply_parameters(const Model& model, const EstimatedParameters& estimated, const Eigen::VectorXd& theta,
+                      std::vector<double>& stiffness, std::vector<double>& young_moduli);
 
 // Throws std::invalid_argument naming `who` for an index `model` does not have.
 void check_estimated_parameters(const EstimatedParameters& estimated, const Model& model, const std::string& who);
