@@ -1,5 +1,6 @@
 // `sigmafem info SCENARIO`: what a scenario resolves to (mesh size and quality, node sets),
 // to check a scenario before a long run.
+#include <algorithm>
 #include <iostream>
 #include <memory>
 
@@ -39,6 +40,14 @@ Action add_info_command(CLI::App& app) {
     for (const Ligament& ligament : s.ligaments) {
       std::cout << "  ligament " << ligament.name << " " << ligament.stiffness << " N/m: ";
       print_nodes(std::cout, ligament.nodes);
+    }
+    for (const Region& region : s.regions) {
+      const bool estimated = s.filter && std::find(s.filter->estimate_regions.begin(), s.filter->estimate_regions.end(),
+                                                   s.region_index(region.name)) != s.filter->estimate_regions.end();
+      std::cout << "  region " << region.name << ": E " << region.young_modulus << " Pa"
+                << (estimated ? " (estimated, " + young_modulus_parameter_name(region.name) + ")" : "") << ", "
+                << region.elements.size() << " tetrahedra"
+                << (region.label ? " labelled " + std::to_string(*region.label) : std::string()) << "\n";
     }
     for (const Ligament& region : s.candidate_regions) {
       Eigen::Vector3d centre = Eigen::Vector3d::Zero();

@@ -488,6 +488,35 @@ TEST_F(CliTest, EstimateRejectsDataOfAnotherScenario) {
   EXPECT_FALSE(fs::exists(dir_ / "estimate" / "estimates.csv"));
 }
 
+// The stiff inclusion from the command line (issue 19): info lists the regions, generate writes
+// their moduli into truth.csv, estimate reports each in Pa with its error against the truth.
+TEST_F(CliTest, TheInclusionScenarioRunsFromTheCommandLine) {
+  const std::string scenario = (fs::path(SIGMAFEM_SOURCE_DIR) / "scenarios" / "liver_inclusion.json").string();
+  const CommandRun info = run_sigmafem("info " + scenario);
+  EXPECT_NE(info.output.find("region left_upper_anterior: E 25000 Pa (estimated, E:left_upper_anterior), 75 tetrahedra"),
+            std::string::npos)
+      << info.output;
+  json shortened = json::parse(std::ifstream(scenario));
+  shortened["time"]["steps"] = 60;
+  shortened["mesh"]["file"] = (fs::path(SIGMAFEM_SOURCE_DIR) / "scenarios" / "liver.msh").string();
+  shortened["control"]["trajectory"]["file"] =
+      (fs::path(SIGMAFEM_SOURCE_DIR) / "scenarios" / "liver_trajectory.csv").string();
+  std::ofstream(dir_ / "inclusion.json") << shortened.dump(2);
+  const std::string path = (dir_ / "inclusion.json").string();
+  ASSERT_EQ(run_sigmafem("generate " + path + " --out " + (dir_ / "data").string() + " --vtk-every 0 --quiet").exit_code, 0);
+  const CommandRun run = run_sigmafem("estimate " + path + " --data " + (dir_ / "data").string() + " --out " +
+                                      (dir_ / "estimate").string() + " --backend cpu");
+  ASSERT_EQ(run.exit_code, 0) << run.output;
+  EXPECT_NE(run.output.find("E:left_upper_anterior"), std::string::npos) << run.output;
+  EXPECT_NE(run.output.find("largest |error| of a Young's modulus"), std::string::npos) << run.output;
+  const json summary = json::parse(std::ifstream(dir_ / "estimate" / "summary.json"));
+  const json& inclusion = summary["young_modulus_errors"]["E:left_upper_anterior"];
+  EXPECT_EQ(inclusion["truth_pa"].get<double>(), 25000.0);
+  EXPECT_LT(std::abs(inclusion["relative_error"].get<double>()), 0.15) << summary.dump(1);
+  EXPECT_TRUE(summary["final"]["E:left_upper_anterior"].contains("young_modulus_pa"));
+  EXPECT_TRUE(summary["final"]["left"].contains("stiffness_n_per_m"));
+}
+
 TEST_F(CliTest, InfoDescribesTheShippedScenarios) {
   for (const char* name : {"box", "liver"}) {
     const CommandRun run =
