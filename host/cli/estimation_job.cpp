@@ -179,10 +179,14 @@ void print_estimation_summary(std::ostream& out, const json& summary, const std:
         << format_number(summary["adaptive_noise"]["max_scale"].get<double>())
         << " (innovations beyond what the parameters explain: a model error, or a change in the steps "
            "before the detector fired)\n";
-  if (summary["catch_up_steps"].get<int>() > 0)
-    out << "  changes detected at steps " << summary["changes_detected_at_steps"].dump() << "; "
-        << summary["catch_up_steps"].get<int>()
+  if (summary["catch_up_steps"].get<int>() > 0) {
+    // Either test may begin a catch-up: the NIS detector's changes, the parameter-change test's.
+    std::vector<int> parameter_changes;
+    for (const auto& change : summary["parameter_changes"]) parameter_changes.push_back(change["step"].get<int>());
+    out << "  changes detected at steps " << summary["changes_detected_at_steps"].dump()
+        << " (parameter changes at " << json(parameter_changes).dump() << "); " << summary["catch_up_steps"].get<int>()
         << " steps of catch-up after them are left out of the residual tests\n";
+  }
   for (const auto& cut : summary["cuts"]) {
     std::snprintf(line, sizeof line,
                   "  ligament %s cut at step %d (t = %.2f s): the data show it lost nearly all of the %.4g N/m it "

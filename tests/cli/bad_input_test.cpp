@@ -272,13 +272,17 @@ TEST_F(BadInputTest, AFullDiskIsTheMachinesFailureNotTheInputs) {
 // A run stopped by SIGTERM (or Ctrl-C) leaves nothing: hundreds of vtk.partial/ frames before.
 // The signal comes twice at once, as `timeout` sends it (to the program, then to its process
 // group): that is one request to stop cleanly, not the second Ctrl-C that ends a run at once.
+// The signal is sent once the run writes (its staging folder exists, up to 60 s): a fixed
+// 2 s once came before the program had started under a loaded ctest -j 2 (stop 47), and the
+// default action then left the folder behind.
 TEST_F(BadInputTest, AnInterruptedRunLeavesNoFilesBehind) {
   json scenario = box_;
   scenario["time"]["steps"] = 100000;
   scenario["output"]["vtk_every"] = 1;
-  const CommandRun run = run_sigmafem_command("sh -c '" + std::string(SIGMAFEM_BINARY) + " generate " +
-                                              scenario_file(scenario) + " --out " + out() +
-                                              " --quiet & pid=$!; sleep 2; kill -TERM $pid; kill -TERM $pid; wait $pid'");
+  const CommandRun run = run_sigmafem_command(
+      "sh -c '" + std::string(SIGMAFEM_BINARY) + " generate " + scenario_file(scenario) + " --out " + out() +
+      " --quiet & pid=$!; i=0; while [ ! -d " + out() + "/.sigmafem-partial ] && [ $i -lt 600 ]; do sleep 0.1; "
+      "i=$((i+1)); done; sleep 0.5; kill -TERM $pid; kill -TERM $pid; wait $pid'");
   EXPECT_EQ(run.exit_code, 128 + 15) << run.output;
   EXPECT_NE(run.output.find("interrupted by signal 15"), std::string::npos) << run.output;
   ASSERT_TRUE(fs::exists(out())) << "the folder was made before the run";
