@@ -584,6 +584,13 @@ void read_windowed_test(const Checker& c, const json& object, const std::string&
   }
 }
 
+// Appends `index` to one of the filter's lists, refusing a repeat ("ligament \"x\"" is `what`).
+void append_once(const Checker& c, std::vector<int>& list, int index, const std::string& path,
+                 const std::string& what) {
+  c.require(std::find(list.begin(), list.end(), index) == list.end(), path, what + " is listed twice");
+  list.push_back(index);
+}
+
 // Whether the filter lists `names_key` (parameters estimated beyond the whole ligaments);
 // `priors_key`, their prior medians, comes with it or not at all.
 bool has_estimated_list(const Checker& c, const json& filter, const std::string& names_key,
@@ -623,10 +630,7 @@ void read_estimated_springs(const Checker& c, const json& filter, const Scenario
     const std::string& name = s.ligaments[static_cast<size_t>(index)].name;
     c.require(std::find(spec.estimate.begin(), spec.estimate.end(), index) == spec.estimate.end(), path,
               "ligament " + in_quotes(name) + " is also in filter.estimate: estimate it whole or per spring, not both");
-    c.require(std::find(spec.estimate_springs.begin(), spec.estimate_springs.end(), index) ==
-                  spec.estimate_springs.end(),
-              path, "ligament " + in_quotes(name) + " is listed twice");
-    spec.estimate_springs.push_back(index);
+    append_once(c, spec.estimate_springs, index, path, "ligament " + in_quotes(name));
   }
   spec.initial_spring_stiffness =
       read_prior_medians(c, filter, "initial_spring_stiffness", "estimate_springs", names.size(), "ligaments");
@@ -636,18 +640,15 @@ void read_estimated_springs(const Checker& c, const json& filter, const Scenario
 void read_estimated_regions(const Checker& c, const json& filter, const Scenario& s, FilterSpec& spec) {
   if (!has_estimated_list(c, filter, "estimate_young_modulus", "initial_young_modulus", "region (Pa)")) return;
   const json& names = c.array(filter.at("estimate_young_modulus"), "filter.estimate_young_modulus");
+  std::string known;
+  for (const Region& region : s.regions) known += (known.empty() ? "" : ", ") + region.name;
   for (size_t i = 0; i < names.size(); ++i) {
     const std::string path = element("filter.estimate_young_modulus", i);
     const std::string name = c.string(names[i], path);
     const int index = s.region_index(name);
-    std::string known;
-    for (const Region& region : s.regions) known += (known.empty() ? "" : ", ") + region.name;
     c.require(index >= 0, path,
               "no region " + in_quotes(name) + " (regions: " + (known.empty() ? "none declared" : known) + ")");
-    c.require(std::find(spec.estimate_regions.begin(), spec.estimate_regions.end(), index) ==
-                  spec.estimate_regions.end(),
-              path, "region " + in_quotes(name) + " is listed twice");
-    spec.estimate_regions.push_back(index);
+    append_once(c, spec.estimate_regions, index, path, "region " + in_quotes(name));
   }
   spec.initial_young_modulus =
       read_prior_medians(c, filter, "initial_young_modulus", "estimate_young_modulus", names.size(), "regions");
@@ -671,10 +672,7 @@ void read_filter(const Checker& c, const json& root, Scenario& s) {
   for (size_t i = 0; i < estimate.size(); ++i) {
     const std::string path = element("filter.estimate", i);
     const int index = ligament_by_name(c, s.ligaments, estimate[i], path);
-    c.require(
-        std::find(spec.estimate.begin(), spec.estimate.end(), index) == spec.estimate.end(), path,
-        "ligament " + in_quotes(s.ligaments[static_cast<size_t>(index)].name) + " is listed twice");
-    spec.estimate.push_back(index);
+    append_once(c, spec.estimate, index, path, "ligament " + in_quotes(s.ligaments[static_cast<size_t>(index)].name));
   }
   spec.initial_stiffness =
       read_prior_medians(c, filter, "initial_stiffness", "estimate", estimate.size(), "estimated ligaments");
