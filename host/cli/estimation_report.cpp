@@ -32,10 +32,6 @@ std::optional<Eigen::MatrixXd> truth_at_steps(const TruthTable& truth,
   return values;
 }
 
-namespace {
-// A region's Young's modulus ("E:NAME", Scenario::parameter_names), in Pa, not a stiffness.
-bool is_modulus_name(const std::string& name) { return name.rfind("E:", 0) == 0; }
-}  // namespace
 
 json adaptive_noise_json(const EstimationRun& run) {
   json j;
@@ -96,7 +92,7 @@ void plot_stiffness(const EstimationReport& report, const EstimationRun& run,
     }
     data.rows.push_back(row);
   }
-  const bool moduli = std::any_of(report.names.begin(), report.names.end(), is_modulus_name);
+  const bool moduli = std::any_of(report.names.begin(), report.names.end(), is_young_modulus_parameter_name);
   std::ostringstream script;
   script << "set output $output\nset title 'Estimated " << (moduli ? "parameters" : "ligament stiffness") << " ("
          << report.scenario_name << ", " << report.sigma_points << " sigma points): median with +-2 std band"
@@ -226,7 +222,7 @@ nlohmann::ordered_json write_estimation_report(const EstimationReport& report, c
     const EstimationStep& last = run.steps.back();
     for (std::size_t j = 0; j < report.names.size(); ++j) {
       const auto jj = static_cast<Eigen::Index>(j);
-      const bool modulus = is_modulus_name(report.names[j]);
+      const bool modulus = is_young_modulus_parameter_name(report.names[j]);
       final_estimates[report.names[j]] = {{modulus ? "young_modulus_pa" : "stiffness_n_per_m", last.stiffness[jj]},
                                           {modulus ? "std_pa" : "std_n_per_m", last.stiffness_std[jj]},
                                           {"log_std", last.log_std[jj]}};
@@ -257,7 +253,7 @@ nlohmann::ordered_json write_estimation_report(const EstimationReport& report, c
     // The ligaments' figures are in N/m; the regions' moduli, after them (Scenario::
     // parameter_names), get their relative errors at the last step instead.
     const auto ligaments = static_cast<Eigen::Index>(
-        std::find_if(report.names.begin(), report.names.end(), is_modulus_name) - report.names.begin());
+        std::find_if(report.names.begin(), report.names.end(), is_young_modulus_parameter_name) - report.names.begin());
     json errors = json::object();
     if (ligaments > 0) {
       const std::vector<std::string> ligament_names(report.names.begin(), report.names.begin() + ligaments);

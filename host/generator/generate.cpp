@@ -140,7 +140,7 @@ GenerateResult generate(const Scenario& scenario, const GenerateOptions& options
   table.points.resize(steps + 1, 3 * static_cast<Eigen::Index>(observed.size()));
   TruthTable truth;
   truth.comments = comments;
-  // The ligaments' stiffness (N/m), then each region's Young's modulus (Pa, "E:NAME").
+  // The ligaments' stiffness (N/m), the springs estimated alone, each region's modulus (Pa).
   truth.names = scenario.truth_names();
   truth.stiffness.resize(steps + 1, static_cast<Eigen::Index>(truth.names.size()));
   GaussianNoise noise(options.seed);

@@ -81,7 +81,8 @@ TruthMesh make_truth_mesh(const Scenario& scenario, const TruthMeshOptions& opti
         truth.scenario.mesh = refine_uniform(truth.scenario.mesh);
       orient_and_check(truth.scenario.mesh, "--truth-refine " + std::to_string(*options.refine));
       truth.description = "the scenario's mesh refined " + levels(*options.refine);
-      // Regions are element sets: selected again on the refined elements (by centroid).
+      // Regions are element sets: selected again on the refined elements (by centroid, or by
+      // the label the children keep).
       for (Region& region : truth.scenario.regions)
         region.elements = region_elements(truth.scenario.mesh, region);
       if (options.spread_springs) {

@@ -49,6 +49,8 @@ int Scenario::region_index(const std::string& region_name) const {
 
 std::string young_modulus_parameter_name(const std::string& region_name) { return "E:" + region_name; }
 
+bool is_young_modulus_parameter_name(const std::string& name) { return name.rfind("E:", 0) == 0; }
+
 std::string spring_parameter_name(const std::string& ligament, int node) {
   return ligament + "@" + std::to_string(node);
 }

@@ -271,8 +271,10 @@ std::vector<int> select_elements(const Mesh& mesh, const NodeSetSpec& selection)
 std::vector<int> region_elements(const Mesh& mesh, const Region& region);
 // The name of node `node`'s spring of ligament `ligament` as a parameter: "LIGAMENT@NODE".
 std::string spring_parameter_name(const std::string& ligament, int node);
-// The name of region `name`'s Young's modulus as a parameter: "E:NAME".
+// The name of region `name`'s Young's modulus as a parameter: "E:NAME"; and whether a
+// parameter's name is one (a modulus in Pa, not a stiffness in N/m).
 std::string young_modulus_parameter_name(const std::string& region_name);
+bool is_young_modulus_parameter_name(const std::string& name);
 
 // Reads and checks a scenario file. Throws InputError with "scenario FILE: FIELD: problem"
 // for an unknown field, a wrong type, a missing file, a ligament or node index that does not

@@ -121,8 +121,8 @@ Scenario scenario_on_mesh(const Scenario& scenario, Mesh mesh, const std::string
   s.control.nodes = resolver.resolve(s.control.selection, s.control.nodes);
   for (Ligament& region : s.candidate_regions) region.nodes = resolver.resolve(region.selection, region.nodes);
   resolve_automatic_regions(scenario, resolver, s);
-  // A region is selected again by element centroids: on a finer mesh its border follows the
-  // finer elements, as a real inclusion's would not follow the model's.
+  // A region is selected again (by element centroids or label): on a finer mesh its border
+  // follows the finer elements, as a real inclusion's would not follow the model's.
   for (Region& region : s.regions) {
     region.elements = region_elements(s.mesh, region);
     if (region.elements.empty())
