@@ -429,6 +429,9 @@ BENCHMARK_CAPTURE(BM_filter_step_parameters, opencl_factorised, kOpenClFactorise
     ->Arg(3)->Arg(8)->Arg(16)->Arg(32)->Arg(64)->Unit(benchmark::kMillisecond)->UseRealTime();
 BENCHMARK_CAPTURE(BM_filter_step_parameters, cpu, kCpu)
     ->Arg(3)->Arg(8)->Arg(16)->Arg(32)->Arg(64)->Unit(benchmark::kMillisecond)->UseRealTime();
+// OpenCL with Jacobi: the GPU form's preconditioner (a GPU has no factor yet).
+BENCHMARK_CAPTURE(BM_filter_step_parameters, opencl, kOpenCl)
+    ->Arg(3)->Arg(16)->Arg(64)->Unit(benchmark::kMillisecond)->UseRealTime();
 BENCHMARK_CAPTURE(BM_filter_step_parameters, vulkan, kVulkan)
     ->Arg(3)->Arg(16)->Arg(64)->Unit(benchmark::kMillisecond)->UseRealTime();
 // The same steps observing a surface cloud of 1000 points instead, and that observation alone.
