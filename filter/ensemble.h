@@ -48,6 +48,16 @@ struct Recentering {
   Eigen::MatrixXd factor;             // p x p: C
 };
 
+// The re-sampled states of `recentering` for the predicted sigma states Y (n x S, one column
+// per sigma point), in double precision: what CpuEnsemble::recenter does with its states and
+// the distributed ensemble (host/mpi/) with every rank's, so that both give the same bits.
+inline Eigen::MatrixXd resampled_states(const Eigen::MatrixXd& Y, const Recentering& r) {
+  const Eigen::VectorXd mean = r.alpha * Y.rowwise().sum();
+  const Eigen::MatrixXd L = r.alpha * Y * r.directions.transpose();   // n x p
+  const Eigen::VectorXd y_hat = mean + L * r.correction;
+  return Eigen::MatrixXd(y_hat.replicate(1, Y.cols()) + L * r.factor * r.directions);
+}
+
 class Ensemble {
  public:
   virtual ~Ensemble() = default;

@@ -82,7 +82,7 @@ Action add_demo_command(CLI::App& app) {
     job.device = options->backend.device_options();
     job.sigma_points = options->sigma_points;
     job.out = &std::cout;
-    const auto summary = run_estimation_job(scenario, job);
+    const auto summary = run_estimation_job(scenario, job).value();   // one rank (main)
     print_estimation_summary(std::cout, summary, job.out_dir);
     return summary["complete"].get<bool>() ? 0 : 1;
   };

@@ -45,9 +45,10 @@ Action add_estimate_command(CLI::App& app) {
     options->job.backend = options->backend.backend;
     options->job.device = options->backend.device_options();
     options->job.out = options->quiet ? nullptr : &std::cout;
-    const nlohmann::ordered_json summary = run_estimation_job(scenario, options->job);
-    if (!options->quiet) print_estimation_summary(std::cout, summary, options->job.out_dir);
-    return summary["complete"].get<bool>() ? 0 : 1;
+    const std::optional<nlohmann::ordered_json> summary = run_estimation_job(scenario, options->job);
+    if (!summary) return 0;   // an MPI rank other than 0: rank 0 reports
+    if (!options->quiet) print_estimation_summary(std::cout, *summary, options->job.out_dir);
+    return (*summary)["complete"].get<bool>() ? 0 : 1;
   };
 }
 

@@ -26,12 +26,14 @@
 #include "host/model/effects.h"
 #include "host/model/estimated_parameters.h"
 #include "host/model/model.h"
+#include "host/mpi/distributed_ensemble.h"
+#include "host/mpi/ranks.h"
 
 namespace sigmafem::cli {
 namespace fs = std::filesystem;
 using json = nlohmann::ordered_json;
 
-json run_estimation_job(const Scenario& scenario, const EstimationJob& job) {
+std::optional<json> run_estimation_job(const Scenario& scenario, const EstimationJob& job) {
   const auto start = std::chrono::steady_clock::now();
   if (!scenario.filter)
     throw InputError("scenario " + scenario.path + ": filter: missing; estimate needs a filter "
@@ -59,14 +61,22 @@ json run_estimation_job(const Scenario& scenario, const EstimationJob& job) {
   if (!job.sigma_points.empty()) options.roukf.sigma_points = parse_sigma_point_set(job.sigma_points);
   const int sigma_count = sigma_point_count(options.roukf.sigma_points, estimated.count());
 
-  fs::create_directories(job.out_dir);
+  const RankInfo& world = ranks();
+  if (world.distributed() && scenario.observations.surface_cloud)
+    throw InputError("scenario " + scenario.path + ": a surface cloud's estimation runs on one rank, not over " +
+                     std::to_string(world.size) + " MPI ranks");
+  if (world.size > sigma_count)
+    throw InputError(std::to_string(world.size) + " MPI ranks for " + std::to_string(sigma_count) +
+                     " sigma points: every rank needs at least one (run with -n " + std::to_string(sigma_count) +
+                     " or fewer)");
   const BackendDecision backend = resolve_backend(job.backend, model, sigma_count);
-  if (job.out) *job.out << "backend: " << backend.backend << " (" << backend.reason << ")\n" << std::flush;
+  if (job.out && world.rank == 0) *job.out << "backend: " << backend.backend << " (" << backend.reason << ")\n" << std::flush;
   // A surface cloud (observations.surface_cloud): the ensemble observes the surface's nodes
   // and each frame's points are observed by their distance to it
   // (host/engine/surface_cloud_estimation.h).
   std::optional<SurfaceCloudEstimation> cloud;
   std::unique_ptr<TimedObservation> tracked;
+  DistributedEnsemble* distributed = nullptr;   // over MPI ranks, inside `tracked`
   nlohmann::ordered_json observations = {{"kind", "tracked_points"}, {"points", table.point_count()}};
   if (scenario.observations.surface_cloud) {
     const std::string cloud_path = (data / "pointcloud.csv").string();
@@ -82,28 +92,58 @@ json run_estimation_job(const Scenario& scenario, const EstimationJob& job) {
                     {"points", cloud_table.point_count()},
                     {"max_points_per_step", max_points},
                     {"surface_triangles", cloud->surface_triangles}};
-  } else {
+  } else if (!world.distributed()) {
     // Frames at their own times (observations.csv's frame_time) are observed then
     // (filter/timed_observation.h); without the column the decorator changes nothing.
     tracked = std::make_unique<TimedObservation>(
         make_ensemble(backend.backend, model, estimated, scenario.observations.observed, sigma_count, job.device),
         table.frame_shares);
     if (!table.frame_times.empty()) observations["frame_time"] = true;
+  } else {
+    // Over MPI ranks: every rank makes its share; all learn whether every rank has one.
+    std::unique_ptr<SimulationEnsemble> local;
+    std::exception_ptr failure;
+    try {
+      local = make_ensemble(backend.backend, model, estimated, scenario.observations.observed,
+                            sigma_share(sigma_count, world.size, world.rank).count, job.device);
+    } catch (...) {
+      failure = std::current_exception();
+    }
+    agree_on_shares(failure, local.get(), sigma_count);
+    if (world.rank != 0) {
+      serve_ensemble(*local, sigma_count);
+      return std::nullopt;
+    }
+    auto ensemble = std::make_unique<DistributedEnsemble>(std::move(local), sigma_count);
+    distributed = ensemble.get();
+    tracked = std::make_unique<TimedObservation>(std::move(ensemble), table.frame_shares);
+    if (!table.frame_times.empty()) observations["frame_time"] = true;
+    observations["mpi_ranks"] = world.size;
   }
+  fs::create_directories(job.out_dir);   // once the ensemble stands (on rank 0 alone over MPI)
   Progress progress("estimate " + scenario.name + ": step", table.row_count() - 1, job.progress);
-  const EstimationRun run = run_estimation(
-      cloud ? static_cast<Ensemble&>(*cloud->ensemble) : *tracked, options, table.times, table.so,
-      cloud ? cloud->measured : table.points,
-      [&](const EstimationStep& step) {
-        char detail[160];
-        std::snprintf(detail, sizeof detail, "innovation %.3f mm", 1e3 * step.innovation_rms);
-        progress.update(step.step, detail);
-      },
-      [&](Eigen::Index row) {
-        if (cloud) cloud->before_step(row);
-        if (tracked) tracked->set_row(row);
-      });
+  std::optional<EstimationRun> finished;
+  try {
+    finished = run_estimation(
+        cloud ? static_cast<Ensemble&>(*cloud->ensemble) : *tracked, options, table.times, table.so,
+        cloud ? cloud->measured : table.points,
+        [&](const EstimationStep& step) {
+          char detail[160];
+          std::snprintf(detail, sizeof detail, "innovation %.3f mm", 1e3 * step.innovation_rms);
+          progress.update(step.step, detail);
+        },
+        [&](Eigen::Index row) {
+          if (cloud) cloud->before_step(row);
+          if (tracked) tracked->set_row(row);
+        });
+  } catch (...) {
+    if (distributed) distributed->stop_after(std::current_exception());   // every rank ends with it
+    throw;
+  }
+  // A step that failed on any rank ends the run incomplete (run_estimation), on every rank.
+  if (distributed) distributed->stop(finished->complete ? 0 : 1, finished->stop_reason);
   progress.finish();
+  const EstimationRun& run = *finished;
 
   EstimationReport report;
   report.scenario_name = scenario.name;

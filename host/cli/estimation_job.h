@@ -3,6 +3,7 @@
 #pragma once
 
 #include <nlohmann/json.hpp>
+#include <optional>
 #include <ostream>
 #include <string>
 
@@ -24,7 +25,10 @@ struct EstimationJob {
 // Runs the job; returns the summary written to summary.json. Throws InputError for bad input
 // (a scenario without a filter block, data that does not match the scenario, ...). A filter
 // that diverges is not an exception: the summary says "complete": false and why.
-nlohmann::ordered_json run_estimation_job(const Scenario& scenario, const EstimationJob& job);
+// Under `mpirun -n R` (R > 1) every rank runs it: each makes its share of the sigma points
+// (host/mpi/distributed_ensemble.h), rank 0 runs the filter and writes everything, and the
+// other ranks serve their shares and return nothing.
+std::optional<nlohmann::ordered_json> run_estimation_job(const Scenario& scenario, const EstimationJob& job);
 
 // A few lines for the terminal: final estimates, errors against the truth, where the files are.
 void print_estimation_summary(std::ostream& out, const nlohmann::ordered_json& summary,

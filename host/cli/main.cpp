@@ -2,7 +2,8 @@
 // input (files, scenario, options), 3 a device that cannot run it (no OpenCL platform or
 // Vulkan driver, a kernel or shader that fails to build or load, out of device memory),
 // with a message on stderr that says where and what; 128 + N after signal N (SIGINT,
-// SIGTERM, SIGHUP), with the run's staging files removed.
+// SIGTERM, SIGHUP), with the run's staging files removed. Under `mpirun -n R` (R > 1) only
+// `estimate` runs (host/mpi/), every rank ending with the same code and a message.
 #include <CLI/CLI.hpp>
 #include <iostream>
 #include <map>
@@ -11,8 +12,47 @@
 #include "host/common/device_error.h"
 #include "host/common/input_error.h"
 #include "host/common/interruption.h"
+#include "host/mpi/ranks.h"
+
+namespace {
+
+// The command's exit code, with every error reported on stderr as the header says.
+int run_command(CLI::App& app, std::map<CLI::App*, sigmafem::cli::Action>& actions) {
+  const std::string name = sigmafem::program_name();
+  try {
+    for (CLI::App* sub : app.get_subcommands()) {
+      if (sigmafem::ranks().distributed() && sub->get_name() != "estimate")
+        throw sigmafem::InputError(sub->get_name() + " runs on one process; over MPI ranks only estimate runs");
+      return actions.at(sub)();
+    }
+  } catch (const sigmafem::Interrupted& e) {
+    std::cerr << name << ": " << e.what() << '\n';
+    return 128 + e.signal_number();
+  } catch (const sigmafem::InputError& e) {
+    std::cerr << name << ": error: " << e.what() << '\n';
+    return 2;
+  } catch (const sigmafem::DeviceError& e) {
+    std::cerr << name << ": device error: " << e.what() << '\n';
+    return 3;
+  } catch (const std::exception& e) {
+    std::cerr << name << ": failed: " << e.what() << '\n';
+    return 1;
+  }
+  return 0;
+}
+
+}  // namespace
 
 int main(int argc, char** argv) {
+  try {
+    sigmafem::start_ranks(&argc, &argv);
+  } catch (const sigmafem::InputError& e) {
+    std::cerr << "sigmafem: error: " << e.what() << '\n';
+    return 2;
+  }
+  struct EndRanks {   // every return below ends MPI where start_ranks started it
+    ~EndRanks() { sigmafem::finish_ranks(); }
+  } end_ranks;
   CLI::App app{"sigmafem: estimates the stiffness of the ligaments that hold an organ from "
                "tracked surface points, with an ensemble reduced-order unscented Kalman filter"};
   app.set_version_flag("--version", std::string("sigmafem ") + SIGMAFEM_VERSION);
@@ -32,20 +72,5 @@ int main(int argc, char** argv) {
     return app.exit(e) == 0 ? 0 : 2;
   }
   sigmafem::install_interruption_handlers();
-  try {
-    for (CLI::App* sub : app.get_subcommands()) return actions.at(sub)();
-  } catch (const sigmafem::Interrupted& e) {
-    std::cerr << "sigmafem: " << e.what() << '\n';
-    return 128 + e.signal_number();
-  } catch (const sigmafem::InputError& e) {
-    std::cerr << "sigmafem: error: " << e.what() << '\n';
-    return 2;
-  } catch (const sigmafem::DeviceError& e) {
-    std::cerr << "sigmafem: device error: " << e.what() << '\n';
-    return 3;
-  } catch (const std::exception& e) {
-    std::cerr << "sigmafem: failed: " << e.what() << '\n';
-    return 1;
-  }
-  return 0;
+  return run_command(app, actions);
 }

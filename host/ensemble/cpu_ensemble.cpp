@@ -99,24 +99,28 @@ void CpuEnsemble::predicted_observations(Eigen::MatrixXd& y) const {
 }
 
 void CpuEnsemble::recenter(const Recentering& r) {
+  Eigen::MatrixXd X, V;
+  read_states(X, V);
+  // docs/ROUKF.md steps 1-2 (filter/ensemble.h, resampled_states): mean and factor of the
+  // predicted states, the correction, then the new factor L C and the re-sampled states;
+  // positions and velocities alike (the state of a dynamic simulation is both).
+  write_states(resampled_states(X, r), resampled_states(V, r));
+}
+
+void CpuEnsemble::read_states(Eigen::MatrixXd& positions, Eigen::MatrixXd& velocities) const {
   const int S = sigma_count();
   const Eigen::Index n = simulations_[0].positions().size();
-  Eigen::MatrixXd X(n, S), V(n, S);
+  positions.resize(n, S);
+  velocities.resize(n, S);
   for (int s = 0; s < S; ++s) {
-    X.col(s) = simulations_[s].positions();
-    V.col(s) = simulations_[s].velocities();
+    positions.col(s) = simulations_[s].positions();
+    velocities.col(s) = simulations_[s].velocities();
   }
-  // docs/ROUKF.md steps 1-2 (see Recentering): mean and factor of the predicted states, the
-  // correction, then the new factor L C and the re-sampled states; positions and velocities
-  // alike (the state of a dynamic simulation is both).
-  auto resample = [&](const Eigen::MatrixXd& Y) {
-    const Eigen::VectorXd mean = r.alpha * Y.rowwise().sum();
-    const Eigen::MatrixXd L = r.alpha * Y * r.directions.transpose();   // n x p
-    const Eigen::VectorXd y_hat = mean + L * r.correction;
-    return Eigen::MatrixXd(y_hat.replicate(1, S) + L * r.factor * r.directions);
-  };
-  const Eigen::MatrixXd X_new = resample(X), V_new = resample(V);
-  for (int s = 0; s < S; ++s) simulations_[s].set_state(X_new.col(s), V_new.col(s));
+}
+
+void CpuEnsemble::write_states(const Eigen::MatrixXd& positions, const Eigen::MatrixXd& velocities) {
+  check_state_matrices(positions, velocities, simulations_[0].positions().size(), sigma_count(), "CpuEnsemble");
+  for (int s = 0; s < sigma_count(); ++s) simulations_[s].set_state(positions.col(s), velocities.col(s));
 }
 
 }  // namespace sigmafem

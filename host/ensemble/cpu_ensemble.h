@@ -50,6 +50,8 @@ class CpuEnsemble : public SimulationEnsemble {
   StepReport advance(const Eigen::Vector3d& so_position) override;
   void predicted_observations(Eigen::MatrixXd& y) const override;
   void recenter(const Recentering& recentering) override;
+  void read_states(Eigen::MatrixXd& positions, Eigen::MatrixXd& velocities) const override;
+  void write_states(const Eigen::MatrixXd& positions, const Eigen::MatrixXd& velocities) override;
 
   void set_physics_effects(const std::vector<PhysicsEffects>& effects) override;
 

@@ -94,6 +94,18 @@ std::vector<double> DeviceEnsemble::column_of(DeviceBuffer buffer, std::size_t r
   return sigma_column(read_reals(buffer, rows * S_), rows, S_, s, who_);
 }
 
+void DeviceEnsemble::read_states(Eigen::MatrixXd& positions, Eigen::MatrixXd& velocities) const {
+  const std::size_t rows = 3 * static_cast<std::size_t>(nodes_);
+  positions = from_sigma_rows(read_reals(DeviceBuffer::x, rows * S_), rows, S_);
+  velocities = from_sigma_rows(read_reals(DeviceBuffer::v, rows * S_), rows, S_);
+}
+
+void DeviceEnsemble::write_states(const Eigen::MatrixXd& positions, const Eigen::MatrixXd& velocities) {
+  check_state_matrices(positions, velocities, 3 * static_cast<Eigen::Index>(nodes_), S_, who_);
+  write_reals(DeviceBuffer::x, to_sigma_rows(positions));
+  write_reals(DeviceBuffer::v, to_sigma_rows(velocities));
+}
+
 Eigen::VectorXd DeviceEnsemble::positions(int s) const {
   const std::vector<double> column = column_of(DeviceBuffer::x, 3 * static_cast<std::size_t>(nodes_), s);
   return Eigen::Map<const Eigen::VectorXd>(column.data(), static_cast<Eigen::Index>(column.size()));

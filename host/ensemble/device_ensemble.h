@@ -36,6 +36,8 @@ class DeviceEnsemble : public SimulationEnsemble {
   void set_parameters(const Eigen::MatrixXd& theta) override;
   void set_physics_effects(const std::vector<PhysicsEffects>& effects) override;
 
+  void read_states(Eigen::MatrixXd& positions, Eigen::MatrixXd& velocities) const override;
+  void write_states(const Eigen::MatrixXd& positions, const Eigen::MatrixXd& velocities) override;
   // Sigma point s's positions and velocities, 3 per node (node-major, as the CPU reference).
   Eigen::VectorXd positions(int s) const;
   Eigen::VectorXd velocities(int s) const;
