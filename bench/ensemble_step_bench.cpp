@@ -11,6 +11,7 @@
 #include <string>
 
 #include "bench/bench_scenarios.h"
+#include "bench/filter_step_timing.h"
 #include "filter/point_cloud_observation.h"
 #include "filter/roukf.h"
 #include "host/engine/estimation_options.h"
@@ -142,49 +143,6 @@ void BM_ensemble_step(benchmark::State& state, const Backend& backend, const std
   state.SetLabel(backend.label);
 }
 
-// Times whole filter steps of `ensemble` on `s`: re-centre, advance, gather, correct (the
-// truth, `model` simulated beside it outside the timing, gives the observations).
-void time_filter_steps(benchmark::State& state, Ensemble& ensemble, const Scenario& s, const Model& model,
-                       RoukfOptions options) {
-  options.sigma_points = SigmaPointSet::simplex;
-  Roukf filter(options, ensemble);
-  ReferenceSimulation truth(model);
-  Eigen::VectorXd y(3 * static_cast<Eigen::Index>(s.observations.observed.size()));
-  int step = 0;
-  const auto observe = [&] {
-    ++step;
-    const Eigen::Vector3d so = bench::so_position(s, step);
-    truth.step(so);
-    for (std::size_t k = 0; k < s.observations.observed.size(); ++k)
-      y.segment<3>(3 * static_cast<Eigen::Index>(k)) = s.observations.observed[k].of(truth.positions());
-    return so;
-  };
-  // Warm-up steps, untimed: PoCL compiles a kernel at its first launch.
-  for (int i = 0; i < 5; ++i) {
-    const Eigen::Vector3d so = observe();
-    filter.step(so, y);
-  }
-  // The factorisations in the timed steps (CPU back end, OpenCL's shared factor; issue 18),
-  // as the steps' reports give them.
-  int factorisations = 0;
-  double cg_iterations = 0.0;   // summed over the sigma points and the steps
-  for (auto _ : state) {
-    state.PauseTiming();
-    const Eigen::Vector3d so = observe();
-    state.ResumeTiming();
-    const RoukfStep result = filter.step(so, y);
-    factorisations += result.ensemble.factorisations;
-    for (int n : result.ensemble.cg_iterations) cg_iterations += n;
-    benchmark::DoNotOptimize(result);
-  }
-  const double steps = static_cast<double>(state.iterations());
-  state.counters["factorisations_per_step"] = factorisations / steps;
-  state.counters["cg_iterations"] = cg_iterations / (steps * ensemble.sigma_count());
-  state.counters["sigma_points"] = ensemble.sigma_count();
-  state.counters["parameters"] = ensemble.parameter_count();
-  state.counters["tetrahedra"] = model.element_count();
-}
-
 // One whole filter step on scenario `name` (simplex sigma points).
 void BM_filter_step(benchmark::State& state, const Backend& backend, const std::string& name) {
   const Scenario& s = bench::scenario(name, 0);
@@ -198,7 +156,7 @@ void BM_filter_step(benchmark::State& state, const Backend& backend, const std::
     state.SkipWithError(e.what());
     return;
   }
-  time_filter_steps(state, *ensemble, s, model, estimation_options(s).roukf);
+  bench::time_filter_steps(state, *ensemble, s, model, estimation_options(s).roukf);
   state.SetLabel(backend.label + ", " + name + ", simplex");
 }
 
@@ -207,17 +165,8 @@ void BM_filter_step(benchmark::State& state, const Backend& backend, const std::
 // e % (p - 3) = r), the truth at the model's moduli.
 void BM_filter_step_parameters(benchmark::State& state, const Backend& backend) {
   const int p = static_cast<int>(state.range(0));
-  Scenario s = bench::scenario("liver", 0);
+  const Scenario s = bench::with_region_moduli(bench::scenario("liver", 0), p);
   const int regions = p - 3;
-  for (int r = 0; r < regions; ++r) {
-    Region region;
-    region.name = "r" + std::to_string(r);
-    for (int e = r; e < s.mesh.tetrahedron_count(); e += regions) region.elements.push_back(e);
-    region.young_modulus = s.material.young_modulus;
-    s.regions.push_back(region);
-    s.filter->estimate_regions.push_back(r);
-    s.filter->initial_young_modulus.push_back(2.0 * s.material.young_modulus);
-  }
   Model model = make_model(s);
   const EstimatedParameters estimated = estimated_parameters(*s.filter, model);
   std::unique_ptr<Ensemble> ensemble;
@@ -227,7 +176,7 @@ void BM_filter_step_parameters(benchmark::State& state, const Backend& backend) 
     state.SkipWithError(e.what());
     return;
   }
-  time_filter_steps(state, *ensemble, s, model, estimation_options(s).roukf);
+  bench::time_filter_steps(state, *ensemble, s, model, estimation_options(s).roukf);
   state.SetLabel(backend.label + ", liver, " + std::to_string(regions) + " region moduli, simplex");
 }
 

@@ -8,6 +8,7 @@
 #include <iostream>
 #include <memory>
 #include <optional>
+#include <thread>
 
 #include "filter/estimation.h"
 #include "filter/residual_diagnostics.h"
@@ -100,16 +101,14 @@ std::optional<json> run_estimation_job(const Scenario& scenario, const Estimatio
         table.frame_shares);
     if (!table.frame_times.empty()) observations["frame_time"] = true;
   } else {
-    // Over MPI ranks: every rank makes its share; all learn whether every rank has one.
-    std::unique_ptr<SimulationEnsemble> local;
-    std::exception_ptr failure;
-    try {
-      local = make_ensemble(backend.backend, model, estimated, scenario.observations.observed,
-                            sigma_share(sigma_count, world.size, world.rank).count, job.device);
-    } catch (...) {
-      failure = std::current_exception();
-    }
-    agree_on_shares(failure, local.get(), sigma_count);
+    // Over MPI ranks: every rank makes its share; all learn whether every rank has one. The
+    // CPU back end's threads share the machine's cores with the other ranks on it.
+    DeviceOptions device = job.device;
+    if (device.cpu_threads == 0)
+      device.cpu_threads = std::max(1, static_cast<int>(std::thread::hardware_concurrency()) / world.local_size);
+    std::unique_ptr<SimulationEnsemble> local = make_share(sigma_count, [&](int count) {
+      return make_ensemble(backend.backend, model, estimated, scenario.observations.observed, count, device);
+    });
     if (world.rank != 0) {
       serve_ensemble(*local, sigma_count);
       return std::nullopt;

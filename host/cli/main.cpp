@@ -16,6 +16,10 @@
 
 namespace {
 
+// One line on stderr, in one write: the ranks of an MPI run share the terminal, and a line
+// written piece by piece could interleave with another rank's.
+void report(const std::string& line) { std::cerr << line + "\n" << std::flush; }
+
 // The command's exit code, with every error reported on stderr as the header says.
 int run_command(CLI::App& app, std::map<CLI::App*, sigmafem::cli::Action>& actions) {
   const std::string name = sigmafem::program_name();
@@ -26,16 +30,16 @@ int run_command(CLI::App& app, std::map<CLI::App*, sigmafem::cli::Action>& actio
       return actions.at(sub)();
     }
   } catch (const sigmafem::Interrupted& e) {
-    std::cerr << name << ": " << e.what() << '\n';
+    report(name + ": " + e.what());
     return 128 + e.signal_number();
   } catch (const sigmafem::InputError& e) {
-    std::cerr << name << ": error: " << e.what() << '\n';
+    report(name + ": error: " + e.what());
     return 2;
   } catch (const sigmafem::DeviceError& e) {
-    std::cerr << name << ": device error: " << e.what() << '\n';
+    report(name + ": device error: " + e.what());
     return 3;
   } catch (const std::exception& e) {
-    std::cerr << name << ": failed: " << e.what() << '\n';
+    report(name + ": failed: " + e.what());
     return 1;
   }
   return 0;
@@ -47,7 +51,7 @@ int main(int argc, char** argv) {
   try {
     sigmafem::start_ranks(&argc, &argv);
   } catch (const sigmafem::InputError& e) {
-    std::cerr << "sigmafem: error: " << e.what() << '\n';
+    report(std::string("sigmafem: error: ") + e.what());
     return 2;
   }
   struct EndRanks {   // every return below ends MPI where start_ranks started it

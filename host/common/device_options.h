@@ -43,6 +43,9 @@ struct DeviceOptions {
   // cg_partitions() in host/ensemble/device_limits.h); 0 chooses by the mesh's size.
   int cg_partitions = 0;
   Preconditioner preconditioner = Preconditioner::automatic;
+  // The CPU back end's worker threads: 0, the machine's cores (over MPI ranks, shared among
+  // the ranks on one machine: estimation_job.cpp).
+  int cpu_threads = 0;
 };
 
 }  // namespace sigmafem

@@ -19,7 +19,7 @@ std::unique_ptr<SimulationEnsemble> make_ensemble(const std::string& backend, co
     return make_ensemble(resolve_backend(backend, model, sigma_count).backend, model, estimated,
                          observed, sigma_count, options);
   if (backend == "cpu")
-    return std::make_unique<CpuEnsemble>(model, estimated, observed, sigma_count, 0,
+    return std::make_unique<CpuEnsemble>(model, estimated, observed, sigma_count, options.cpu_threads,
                                          options.preconditioner);
   if (options.preconditioner == Preconditioner::factorised && backend == "vulkan")
     throw InputError("--preconditioner factorised: the cpu back end and OpenCL on a CPU device "

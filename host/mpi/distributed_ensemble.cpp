@@ -1,5 +1,6 @@
 #include "host/mpi/distributed_ensemble.h"
 
+#include <chrono>
 #include <cstdio>
 #include <cstdlib>
 #include <stdexcept>
@@ -264,6 +265,7 @@ void DistributedEnsemble::predicted_observations(Eigen::MatrixXd& y) const {
 }
 
 void DistributedEnsemble::recenter(const Recentering& recentering) {
+  const auto start = std::chrono::steady_clock::now();
   broadcast_command(kRecenter);
   Eigen::MatrixXd X, V;
   std::exception_ptr own;
@@ -306,6 +308,7 @@ void DistributedEnsemble::recenter(const Recentering& recentering) {
   if (failure.code != 0) failure.raise();
   const Eigen::Index count = shares_[0].count;
   local_->write_states(new_X.leftCols(count), new_V.leftCols(count));
+  recenter_seconds_ += std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
 }
 
 void serve_ensemble(SimulationEnsemble& local, int sigma_count) {

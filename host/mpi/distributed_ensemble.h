@@ -22,6 +22,7 @@
 #include <vector>
 
 #include "host/ensemble/simulation_ensemble.h"
+#include "host/mpi/ranks.h"
 #include "host/mpi/sigma_share.h"
 
 namespace sigmafem {
@@ -48,6 +49,9 @@ class DistributedEnsemble : public Ensemble {
   void stop(int exit_code = 0, const std::string& failure = "");
   // The same after `failure` ended rank 0's run: the exit code and message main gives for it.
   void stop_after(const std::exception_ptr& failure);
+  // Seconds rank 0 spent in the re-centrings so far: reading its share, the gather, the
+  // re-sampling of all S and the scatter (what the benchmark's model of many machines needs).
+  double recenter_seconds() const { return recenter_seconds_; }
 
  private:
   std::unique_ptr<SimulationEnsemble> local_;
@@ -56,6 +60,7 @@ class DistributedEnsemble : public Ensemble {
   std::vector<SigmaShare> shares_;   // per rank
   bool serving_ = true;              // the other ranks wait for commands
   int advances_ = 0;
+  double recenter_seconds_ = 0.0;
 };
 
 // On every rank other than 0: runs this rank's share `local` on rank 0's commands until rank 0
@@ -68,5 +73,20 @@ void serve_ensemble(SimulationEnsemble& local, int sigma_count);
 // (sigma points, parameters, observations, state size). Throws on every rank when not: the
 // failing rank its own error, the others the same kind of error naming that rank.
 void agree_on_shares(const std::exception_ptr& failure, const SimulationEnsemble* local, int sigma_count);
+
+// Every rank: this rank's share of S sigma points, made by `make(count)` (make_ensemble with
+// the share's count), once every rank has agreed (agree_on_shares).
+template <class Make>
+std::unique_ptr<SimulationEnsemble> make_share(int sigma_count, Make make) {
+  std::unique_ptr<SimulationEnsemble> local;
+  std::exception_ptr failure;
+  try {
+    local = make(sigma_share(sigma_count, ranks().size, ranks().rank).count);
+  } catch (...) {
+    failure = std::current_exception();
+  }
+  agree_on_shares(failure, local.get(), sigma_count);
+  return local;
+}
 
 }  // namespace sigmafem

@@ -30,6 +30,10 @@ void start_ranks(int* argc, char*** argv) {
   started = true;
   MPI_Comm_rank(MPI_COMM_WORLD, &world.rank);
   MPI_Comm_size(MPI_COMM_WORLD, &world.size);
+  MPI_Comm machine;
+  MPI_Comm_split_type(MPI_COMM_WORLD, MPI_COMM_TYPE_SHARED, 0, MPI_INFO_NULL, &machine);
+  MPI_Comm_size(machine, &world.local_size);
+  MPI_Comm_free(&machine);
 #else
   (void)argc;
   (void)argv;

@@ -11,6 +11,7 @@ namespace sigmafem {
 struct RankInfo {
   int rank = 0;    // this process's rank in MPI_COMM_WORLD
   int size = 1;    // ranks in all
+  int local_size = 1;   // ranks on this machine (they share its cores)
   bool distributed() const { return size > 1; }
 };
 
