@@ -77,10 +77,7 @@ def main():
     spec['control'] = fine['control']
     spec['solver'] = fine['solver']
     spec['time'] = {'dt': base['time']['dt'], 'steps': 10}
-    # liver.json's noise (0.5 mm) and no gravity, as sigmafem_mpi_bench's 38k case (which
-    # steps in 7.6 s on 2 ranks). Measured on 2 ranks of the 2-core machine, CPU back end:
-    # this scenario's 10 steps did not finish in 5 minutes, nor with gravity and
-    # liver_inclusion.json's noise-free data in 20 (README, "Over MPI ranks").
+    # liver.json's noise (0.5 mm) and no gravity, as sigmafem_mpi_bench's 38k case.
     spec['gravity'] = [0.0, 0.0, 0.0]
     spec['observations'] = dict(base['observations'], nodes=list(range(140)), noise_std=0.0005)
     spec['regions'] = regions

@@ -39,6 +39,7 @@ void CpuEnsemble::make_factors() {
   shared_factor_ = sigma_count() * first->bytes() > own_factors_budget_;
   factors_.push_back(std::move(first));
   if (shared_factor_) {
+    if (sigma_count() > 1) factors_[0]->factorise(representative_system());
     for (ReferenceSimulation& simulation : simulations_)
       simulation.set_preconditioner(factors_[0].get(), false);
     return;
@@ -53,8 +54,27 @@ int CpuEnsemble::factorisations() const {
   return count;
 }
 
+Eigen::SparseMatrix<double> CpuEnsemble::representative_system() const {
+  ReferenceSimulation representative = simulations_[0];
+  if (mean_theta_.size() > 0) {
+    std::vector<double> stiffness = representative.ligament_stiffness(), moduli;
+    apply_parameters(representative.model(), estimated_, mean_theta_, stiffness, moduli);
+    representative.set_ligament_stiffness(stiffness);
+    representative.set_region_young_modulus(moduli);
+  }
+  Eigen::VectorXd x = Eigen::VectorXd::Zero(simulations_[0].positions().size());
+  Eigen::VectorXd v = x;
+  for (const ReferenceSimulation& simulation : simulations_) {
+    x += simulation.positions();
+    v += simulation.velocities();
+  }
+  representative.set_state(x / sigma_count(), v / sigma_count());
+  return representative.system_matrix();
+}
+
 void CpuEnsemble::set_parameters(const Eigen::MatrixXd& theta) {
   check_parameter_matrix(theta, parameter_count(), sigma_count(), "CpuEnsemble");
+  mean_theta_ = theta.rowwise().mean();
   for (int s = 0; s < sigma_count(); ++s) {
     std::vector<double> stiffness = simulations_[s].ligament_stiffness(), moduli;
     apply_parameters(simulations_[s].model(), estimated_, theta.col(s), stiffness, moduli);
@@ -78,7 +98,7 @@ StepReport CpuEnsemble::advance(const Eigen::Vector3d& so_position) {
   const int factorisations_before = factorisations();
   if (preconditioner_ != Preconditioner::jacobi && factors_.empty()) make_factors();
   // A shared factor is made again here, between steps; own ones in each simulation's step.
-  if (shared_factor_ && factors_[0]->due()) factors_[0]->factorise(simulations_[0].system_matrix());
+  if (shared_factor_ && factors_[0]->due()) factors_[0]->factorise(representative_system());
   pool_->run(S, [&](int s) {
     const CgResult cg = simulations_[s].step(so_position);
     report.cg_iterations[s] = cg.iterations;

@@ -8,7 +8,8 @@
 // CG's preconditioner (host/common/device_options.h): Jacobi, as the lone ReferenceSimulation,
 // or sparse Cholesky factors (factorised_preconditioner.h): one per sigma point, each made
 // from its own system and again when it stops paying, while the S of them fit in
-// kOwnFactorsBytes (cpu_ensemble.cpp); else one that all share, of sigma point 0's system,
+// kOwnFactorsBytes (cpu_ensemble.cpp); else one that all share, of the representative
+// system (the sigma points' mean parameters at their mean state, as OpenCL's shared factor),
 // made again between steps. The choice is made at the first step, from the size of sigma
 // point 0's factor. Either way the results do not depend on the thread count; they differ
 // from Jacobi's within the CG tolerance.
@@ -77,7 +78,14 @@ class CpuEnsemble : public SimulationEnsemble {
   std::vector<std::unique_ptr<FactorisedPreconditioner>> factors_;
   bool shared_factor_ = false;
   double own_factors_budget_;
+  Eigen::VectorXd mean_theta_;   // the sigma points' mean parameters (none yet: the model's)
   void make_factors();
+  // What a shared factor is made of: the sigma points' mean parameters at their mean state.
+  // Sigma point 0's own system was used until stop 48: a simplex point lies sqrt(p) prior
+  // stds from the mean along one parameter, and over MPI ranks (p = 32 box regions on the 38k
+  // liver) the rank whose first point held a region at 0.4% of the mean's modulus ran many
+  // times the others' CG iterations (bench/RESULTS.md, stop 48).
+  Eigen::SparseMatrix<double> representative_system() const;
 };
 
 }  // namespace sigmafem
