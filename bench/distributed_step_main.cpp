@@ -11,7 +11,6 @@
 #include <iostream>
 #include <memory>
 #include <string>
-#include <thread>
 
 #include "bench/bench_scenarios.h"
 #include "bench/filter_step_timing.h"
@@ -63,7 +62,7 @@ int run(int argc, char** argv) {
   Model model = make_model(s);
   const EstimatedParameters estimated = estimated_parameters(*s.filter, model);
   DeviceOptions options;
-  options.cpu_threads = std::max(1, static_cast<int>(std::thread::hardware_concurrency()) / world.local_size);
+  options.cpu_threads = world.cores_per_rank();
   std::unique_ptr<SimulationEnsemble> local = make_share(S, [&](int count) {
     return make_ensemble(c.backend, model, estimated, s.observations.observed, count, options);
   });

@@ -8,7 +8,6 @@
 #include <iostream>
 #include <memory>
 #include <optional>
-#include <thread>
 
 #include "filter/estimation.h"
 #include "filter/residual_diagnostics.h"
@@ -105,7 +104,7 @@ std::optional<json> run_estimation_job(const Scenario& scenario, const Estimatio
     // CPU back end's threads share the machine's cores with the other ranks on it.
     DeviceOptions device = job.device;
     if (device.cpu_threads == 0)
-      device.cpu_threads = std::max(1, static_cast<int>(std::thread::hardware_concurrency()) / world.local_size);
+      device.cpu_threads = world.cores_per_rank();
     std::unique_ptr<SimulationEnsemble> local = make_share(sigma_count, [&](int count) {
       return make_ensemble(backend.backend, model, estimated, scenario.observations.observed, count, device);
     });

@@ -1,6 +1,8 @@
 #include "host/mpi/ranks.h"
 
+#include <algorithm>
 #include <cstdlib>
+#include <thread>
 
 #include "host/common/input_error.h"
 #if SIGMAFEM_HAVE_MPI
@@ -48,6 +50,10 @@ void finish_ranks() {
   if (started) MPI_Finalize();
   started = false;
 #endif
+}
+
+int RankInfo::cores_per_rank() const {
+  return std::max(1, static_cast<int>(std::thread::hardware_concurrency()) / local_size);
 }
 
 const RankInfo& ranks() { return world; }

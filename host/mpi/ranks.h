@@ -13,6 +13,8 @@ struct RankInfo {
   int size = 1;    // ranks in all
   int local_size = 1;   // ranks on this machine (they share its cores)
   bool distributed() const { return size > 1; }
+  // This machine's cores divided among its ranks (at least 1): a rank's CPU threads.
+  int cores_per_rank() const;
 };
 
 // Starts MPI when the process was launched by mpirun (Open MPI's OMPI_COMM_WORLD_SIZE, or
