@@ -21,9 +21,13 @@ inline constexpr int kTetrahedronEdges[6][2] = {{0, 1}, {0, 2}, {0, 3}, {1, 2}, 
 struct Mesh {
   std::vector<Eigen::Vector3d> nodes;            // positions, metres once transformed
   std::vector<std::array<int, 4>> tetrahedra;    // 0-based node indices, positively oriented
-  // Per tetrahedron, the label the file gives it (Gmsh: its physical group; 0 when it has
-  // none), for regions selected by label; empty when the reader keeps none (VTK).
+  // Per tetrahedron, the label the file gives it (Gmsh: its physical group, 0 when it has
+  // none; VTK: its value in a CELL_DATA array of integers), for regions selected by label;
+  // empty when the file gives none.
   std::vector<int> labels;
+  // Where the labels come from ("physical groups", "CELL_DATA array ..."), or when there are
+  // none, why: for the error of a scenario that selects a region by label.
+  std::string labels_from;
   int node_count() const { return static_cast<int>(nodes.size()); }
   int tetrahedron_count() const { return static_cast<int>(tetrahedra.size()); }
 };

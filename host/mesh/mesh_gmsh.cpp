@@ -395,6 +395,7 @@ class GmshReader {
                            std::to_string(other_elements_) +
                            " elements of other types; sigmafem needs a volume mesh (gmsh -3)");
     }
+    mesh_.labels_from = "physical groups";
     return std::move(mesh_);
   }
 

@@ -80,6 +80,7 @@ Mesh refine_uniform(const Mesh& mesh) {
   }
 
   refined.tetrahedra.reserve(8 * mesh.tetrahedra.size());
+  refined.labels_from = mesh.labels_from;
   if (!mesh.labels.empty())
     for (int label : mesh.labels) refined.labels.insert(refined.labels.end(), 8, label);   // the children's order below
   for (int e = 0; e < mesh.tetrahedron_count(); ++e) {

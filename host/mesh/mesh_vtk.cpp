@@ -12,11 +12,20 @@
 //                                     "CONNECTIVITY type" m values; cell i is
 //                                     connectivity[offsets[i] .. offsets[i+1])
 //   CELL_TYPES n                      n ints
-//   POINT_DATA / CELL_DATA ...        ignored: reading stops once the three above are read
+//   POINT_DATA n / CELL_DATA n        attributes (SCALARS, FIELD, VECTORS, ...): skipped, except
+//                                     CELL_DATA's one-component integer arrays, which give the
+//                                     tetrahedra's labels (below)
 // ASCII values are separated by any white space. BINARY values are big-endian, start right
 // after the keyword's line and are followed by a line end; legacy CELLS and CELL_TYPES are
 // 32-bit ints. Point indices are 0-based, so the Mesh's nodes are the file's points as they
 // are. FIELD and METADATA blocks before the cells are skipped.
+//
+// Labels (regions by label, issue 19): a one-component array of an integer type in
+// CELL_DATA, SCALARS or a FIELD array: the one named "gmsh:physical" (meshio's name for
+// Gmsh's physical groups) when there is one, else the first. The data sections never fail
+// the mesh, which needs none of them: one this reader cannot read (a type it does not
+// know, a truncated block) ends the reading there, and Mesh::labels_from says why there
+// are no labels, for the scenario that asks for them.
 #include <algorithm>
 #include <climits>
 #include <cmath>
@@ -28,6 +37,7 @@
 #include <utility>
 #include <vector>
 
+#include "host/common/input_error.h"
 #include "host/mesh/mesh_formats.h"
 #include "host/mesh/text_cursor.h"
 
@@ -63,6 +73,8 @@ constexpr ValueType kValueTypes[] = {
     {"vtktypeuint64", 8, ValueType::Kind::unsigned_integer},
 };
 constexpr ValueType kInt32 = {"int", 4, ValueType::Kind::signed_integer};
+// COLOR_SCALARS and LOOKUP_TABLE values: floats in ASCII files, bytes in BINARY ones.
+constexpr ValueType kUnsignedChar = {"unsigned_char", 1, ValueType::Kind::unsigned_integer};
 
 std::string lower_case(std::string_view text) {
   std::string lower(text);
@@ -111,6 +123,7 @@ class VtkReader {
         in_.fail("expected POINTS, CELLS or CELL_TYPES, found " + quote_for_message(token));
       }
     }
+    if (have_points_ && have_cells_ && have_cell_types_) read_data_sections();
     return finish();
   }
 
@@ -244,6 +257,111 @@ class VtkReader {
     in_.finish_line();
     while (const std::optional<std::string_view> line = in_.next_line()) {
       if (split_fields(*line).empty()) return;
+    }
+  }
+
+  // ---- data sections: the labels -----------------------------------------------------------
+
+  void read_data_sections() {
+    try {
+      bool cell_data = false;
+      long long count = -1;  // values per component in the current section
+      while (true) {
+        const std::string_view token = in_.next_token();
+        if (token.empty()) break;
+        const std::string keyword = lower_case(token);
+        if (keyword == "point_data" || keyword == "cell_data") {
+          cell_data = keyword == "cell_data";
+          count = read_count("the number of values");
+        } else if (keyword == "metadata") {
+          skip_metadata();
+        } else if (count < 0) {
+          in_.fail("expected POINT_DATA or CELL_DATA, found " + quote_for_message(token));
+        } else {
+          read_attribute(keyword, count, cell_data);
+        }
+      }
+    } catch (const InputError& error) {
+      data_stopped_ = std::string("reading the data sections stopped: ") + error.what();
+    }
+  }
+
+  // One attribute of a data section of `count` tuples; SCALARS and FIELD arrays of CELL_DATA
+  // become label candidates.
+  void read_attribute(const std::string& keyword, long long count, bool cell_data) {
+    const int line = in_.line();
+    if (keyword == "scalars") {
+      const std::string name(in_.require_token("the array name"));
+      const ValueType& type = read_type();
+      long long components = 1;
+      TextCursor ahead = in_;  // the component count is optional, on the same line
+      const std::string_view next = ahead.next_token();
+      if (!next.empty() && ahead.line() == in_.line()) components = read_count("the number of components");
+      ahead = in_;  // so is, against the format's text but as VTK's reader allows, LOOKUP_TABLE
+      if (lower_case(ahead.next_token()) == "lookup_table") {
+        in_.next_token();
+        in_.require_token("the lookup table's name");
+      }
+      read_array(name, line, components, count, type, cell_data);
+    } else if (keyword == "field") {
+      in_.require_token("the field name");
+      const long long arrays = read_count("the number of field arrays");
+      for (long long a = 0; a < arrays; ++a) {
+        const std::string name(in_.require_token("a field array name"));
+        const int array_line = in_.line();
+        const long long components = read_count("the number of components");
+        const long long tuples = read_count("the number of tuples");
+        read_array(name, array_line, components, tuples, read_type(), cell_data);
+      }
+    } else if (keyword == "vectors" || keyword == "normals" || keyword == "tensors" ||
+               keyword == "tensors6" || keyword == "global_ids" || keyword == "pedigree_ids") {
+      in_.require_token("the array name");
+      const long long components = keyword == "vectors" || keyword == "normals" ? 3
+                                   : keyword == "tensors"                     ? 9
+                                   : keyword == "tensors6"                    ? 6
+                                                                              : 1;
+      skip_values(components, count, read_type());
+    } else if (keyword == "texture_coordinates") {
+      in_.require_token("the array name");
+      const long long dimension = read_count("the texture dimension");
+      skip_values(dimension, count, read_type());
+    } else if (keyword == "color_scalars") {
+      in_.require_token("the array name");
+      skip_values(read_count("the number of values"), count, kUnsignedChar);
+    } else if (keyword == "lookup_table") {
+      in_.require_token("the lookup table's name");
+      skip_values(4, read_count("the lookup table's size"), kUnsignedChar);
+    } else {
+      in_.fail("expected a data attribute (SCALARS, FIELD, VECTORS, ...), found " + quote_for_message(keyword));
+    }
+  }
+
+  // An array of `components` x `tuples` values: a label candidate when it is one integer a
+  // cell, else skipped.
+  void read_array(const std::string& name, int line, long long components, long long tuples,
+                  const ValueType& type, bool cell_data) {
+    if (!cell_data || components != 1 || type.kind == ValueType::Kind::real) {
+      skip_values(components, tuples, type);
+      return;
+    }
+    std::vector<long long> values = read_integers(tuples, type, "CELL_DATA values");
+    if (label_array_.empty() || (name == "gmsh:physical" && label_array_name_ != name)) {
+      label_array_ = std::move(values);
+      label_array_name_ = name;
+      label_array_line_ = line;
+    }
+  }
+
+  void skip_values(long long components, long long tuples, const ValueType& type) {
+    if (components > 0 && tuples > kMaxMeshCount / components) {
+      in_.fail("an array of " + std::to_string(components) + " x " + std::to_string(tuples) +
+               " values is too large");
+    }
+    const long long count = components * tuples;
+    if (binary_) {
+      read_block(count, type, "data values");
+    } else {
+      for (long long i = 0; i < count; ++i) in_.require_token("data values");
     }
   }
 
@@ -384,7 +502,34 @@ class VtkReader {
                                    std::to_string(other_cells) +
                                    " cells of other types; sigmafem needs a volume mesh");
     }
+    keep_labels(cells);
     return std::move(mesh_);
+  }
+
+  // The label array's values of the tetrahedra, or in labels_from why there are none.
+  void keep_labels(long long cells) {
+    if (label_array_.empty()) {
+      mesh_.labels_from = !data_stopped_.empty() ? data_stopped_ : "no one-component integer array in CELL_DATA";
+      return;
+    }
+    const std::string array = "CELL_DATA array \"" + label_array_name_ + "\" (line " + std::to_string(label_array_line_) + ")";
+    if (static_cast<long long>(label_array_.size()) != cells) {
+      mesh_.labels_from = array + " has " + std::to_string(label_array_.size()) + " values for " +
+                          std::to_string(cells) + " cells";
+      return;
+    }
+    std::vector<int> labels;
+    for (long long i = 0; i < cells; ++i) {
+      if (cell_types_[static_cast<std::size_t>(i)] != kTetraCellType) continue;
+      const long long label = label_array_[static_cast<std::size_t>(i)];
+      if (label < INT_MIN || label > INT_MAX) {
+        mesh_.labels_from = array + ": cell " + std::to_string(i) + "'s value " + std::to_string(label) + " is not an int";
+        return;
+      }
+      labels.push_back(static_cast<int>(label));
+    }
+    mesh_.labels = std::move(labels);
+    mesh_.labels_from = array;
   }
 
   TextCursor& in_;
@@ -401,6 +546,11 @@ class VtkReader {
   int points_line_ = 0;
   int cells_line_ = 0;
   int cell_types_line_ = 0;
+  // The CELL_DATA array chosen for the labels, one value a cell, and why reading stopped.
+  std::vector<long long> label_array_;
+  std::string label_array_name_;
+  int label_array_line_ = 0;
+  std::string data_stopped_;
 };
 
 }  // namespace

@@ -337,12 +337,14 @@ void read_regions(const Checker& c, const json& root, Scenario& s) {
               "duplicate region name (also regions[" + std::to_string(s.region_index(region.name)) +
                   "]); names must be unique");
     c.require(item.contains("select") != item.contains("label"), path,
-              "give either \"select\" (by element centroids) or \"label\" (a physical group of the mesh file)");
+              "give either \"select\" (by element centroids) or \"label\" (a physical group or CELL_DATA label of the mesh file)");
     region.selection.field = path;
     if (item.contains("label")) {
       region.label = c.integer(item.at("label"), child(path, "label"));
       c.require(!s.mesh.labels.empty(), child(path, "label"),
-                "mesh " + s.mesh_spec.file + " labels no element (Gmsh files do, by physical group; VTK files do not)");
+                "mesh " + s.mesh_spec.file + " labels no element (" +
+                    (s.mesh.labels_from.empty() ? "it was not read from a file" : s.mesh.labels_from) +
+                    "; Gmsh files label by physical group, VTK files by a CELL_DATA array of integers)");
       region.elements = region_elements(s.mesh, region);
       std::set<int> labels(s.mesh.labels.begin(), s.mesh.labels.end());
       std::string known;

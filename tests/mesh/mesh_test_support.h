@@ -153,8 +153,10 @@ inline std::string vtk_ascii_text(const Mesh& mesh) {
     out << "4 " << t[0] << " " << t[1] << "\n" << t[2] << " " << t[3] << "\n";
   out << "CELL_TYPES " << cells << "\n1\n5\n";
   for (int e = 0; e < mesh.tetrahedron_count(); ++e) out << "10\n";
-  out << "CELL_DATA " << cells << "\nSCALARS region int 1\nLOOKUP_TABLE default\n";
-  for (int e = 0; e < cells; ++e) out << "1\n";
+  // The mesh's labels (1 without), 7 for the vertex and the triangle, which are no tetrahedra.
+  out << "CELL_DATA " << cells << "\nSCALARS region int 1\nLOOKUP_TABLE default\n7\n7\n";
+  for (int e = 0; e < mesh.tetrahedron_count(); ++e)
+    out << (mesh.labels.empty() ? 1 : mesh.labels[static_cast<std::size_t>(e)]) << "\n";
   return out.str();
 }
 

@@ -31,6 +31,11 @@ void expect_vtk_error(const std::string& content, const std::string& expected) {
 }
 using test::replace;
 
+Mesh read_named(const std::string& name, const std::string& content) {
+  test::TempDir dir;
+  return read_mesh(dir.write(name, content));
+}
+
 TEST(VtkReader, MinimalAsciiFileReads) {
   test::TempDir dir;
   const Mesh mesh = read_mesh(dir.write("tet.vtk", kAscii));
@@ -126,6 +131,55 @@ TEST(VtkReader, Version51OffsetsAreChecked) {
   const std::size_t connectivity = binary.find("CONNECTIVITY vtktypeint64\n") + 26;
   binary[connectivity] = '\x7f';
   expect_vtk_error(binary, "cell 0 refers to point 9151314442816847872");
+}
+
+// Labels (regions by label, issue 19): a one-component integer array of CELL_DATA, the
+// tetrahedra's values only; "gmsh:physical" (meshio's name) before any other.
+TEST(VtkReader, CellDataOfIntegersGivesTheTetrahedraLabels) {
+  Mesh two = one_tetrahedron();
+  two.tetrahedra.push_back({1, 0, 2, 3});
+  two.labels = {4, 9};
+  const Mesh ascii = read_named("labels.vtk", test::vtk_ascii_text(two));
+  EXPECT_EQ(ascii.labels, (std::vector<int>{4, 9})) << "the vertex and the triangle (7) are no tetrahedra";
+  EXPECT_EQ(ascii.labels_from, "CELL_DATA array \"region\" (line 22)");
+
+  // meshio's Gmsh arrays in a FIELD, after POINT_DATA (skipped), geometrical first.
+  const std::string cells = kAscii + "POINT_DATA 4\nVECTORS v float\n" + std::string(12 * 2, ' ') +
+                            "0 0 0 0 0 0 0 0 0 0 0 0\nCELL_DATA 1\nSCALARS heat double\nLOOKUP_TABLE default\n0.5\n";
+  const std::string field = "FIELD FieldData 2\ngmsh:geometrical 1 1 int\n3\ngmsh:physical 1 1 int\n12\n";
+  EXPECT_EQ(read_named("field.vtk", cells + field).labels, std::vector<int>{12});
+  EXPECT_TRUE(read_named("reals.vtk", cells).labels.empty()) << "a double array is no label";
+  EXPECT_EQ(read_named("reals.vtk", cells).labels_from, "no one-component integer array in CELL_DATA");
+  // No component count, no LOOKUP_TABLE (VTK's own reader allows both).
+  EXPECT_EQ(read_named("bare.vtk", kAscii + "CELL_DATA 1\nSCALARS tag short\n-3\n").labels, std::vector<int>{-3});
+
+  // BINARY: a big-endian int per cell, the triangle's first.
+  std::string binary = test::vtk_binary_text(two) + "CELL_DATA 3\nSCALARS material int 1\nLOOKUP_TABLE default\n";
+  std::ostringstream values;
+  for (const std::int32_t v : {7, 4, 9}) test::put_big_endian(values, v);
+  binary += values.str() + "\n";
+  EXPECT_EQ(read_named("labels_binary.vtk", binary).labels, (std::vector<int>{4, 9}));
+}
+
+// The data sections never fail a mesh (it needs none of them): what stopped the reading, or
+// why an array gives no labels, is kept for the scenario that asks for labels.
+TEST(VtkReader, AnUnreadableDataSectionLeavesTheMeshWithoutLabelsAndSaysWhy) {
+  const Mesh unknown_type = read_named("bits.vtk", kAscii + "CELL_DATA 1\nSCALARS flag bit 1\nLOOKUP_TABLE default\n1\n");
+  EXPECT_EQ(unknown_type.tetrahedron_count(), 1);
+  EXPECT_TRUE(unknown_type.labels.empty());
+  EXPECT_EQ(unknown_type.labels_from.rfind("reading the data sections stopped: mesh ", 0), 0u) << unknown_type.labels_from;
+  EXPECT_NE(unknown_type.labels_from.find("bits.vtk: line 13: data type \"bit\""),
+            std::string::npos)
+      << unknown_type.labels_from;
+  const Mesh truncated = read_named("short.vtk", kAscii + "CELL_DATA 1\nSCALARS region int 1\nLOOKUP_TABLE default\n");
+  EXPECT_NE(truncated.labels_from.find("(truncated?): expected CELL_DATA values"), std::string::npos) << truncated.labels_from;
+  const Mesh miscounted = read_named("count.vtk", kAscii + "CELL_DATA 2\nSCALARS region int\n1 2\n");
+  EXPECT_EQ(miscounted.labels_from, "CELL_DATA array \"region\" (line 13) has 2 values for 1 cells");
+  const Mesh huge = read_named("huge.vtk", kAscii + "CELL_DATA 1\nSCALARS region vtktypeint64\n4294967296\n");
+  EXPECT_NE(huge.labels_from.find("cell 0's value 4294967296 is not an int"), std::string::npos) << huge.labels_from;
+  EXPECT_NE(read_named("junk.vtk", kAscii + "CELL_DATA 1\nCOLOURS x\n").labels_from.find(
+                "expected a data attribute (SCALARS, FIELD, VECTORS, ...), found \"colours\""),
+            std::string::npos);
 }
 
 }  // namespace

@@ -18,6 +18,7 @@
 #include "host/scenario/scenario.h"
 #include "host/scenario/scenario_on_mesh.h"
 #include "temp_path.h"
+#include "tests/mesh/mesh_test_support.h"
 
 namespace sigmafem {
 namespace {
@@ -184,6 +185,18 @@ TEST_F(ParameterFieldsTest, ARegionByLabelHoldsThatPhysicalGroup) {
   json both = labelled;
   both["regions"][0]["select"] = json::parse(R"({"near": [0, 0, 0], "radius": 0.1})");
   EXPECT_NE(error_of(both).find("either \"select\""), std::string::npos) << error_of(both);
+
+  // The same labels as a VTK file's CELL_DATA array hold the same tetrahedra; a VTK file
+  // without one is refused, saying so.
+  const Mesh file_mesh = read_mesh(dir_.path() + "/box.msh");
+  json from_vtk = labelled;
+  from_vtk["mesh"]["file"] = "box.vtk";
+  dir_.write("box.vtk", test::vtk_ascii_text(file_mesh));
+  EXPECT_EQ(load(from_vtk).regions[0].elements, s.regions[0].elements);
+  dir_.write("box.vtk", test::vtk51_text(file_mesh, false));
+  EXPECT_NE(error_of(from_vtk).find("mesh box.vtk labels no element (no one-component integer array in CELL_DATA"),
+            std::string::npos)
+      << error_of(from_vtk);
 }
 
 TEST_F(ParameterFieldsTest, ALigamentEstimatedPerSpringIsSplitInTheModel) {
