@@ -117,7 +117,8 @@ Action add_diagnose_command(CLI::App& app) {
         diagnose_options.sigma_points.value_or(estimation_options(scenario).roukf.sigma_points);
     const BackendDecision backend = resolve_backend(
         options->backend.backend, make_model(scenario),
-        sigma_point_count(set, static_cast<int>(scenario.filter->estimate.size())));
+        sigma_point_count(set, static_cast<int>(scenario.filter->estimate.size())),
+        /*estimated_regions=*/0);   // diagnose refuses parameter fields (above)
     diagnose_options.backend = report.backend = backend.backend;
     report.backend_reason = backend.reason;
     report.preconditioner = preconditioner_used(backend.backend, diagnose_options.device);

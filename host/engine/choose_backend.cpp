@@ -16,13 +16,18 @@ GpuPresence find_gpus() {
   return gpus;
 }
 
-BackendDecision choose_backend(const GpuPresence& gpus, long long elements, int sigma_count) {
+BackendDecision choose_backend(const GpuPresence& gpus, long long elements, int sigma_count,
+                               int estimated_regions) {
   const long long pairs = elements * sigma_count;
   const std::string size = std::to_string(elements) + " tetrahedra x " +
                            std::to_string(sigma_count) + " sigma points";
   if (gpus.opencl.empty() && gpus.vulkan.empty()) {
     const std::string bounds = "up to " + std::to_string(kCpuDeviceElements) +
                                " tetrahedra or from " + std::to_string(kCpuDevicePairs) + " pairs";
+    if (!gpus.opencl_cpu.empty() && pairs < kCpuDevicePairs && estimated_regions > 0)
+      return {"cpu", "auto: no GPU; " + size + " with " + std::to_string(estimated_regions) +
+                     " region moduli estimated: the CPU back end's own factors precondition sigma points "
+                     "that differ by them better than OpenCL's shared one"};
     if (!gpus.opencl_cpu.empty() && (elements <= kCpuDeviceElements || pairs >= kCpuDevicePairs))
       return {"opencl", "auto: no GPU; " + size + " on the CPU device " + gpus.opencl_cpu +
                             ", faster there than the CPU back end (" + bounds + ")"};
@@ -38,9 +43,10 @@ BackendDecision choose_backend(const GpuPresence& gpus, long long elements, int 
   return {"vulkan", "auto: " + size + " on the GPU " + gpus.vulkan};
 }
 
-BackendDecision resolve_backend(const std::string& backend, const Model& model, int sigma_count) {
+BackendDecision resolve_backend(const std::string& backend, const Model& model, int sigma_count,
+                                int estimated_regions) {
   if (backend != "auto") return {backend, "given"};
-  return choose_backend(find_gpus(), model.element_count(), sigma_count);
+  return choose_backend(find_gpus(), model.element_count(), sigma_count, estimated_regions);
 }
 
 }  // namespace sigmafem

@@ -11,7 +11,12 @@
 // 21 ms; 4768 x 16 23 against 47 ms) and the 38k liver at S = 16 (336 against 2333 ms, where
 // the CPU back end's S factors outgrow its memory budget and it shares one), but not the
 // 38k liver's filter step at S = 4 (374 against 268 ms: the shared factor takes 5.7 CG
-// iterations there, the CPU back end's own factors 2-3). Otherwise the CPU back end.
+// iterations there, the CPU back end's own factors 2-3). Nor when the sigma points differ by
+// estimated Young's moduli of regions (issue 19): the one factor of the mean sigma point
+// preconditions them less well (10-13 CG iterations against the CPU back end's 3.5-4.8), and
+// the liver's filter step with 5 to 61 region moduli took 1.2-2.3x the CPU back end's time on
+// OpenCL (bench/RESULTS.md, stop 47: p = 8 4.67 against 3.43 ms, p = 64 47.8 against 20.4).
+// Otherwise the CPU back end.
 #pragma once
 
 #include <string>
@@ -42,11 +47,14 @@ struct BackendDecision {
   std::string reason;    // one line: why
 };
 
-// The choice for `elements` tetrahedra and `sigma_count` sigma points on these GPUs.
-BackendDecision choose_backend(const GpuPresence& gpus, long long elements, int sigma_count);
+// The choice for `elements` tetrahedra and `sigma_count` sigma points, of which
+// `estimated_regions` parameters are regions' Young's moduli, on these GPUs.
+BackendDecision choose_backend(const GpuPresence& gpus, long long elements, int sigma_count,
+                               int estimated_regions = 0);
 
 // `backend` as given ("cpu", "opencl", "vulkan": reason "given"), or "auto" decided by
 // choose_backend on this machine's GPUs for the model.
-BackendDecision resolve_backend(const std::string& backend, const Model& model, int sigma_count);
+BackendDecision resolve_backend(const std::string& backend, const Model& model, int sigma_count,
+                                int estimated_regions);
 
 }  // namespace sigmafem
