@@ -17,14 +17,17 @@ dominates where transfer + latency exceed compute.
 """
 import math
 
-# Measured here (bench/RESULTS.md, stop 48; sigmafem_mpi_bench on the 2-core machine, CPU back
-# end): core-seconds per sigma point and filter step (1 rank, 2 threads: step time x 2 / S),
-# and rank 0's re-centring at R = 1 (reading, re-sampling and writing the states).
+# Measured here (bench/RESULTS.md; sigmafem_mpi_bench on the 2-core machine, CPU back end):
+# core-seconds per sigma point and filter step (1 rank, 2 threads: step time x 2 / S), and
+# rank 0's re-centring at R = 1 (reading, re-sampling and writing the states). The liver's
+# from stop 48; the 38k liver's from stop 49, with the mean sigma point's shared factor and
+# the re-sampling on rank 0's two threads (4.85 s a step, 61 ms; stop 48 without them: 6.59 s,
+# 97 ms).
 CASES = [
     # name, tetrahedra, n (3 x nodes), p, S, t_sigma (core-s), resample (s) at this S and p
     ('liver, p = 16 simplex', 596, 3 * 181, 16, 17, 9.8e-3 * 2 / 17, 0.44e-3),
-    ('38k liver, p = 32 simplex', 38144, 3 * 7509, 32, 33, 6.59 * 2 / 33, 0.097),
-    ('38k liver, p = 64 star', 38144, 3 * 7509, 64, 129, 6.59 * 2 / 33, 0.097 * (129 * 64) / (33 * 32)),
+    ('38k liver, p = 32 simplex', 38144, 3 * 7509, 32, 33, 4.85 * 2 / 33, 0.061),
+    ('38k liver, p = 64 star', 38144, 3 * 7509, 64, 129, 4.85 * 2 / 33, 0.061 * (129 * 64) / (33 * 32)),
 ]
 NETWORKS = [('10 Gb/s Ethernet', 1.25e9, 50e-6), ('100 Gb/s InfiniBand', 12.5e9, 2e-6)]
 CORES = 2   # per machine, as this kind

@@ -6,6 +6,8 @@
 #include <string>
 #include <thread>
 
+#include "host/ensemble/threaded_resampling.h"
+
 namespace sigmafem {
 namespace {
 
@@ -121,10 +123,11 @@ void CpuEnsemble::predicted_observations(Eigen::MatrixXd& y) const {
 void CpuEnsemble::recenter(const Recentering& r) {
   Eigen::MatrixXd X, V;
   read_states(X, V);
-  // docs/ROUKF.md steps 1-2 (filter/ensemble.h, resampled_states): mean and factor of the
+  // docs/ROUKF.md steps 1-2 (filter/ensemble.h, resampled_states, by blocks of rows on the
+  // ensemble's threads: host/ensemble/threaded_resampling.h): mean and factor of the
   // predicted states, the correction, then the new factor L C and the re-sampled states;
   // positions and velocities alike (the state of a dynamic simulation is both).
-  write_states(resampled_states(X, r), resampled_states(V, r));
+  write_states(resampled_states_on(*pool_, X, r), resampled_states_on(*pool_, V, r));
 }
 
 void CpuEnsemble::read_states(Eigen::MatrixXd& positions, Eigen::MatrixXd& velocities) const {

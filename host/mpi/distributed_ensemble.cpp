@@ -8,6 +8,7 @@
 #include "host/common/device_error.h"
 #include "host/common/input_error.h"
 #include "host/common/interruption.h"
+#include "host/ensemble/threaded_resampling.h"
 #include "host/mpi/ranks.h"
 #if SIGMAFEM_HAVE_MPI
 #  include <mpi.h>
@@ -175,7 +176,7 @@ void pack_report(const StepReport& report, std::vector<double>& numbers) {
 }  // namespace
 
 DistributedEnsemble::DistributedEnsemble(std::unique_ptr<SimulationEnsemble> local, int sigma_count)
-    : local_(std::move(local)), S_(sigma_count) {
+    : local_(std::move(local)), S_(sigma_count), pool_(std::make_unique<WorkerPool>(ranks().cores_per_rank())) {
   for (int r = 0; r < ranks().size; ++r) shares_.push_back(sigma_share(S_, ranks().size, r));
   Eigen::MatrixXd X, V;
   local_->read_states(X, V);
@@ -291,9 +292,10 @@ void DistributedEnsemble::recenter(const Recentering& recentering) {
     all_X.middleCols(shares_[r].first, count) = Eigen::Map<const Eigen::MatrixXd>(at, n, count);
     all_V.middleCols(shares_[r].first, count) = Eigen::Map<const Eigen::MatrixXd>(at + n * count, n, count);
   }
-  // The whole ensemble in sigma order, as the CPU back end does it: the same bits on any R.
-  const Eigen::MatrixXd new_X = resampled_states(all_X, recentering);
-  const Eigen::MatrixXd new_V = resampled_states(all_V, recentering);
+  // The whole ensemble in sigma order, as the CPU back end does it: the same bits on any R
+  // (and any thread count).
+  const Eigen::MatrixXd new_X = resampled_states_on(*pool_, all_X, recentering);
+  const Eigen::MatrixXd new_V = resampled_states_on(*pool_, all_V, recentering);
   const ReplyLayout back(shares_, 0, 2 * static_cast<long>(n));
   std::vector<double> out(static_cast<std::size_t>(back.total));
   for (std::size_t r = 0; r < shares_.size(); ++r) {

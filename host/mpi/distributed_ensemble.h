@@ -21,6 +21,7 @@
 #include <string>
 #include <vector>
 
+#include "host/common/worker_pool.h"
 #include "host/ensemble/simulation_ensemble.h"
 #include "host/mpi/ranks.h"
 #include "host/mpi/sigma_share.h"
@@ -61,6 +62,9 @@ class DistributedEnsemble : public Ensemble {
   bool serving_ = true;              // the other ranks wait for commands
   int advances_ = 0;
   double recenter_seconds_ = 0.0;
+  // Rank 0's threads for re-sampling all S (its share of the machine's cores; its share of the
+  // ensemble is idle meanwhile).
+  std::unique_ptr<WorkerPool> pool_;
 };
 
 // On every rank other than 0: runs this rank's share `local` on rank 0's commands until rank 0
