@@ -33,6 +33,13 @@ VtkSeries::VtkSeries(const Model& model, std::vector<int> observed_nodes, std::s
   for (std::size_t k = 0; k < observed_nodes.size(); ++k)
     observed_mark_[observed_nodes[k]] = static_cast<int>(k) + 1;
   for (int node : model.control.nodes) control_mark_[node] = 1;
+  region_mark_.assign(static_cast<std::size_t>(model.element_count()), 0);
+  young_modulus_.assign(static_cast<std::size_t>(model.element_count()), model.material.young_modulus);
+  for (std::size_t r = 0; r < model.regions.size(); ++r)
+    for (int e : model.regions[r].elements) {
+      region_mark_[static_cast<std::size_t>(e)] = static_cast<int>(r) + 1;
+      young_modulus_[static_cast<std::size_t>(e)] = model.regions[r].young_modulus;
+    }
   const fs::path frames = fs::path(directory_) / "vtk";
   std::error_code error;
   if (!fs::create_directories(frames, error) && error)
@@ -76,7 +83,12 @@ void VtkSeries::write_frame(double t, const Eigen::VectorXd& x) {
   write_int_array(out, "ligament", ligament_mark_);
   write_int_array(out, "observed", observed_mark_);
   write_int_array(out, "control", control_mark_);
-  out << "      </PointData>\n    </Piece>\n  </UnstructuredGrid>\n</VTKFile>\n";
+  out << "      </PointData>\n"
+      << "      <CellData Scalars=\"region\">\n";
+  write_int_array(out, "region", region_mark_);
+  out << "        <DataArray type=\"Float64\" Name=\"young_modulus\" format=\"ascii\">\n";
+  for (int e = 0; e < m; ++e) out << format_number(young_modulus_[static_cast<std::size_t>(e)]) << (e % 8 == 7 ? '\n' : ' ');
+  out << "\n        </DataArray>\n      </CellData>\n    </Piece>\n  </UnstructuredGrid>\n</VTKFile>\n";
   file.commit();
   frames_.emplace_back(t, file_name);
 }
