@@ -20,8 +20,7 @@ using json = nlohmann::ordered_json;
 
 namespace {
 
-json number(double x) { return std::isfinite(x) ? json(x) : json(nullptr); }
-json optional_number(const std::optional<double>& x) { return x ? number(*x) : json(nullptr); }
+json optional_number(const std::optional<double>& x) { return x ? finite_number(*x) : json(nullptr); }
 
 std::string model_name(const ModelFit& fit) {
   std::string name = "declared";
@@ -48,8 +47,8 @@ json fit_json(const ModelFit& fit) {
   json stiffness = json::object();
   for (std::size_t j = 0; j < fit.ligaments.size(); ++j) {
     const auto jj = static_cast<Eigen::Index>(j);
-    stiffness[fit.ligaments[j]] = {{"stiffness_n_per_m", number(fit.stiffness.size() > jj ? fit.stiffness[jj] : NAN)},
-                                   {"std_n_per_m", number(fit.stiffness_std.size() > jj ? fit.stiffness_std[jj] : NAN)}};
+    stiffness[fit.ligaments[j]] = {{"stiffness_n_per_m", finite_number(fit.stiffness.size() > jj ? fit.stiffness[jj] : NAN)},
+                                   {"std_n_per_m", finite_number(fit.stiffness_std.size() > jj ? fit.stiffness_std[jj] : NAN)}};
   }
   json estimates = json::array();
   for (const EffectEstimate& e : fit.estimates) estimates.push_back(estimate_json(e));
@@ -61,8 +60,8 @@ json fit_json(const ModelFit& fit) {
           {"cuts", cuts_json(fit.run, fit.ligaments)},
           {"verdict", to_string(fit.residual.verdict.consistency)},
           {"failed_tests", failed_details(fit)},
-          {"log_likelihood", number(fit.log_likelihood)},
-          {"innovation_rms_mm", number(1e3 * fit.innovation_rms)},
+          {"log_likelihood", finite_number(fit.log_likelihood)},
+          {"innovation_rms_mm", finite_number(1e3 * fit.innovation_rms)},
           {"stiffness", stiffness},
           {"stiffness_error_n_per_m", optional_number(fit.stiffness_error)},
           {"stiffness_relative_error", optional_number(fit.stiffness_relative_error)}};
@@ -144,24 +143,24 @@ json write_diagnosis_report(const Scenario& scenario, const Diagnosis& d, const 
   j["truth_effects"] = report.truth_effects;
   json removed = json::array();
   for (std::size_t k = 0; k < d.misfit.removed.size(); ++k)
-    removed.push_back({{"effect", d.misfit.effects[k]}, {"share", number(d.misfit.removed[k])}});
-  j["misfit"] = {{"declared_excess_nis", number(d.misfit.declared_excess)},
+    removed.push_back({{"effect", d.misfit.effects[k]}, {"share", finite_number(d.misfit.removed[k])}});
+  j["misfit"] = {{"declared_excess_nis", finite_number(d.misfit.declared_excess)},
                  {"removed", removed},
-                 {"remaining_share", number(d.misfit.remaining)}};
+                 {"remaining_share", finite_number(d.misfit.remaining)}};
   json claims = json::array();
   for (const ClaimCheck& c : d.claims)
     claims.push_back({{"effect", c.effect},
-                      {"share_of_declared", number(c.share_of_declared)},
-                      {"share_of_remaining", number(c.share_of_remaining)},
+                      {"share_of_declared", finite_number(c.share_of_declared)},
+                      {"share_of_remaining", finite_number(c.share_of_remaining)},
                       {"runner_up", c.runner_up},
-                      {"runner_up_ratio", number(c.runner_up_ratio)},
-                      {"runner_up_score_after", number(c.runner_up_after)},
-                      {"runner_up_unique_ratio", number(c.runner_up_unique_ratio)},
-                      {"scale_follow", number(c.scale_follow)},
-                      {"distance_from_absence", number(c.distance)},
-                      {"distance_bound", number(c.distance_bound)},
-                      {"full_size_share", number(c.size)},
-                      {"stiffness_r2", number(c.stiffness_r2)},
+                      {"runner_up_ratio", finite_number(c.runner_up_ratio)},
+                      {"runner_up_score_after", finite_number(c.runner_up_after)},
+                      {"runner_up_unique_ratio", finite_number(c.runner_up_unique_ratio)},
+                      {"scale_follow", finite_number(c.scale_follow)},
+                      {"distance_from_absence", finite_number(c.distance)},
+                      {"distance_bound", finite_number(c.distance_bound)},
+                      {"full_size_share", finite_number(c.size)},
+                      {"stiffness_r2", finite_number(c.stiffness_r2)},
                       {"claimed", c.claimed},
                       {"reason", c.reason}});
   j["claim_checks"] = claims;
@@ -174,10 +173,10 @@ json write_diagnosis_report(const Scenario& scenario, const Diagnosis& d, const 
     for (const CandidateScore& c : round.candidates) {
       candidates.push_back({{"effect", c.effect},
                             {"parameters", c.parameters},
-                            {"log_likelihood", number(c.log_likelihood)},
-                            {"gain", number(c.gain)},
-                            {"penalty", number(c.penalty)},
-                            {"score", number(c.score)},
+                            {"log_likelihood", finite_number(c.log_likelihood)},
+                            {"gain", finite_number(c.gain)},
+                            {"penalty", finite_number(c.penalty)},
+                            {"score", finite_number(c.score)},
                             {"complete", c.complete},
                             {"steps", c.steps},
                             {"compared_steps", c.compared_steps},
@@ -191,8 +190,8 @@ json write_diagnosis_report(const Scenario& scenario, const Diagnosis& d, const 
                       {"model", model_name(fit)},
                       {"verdict", to_string(round.verdict)},
                       {"failed_tests", fit.residual.verdict.failed()},
-                      {"log_likelihood", number(fit.log_likelihood)},
-                      {"innovation_rms_mm", number(1e3 * fit.innovation_rms)},
+                      {"log_likelihood", finite_number(fit.log_likelihood)},
+                      {"innovation_rms_mm", finite_number(1e3 * fit.innovation_rms)},
                       {"candidates", candidates},
                       {"chosen", round.chosen.empty() ? json(nullptr) : json(round.chosen)}});
   }

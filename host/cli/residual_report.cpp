@@ -13,21 +13,21 @@ namespace {
 
 const char* const kAxes[] = {"x", "y", "z"};
 
-json number(double value) { return std::isfinite(value) ? json(value) : json(nullptr); }
-
 json vector3(const Eigen::Vector3d& v, double scale) {
-  return json::array({number(scale * v.x()), number(scale * v.y()), number(scale * v.z())});
+  return json::array({finite_number(scale * v.x()), finite_number(scale * v.y()), finite_number(scale * v.z())});
 }
 
 json row_json(int row) { return {{"row", row}, {"point", row / 3}, {"axis", kAxes[row % 3]}}; }
 
 json test_json(const DiagnosticTest& test) {
-  return {{"name", test.name},       {"passed", test.passed},           {"statistic", number(test.statistic)},
-          {"accept_low", number(test.accept_low)}, {"accept_high", number(test.accept_high)},
-          {"p_value", number(test.p_value)},       {"level", test.level}, {"detail", test.detail}};
+  return {{"name", test.name},       {"passed", test.passed},           {"statistic", finite_number(test.statistic)},
+          {"accept_low", finite_number(test.accept_low)}, {"accept_high", finite_number(test.accept_high)},
+          {"p_value", finite_number(test.p_value)},       {"level", test.level}, {"detail", test.detail}};
 }
 
 }  // namespace
+
+json finite_number(double value) { return std::isfinite(value) ? json(value) : json(nullptr); }
 
 json residual_json(const ResidualDiagnostics& d, const ResidualDiagnosticsOptions& options) {
   json j;
@@ -78,10 +78,10 @@ json residual_json(const ResidualDiagnostics& d, const ResidualDiagnosticsOption
   for (Eigen::Index i = 0; i < b.mean.size(); ++i) {
     json entry = row_json(static_cast<int>(i));
     entry["count"] = b.count[i];
-    entry["mean_mm"] = number(1e3 * b.mean[i]);
-    entry["standard_error_mm"] = number(1e3 * b.standard_error[i]);
-    entry["t"] = number(b.t[i]);
-    entry["t_threshold"] = number(b.t_threshold[i]);
+    entry["mean_mm"] = finite_number(1e3 * b.mean[i]);
+    entry["standard_error_mm"] = finite_number(1e3 * b.standard_error[i]);
+    entry["t"] = finite_number(b.t[i]);
+    entry["t_threshold"] = finite_number(b.t_threshold[i]);
     entry["flagged"] = std::isfinite(b.t[i]) && std::fabs(b.t[i]) > b.t_threshold[i];
     rows.push_back(entry);
   }
@@ -101,9 +101,9 @@ json residual_json(const ResidualDiagnostics& d, const ResidualDiagnosticsOption
   j["spatial"] = {{"centroid_m", vector3(s.centroid, 1.0)},
                   {"translation_mm", vector3(s.translation, 1e3)},
                   {"rotation_mrad", vector3(s.rotation, 1e3)},
-                  {"total_rms_mm", number(1e3 * s.total_rms)},
-                  {"rigid_rms_mm", number(1e3 * s.rigid_rms)},
-                  {"deformation_rms_mm", number(1e3 * s.deformation_rms)},
+                  {"total_rms_mm", finite_number(1e3 * s.total_rms)},
+                  {"rigid_rms_mm", finite_number(1e3 * s.rigid_rms)},
+                  {"deformation_rms_mm", finite_number(1e3 * s.deformation_rms)},
                   {"rigid_share", s.rigid_share},
                   {"component_t", component_t},
                   {"component_t_threshold", s.component_t_threshold},

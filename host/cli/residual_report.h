@@ -12,6 +12,9 @@
 namespace sigmafem::cli {
 
 // The whole diagnostics as JSON (innovations in mm, rotations in mrad).
+// `value` as JSON, null when it is not finite (JSON has no NaN or infinity); the reports' numbers.
+nlohmann::ordered_json finite_number(double value);
+
 nlohmann::ordered_json residual_json(const ResidualDiagnostics& diagnostics,
                                      const ResidualDiagnosticsOptions& options);
 
