@@ -2,7 +2,9 @@
 // to check a scenario before a long run.
 #include <algorithm>
 #include <iostream>
+#include <map>
 #include <memory>
+#include <string>
 
 #include "host/cli/commands.h"
 #include "host/common/input_error.h"
@@ -19,6 +21,18 @@ void print_nodes(std::ostream& out, const std::vector<int>& nodes) {
   out << "]\n";
 }
 
+// The mesh file's labels and how many tetrahedra carry each ("3 (120), 5 (476) from physical
+// groups"), or why there are none.
+std::string label_counts(const Mesh& mesh) {
+  if (mesh.labels.empty()) return "none (" + (mesh.labels_from.empty() ? std::string("not read from a file") : mesh.labels_from) + ")";
+  std::map<int, int> count;
+  for (int label : mesh.labels) ++count[label];
+  std::string text;
+  for (const auto& [label, tetrahedra] : count)
+    text += (text.empty() ? "" : ", ") + std::to_string(label) + " (" + std::to_string(tetrahedra) + ")";
+  return text + " from " + mesh.labels_from;
+}
+
 }  // namespace
 
 Action add_info_command(CLI::App& app) {
@@ -33,6 +47,7 @@ Action add_info_command(CLI::App& app) {
               << boundary_faces(s.mesh).size() << " boundary faces, volume "
               << s.mesh_report.total_volume << " m^3, " << s.mesh_report.inverted_reordered
               << " inverted tetrahedra reordered\n"
+              << "  mesh labels (for regions' \"label\"): " << label_counts(s.mesh) << "\n"
               << "  material E " << s.material.young_modulus << " Pa, nu " << s.material.poisson_ratio << ", density "
               << s.material.density << " kg/m^3, "
               << (s.material.rotation == ElementRotation::polar ? "polar" : "qr") << " element rotations\n"

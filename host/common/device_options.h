@@ -43,6 +43,10 @@ struct DeviceOptions {
   // cg_partitions() in host/ensemble/device_limits.h); 0 chooses by the mesh's size.
   int cg_partitions = 0;
   Preconditioner preconditioner = Preconditioner::automatic;
+  // OpenCL's CPU form with a factor: each sigma point gets its own (of its own system) where
+  // the S copies of L's values take at most this many bytes, so that they stay in a CPU's
+  // cache; else one factor of the mean sigma point, shared (0: always shared).
+  std::size_t own_factors_bytes = std::size_t{8} << 20;
   // The CPU back end's worker threads: 0, the machine's cores (over MPI ranks, shared among
   // the ranks on one machine: estimation_job.cpp).
   int cpu_threads = 0;

@@ -139,7 +139,7 @@ std::vector<DeviceBufferSpec> device_buffer_specs(const Model& model, const Obse
       reals(B::weights, "re-centring", static_cast<std::size_t>(kDeviceMaxParameters) * sigma),
       integers(B::factor_columns, "the factor", std::vector<int>(rows + 1, 0)),
       integers(B::factor_rows, "the factor", std::vector<int>(factor_nonzeros, 0)),
-      reals(B::factor_values, "the factor", factor_nonzeros),
+      reals(B::factor_values, "the factor", factor_nonzeros * static_cast<std::size_t>(sizes.factor_copies)),
       integers(B::factor_order, "the factor", std::vector<int>(std::max<std::size_t>(1, rows), 0)),
       reals(B::factor_work, "the factor", rows * sigma),
   };

@@ -68,6 +68,7 @@ struct DeviceBufferSizes {
   std::size_t element_out = 0;    // at least 12 per element and sigma point
   int cg_partitions = 1;          // CG work-groups per sigma point
   std::size_t factor_nonzeros = 0;   // of CG's factor, if it has one (0: Jacobi)
+  int factor_copies = 1;             // of L's values: 1 shared, S when each sigma point has its own
 };
 
 // Every buffer of an ensemble of `model` with S sigma points, in DeviceBuffer order. The

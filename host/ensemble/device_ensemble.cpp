@@ -60,26 +60,37 @@ void DeviceEnsemble::set_parameters(const Eigen::MatrixXd& theta) {
   step_constants_.set_region_scales(parameters_from_theta(model_, estimated_, theta, S_, ligament_k_));
   upload_ligament_k();
   representative_theta_ = theta.rowwise().mean();
+  theta_ = theta;
 }
 
 void DeviceEnsemble::set_physics_effects(const std::vector<PhysicsEffects>& effects) {
   step_constants_.set_physics_effects(effects, who_);
   representative_effects_ = effects.at(0);
+  effects_ = effects;
+}
+
+Eigen::SparseMatrix<double> DeviceEnsemble::system_at(const Eigen::VectorXd& theta, const PhysicsEffects& effects,
+                                                      const Eigen::VectorXd& x, const Eigen::VectorXd& v) const {
+  if (!representative_) representative_ = std::make_unique<ReferenceSimulation>(model_);
+  // Before set_parameters the model's values (theta still empty).
+  std::vector<double> stiffness = representative_->ligament_stiffness(), moduli;
+  for (const ElasticRegion& region : model_.regions) moduli.push_back(region.young_modulus);
+  if (theta.size() == estimated_.count()) apply_parameters(model_, estimated_, theta, stiffness, moduli);
+  representative_->set_ligament_stiffness(stiffness);
+  representative_->set_region_young_modulus(moduli);
+  representative_->set_physics_effects(effects);
+  representative_->set_state(x, v);
+  return representative_->system_matrix();
 }
 
 Eigen::SparseMatrix<double> DeviceEnsemble::representative_system(const Eigen::VectorXd& x,
                                                                   const Eigen::VectorXd& v) const {
-  if (!representative_) representative_ = std::make_unique<ReferenceSimulation>(model_);
-  // Before set_parameters the model's values (representative_theta_ still empty).
-  std::vector<double> stiffness = representative_->ligament_stiffness(), moduli;
-  for (const ElasticRegion& region : model_.regions) moduli.push_back(region.young_modulus);
-  if (representative_theta_.size() == estimated_.count())
-    apply_parameters(model_, estimated_, representative_theta_, stiffness, moduli);
-  representative_->set_ligament_stiffness(stiffness);
-  representative_->set_region_young_modulus(moduli);
-  representative_->set_physics_effects(representative_effects_);
-  representative_->set_state(x, v);
-  return representative_->system_matrix();
+  return system_at(representative_theta_, representative_effects_, x, v);
+}
+
+Eigen::SparseMatrix<double> DeviceEnsemble::sigma_system(int s, const Eigen::VectorXd& x, const Eigen::VectorXd& v) const {
+  const Eigen::VectorXd theta = theta_.cols() == S_ ? Eigen::VectorXd(theta_.col(s)) : representative_theta_;
+  return system_at(theta, effects_.empty() ? representative_effects_ : effects_.at(static_cast<std::size_t>(s)), x, v);
 }
 
 Eigen::SparseMatrix<double> DeviceEnsemble::representative_system() const {

@@ -91,6 +91,9 @@ class DeviceEnsemble : public SimulationEnsemble {
   // point 0's took 7.2.
   Eigen::SparseMatrix<double> representative_system(const Eigen::VectorXd& x,
                                                     const Eigen::VectorXd& v) const;
+  // Sigma point s's own matrix at its state (x, v): its parameters and effects (a factor of
+  // its own, OpenCL's CPU form on small meshes).
+  Eigen::SparseMatrix<double> sigma_system(int s, const Eigen::VectorXd& x, const Eigen::VectorXd& v) const;
   // The same at the sigma points' mean state.
   Eigen::SparseMatrix<double> representative_system() const;
   // The step's solver report from CG's per-sigma results; notes the iterations for the next
@@ -124,6 +127,12 @@ class DeviceEnsemble : public SimulationEnsemble {
   std::vector<double> column_of(DeviceBuffer buffer, std::size_t rows, int s) const;
   Eigen::VectorXd representative_theta_;        // the sigma points' mean parameters (none yet: the model's)
   PhysicsEffects representative_effects_;       // and its effects
+  Eigen::MatrixXd theta_;                       // each sigma point's parameters (none yet: the model's)
+  std::vector<PhysicsEffects> effects_;         // and effects (none: the representative's)
+  // The implicit-Euler matrix of parameters `theta` (empty: the model's) and `effects` at
+  // state (x, v), assembled on the host by the representative simulation.
+  Eigen::SparseMatrix<double> system_at(const Eigen::VectorXd& theta, const PhysicsEffects& effects,
+                                        const Eigen::VectorXd& x, const Eigen::VectorXd& v) const;
   mutable std::unique_ptr<ReferenceSimulation> representative_;   // keeps its assembly pattern
 };
 

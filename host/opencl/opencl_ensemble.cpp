@@ -91,9 +91,20 @@ OpenClEnsemble::OpenClEnsemble(const Model& model, EstimatedParameters estimated
     factor_ = std::make_unique<FactorisedPreconditioner>();
     const ReferenceSimulation rest(model_);
     factor_->analyse(representative_system(rest.positions(), rest.velocities()));
-    // Again with the factor's buffers (L alone is 125 MB on the 38k liver).
+    // Again with the factor's buffers (L alone is 125 MB on the 38k liver; the copies of its
+    // values below add at most own_factors_bytes).
     check_device_memory(device_.real_size(), info.name, info.global_memory, info.max_allocation,
                         factor_->nonzeros());
+    // Each sigma point its own factor where the S copies of L's values stay small enough for a
+    // CPU's cache: the sigma points of a filter step differ (by the covariance's spread, and by
+    // region moduli), and the mean's factor took 5.5 CG iterations a step on the liver where
+    // each CPU sigma point's own took 2.6 (bench/RESULTS.md, stop 49). Beyond the cache a
+    // solve's time is reading L, which the shared factor reads once for a block.
+    if (S_ > 1 && static_cast<std::size_t>(S_) * factor_->nonzeros() * device_.real_size() <= options.own_factors_bytes)
+      factor_copies_ = S_;
+    // The copies in the layout of the blocks that solve with them (conjugate_gradient.cl): cg_solve's
+    // blocks of their own vectors one after the other, else all S interleaved.
+    factor_block_ = whole_solve_ && solve_block_ < S_ ? solve_block_ : S_;
   }
   device_.build_program("-DSF_SIGMA_BLOCK=" + std::to_string(sigma_block_) +
                         " -DSF_ELEMENT_CHUNKS=" + std::to_string(element_chunks_) +
@@ -104,6 +115,7 @@ OpenClEnsemble::OpenClEnsemble(const Model& model, EstimatedParameters estimated
                         " -DSF_CG_SOLVE_VECTORS=" + std::to_string(kCgSolveBlockVectors) +
                         " -DSF_CG_PARTITIONS=" + std::to_string(cg_partitions_) +
                         " -DSF_FACTOR=" + std::to_string(factor_ ? 1 : 0) +
+                        " -DSF_FACTOR_PER_SIGMA=" + std::to_string(factor_copies_ > 1 ? 1 : 0) +
                         " -DSF_POLAR_FRAMES=" +
                         std::to_string(model_.material.rotation == ElementRotation::polar ? 1 : 0));
 
@@ -115,7 +127,7 @@ OpenClEnsemble::OpenClEnsemble(const Model& model, EstimatedParameters estimated
     const std::size_t cg_solve_vectors = whole_solve_ && solve_block_ < S_ ? kCgSolveBlockVectors : 0;
     const DeviceBufferSizes sizes{std::max<std::size_t>(element_chunks_, cg_solve_vectors) * dof,
                                   cg_partitions_,
-                                  factor_ ? factor_->nonzeros() : 0};
+                                  factor_ ? factor_->nonzeros() : 0, factor_copies_};
     written_.resize(kDeviceBufferCount);
     write_done_.resize(written_.size());
     for (const DeviceBufferSpec& spec : buffer_specs(sizes)) {
@@ -350,26 +362,48 @@ StepReport OpenClEnsemble::advance(const Eigen::Vector3d& so_position) {
 }
 
 void OpenClEnsemble::refresh_factor() {
-  const Eigen::SparseMatrix<double> A = representative_system();
-  if (!factor_->factorise(A)) {
-    // A matrix that is not positive definite (a diverged state?) leaves the last factor in
-    // place, and the next step tries again.
-    if (on_device_ == FactorOnDevice::none) upload_diagonal_factor(A);
-    return;
+  std::vector<double> values;
+  if (factor_copies_ == 1) {
+    const Eigen::SparseMatrix<double> A = representative_system();
+    if (!factor_->factorise(A)) return fall_back_to_diagonal(A);
+    const Eigen::SparseMatrix<double>& L = factor_->lower();
+    values.assign(L.valuePtr(), L.valuePtr() + L.nonZeros());
+  } else {
+    // Each sigma point's own system at its own state, factorised on the same analysis (the
+    // pattern is the assembly's, the same for all).
+    Eigen::MatrixXd X, V;
+    read_states(X, V);
+    values.resize(factor_->nonzeros() * static_cast<std::size_t>(S_));
+    for (int s = 0; s < S_; ++s) {
+      if (!factor_->factorise(sigma_system(s, X.col(s), V.col(s)))) return fall_back_to_diagonal(representative_system());
+      const double* L = factor_->lower().valuePtr();
+      for (std::size_t k = 0; k < factor_->nonzeros(); ++k) values[factor_value_index(s, k, factor_->nonzeros())] = L[k];
+    }
   }
-  const Eigen::SparseMatrix<double>& L = factor_->lower();
-  const std::size_t rows = static_cast<std::size_t>(L.cols());
-  const std::size_t nonzeros = static_cast<std::size_t>(L.nonZeros());
   // The factor's pattern and ordering are the same at every refresh (the representative's
   // assembly pattern does not change, so neither does the analysis): only the values go down
   // again.
   if (on_device_ != FactorOnDevice::factor) {
+    const Eigen::SparseMatrix<double>& L = factor_->lower();
+    const std::size_t rows = static_cast<std::size_t>(L.cols());
     write_integers(DeviceBuffer::factor_columns, L.outerIndexPtr(), rows + 1);
-    write_integers(DeviceBuffer::factor_rows, L.innerIndexPtr(), nonzeros);
+    write_integers(DeviceBuffer::factor_rows, L.innerIndexPtr(), static_cast<std::size_t>(L.nonZeros()));
     write_integers(DeviceBuffer::factor_order, factor_->order(), rows);
   }
-  write_reals(DeviceBuffer::factor_values, std::vector<double>(L.valuePtr(), L.valuePtr() + nonzeros));
+  write_reals(DeviceBuffer::factor_values, values);
   on_device_ = FactorOnDevice::factor;
+}
+
+std::size_t OpenClEnsemble::factor_value_index(int s, std::size_t k, std::size_t nonzeros) const {
+  if (factor_copies_ == 1) return k;
+  const std::size_t block = static_cast<std::size_t>(factor_block_), sigma = static_cast<std::size_t>(s);
+  return (sigma / block) * nonzeros * block + k * block + sigma % block;
+}
+
+void OpenClEnsemble::fall_back_to_diagonal(const Eigen::SparseMatrix<double>& A) {
+  // A matrix that is not positive definite (a diverged state?) leaves the last factor in
+  // place, and the next step tries again.
+  if (on_device_ == FactorOnDevice::none) upload_diagonal_factor(A);
 }
 
 void OpenClEnsemble::upload_diagonal_factor(const Eigen::SparseMatrix<double>& A) {
@@ -389,7 +423,11 @@ void OpenClEnsemble::upload_diagonal_factor(const Eigen::SparseMatrix<double>& A
   write_integers(DeviceBuffer::factor_columns, columns.data(), columns.size());
   write_integers(DeviceBuffer::factor_rows, order.data(), order.size());   // row i: i
   write_integers(DeviceBuffer::factor_order, order.data(), order.size());
-  write_reals(DeviceBuffer::factor_values, values);
+  // The same diagonal for every sigma point when each has its own factor.
+  std::vector<double> copies(values.size() * static_cast<std::size_t>(factor_copies_));
+  for (int s = 0; s < factor_copies_; ++s)
+    for (std::size_t k = 0; k < values.size(); ++k) copies[factor_value_index(s, k, values.size())] = values[k];
+  write_reals(DeviceBuffer::factor_values, copies);
   on_device_ = FactorOnDevice::diagonal;
 }
 

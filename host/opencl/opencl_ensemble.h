@@ -75,13 +75,16 @@ class OpenClEnsemble : public DeviceEnsemble {
   void run_partitions(cl::Kernel& kernel) const;   // a CG kernel's S x P groups (GPU form)
   // The observation gather and its read, not waited for.
   void enqueue_observations() const;
-  // Makes the factor again from the representative (the mean sigma point) when it is due,
-  // and uploads it; with no factor yet and a representative that is not positive definite,
-  // uploads its diagonal instead (upload_diagonal_factor).
+  // Makes the factor again from the representative (the mean sigma point), or each sigma
+  // point's from its own system, when it is due, and uploads it; with no factor yet and a
+  // system that is not positive definite, uploads the representative's diagonal instead
+  // (upload_diagonal_factor).
   void refresh_factor();
   // A stand-in for the factor: L = sqrt(|diag A|), no reordering, so that z = r / |diag A|,
   // Jacobi's preconditioner, until a factorisation succeeds.
   void upload_diagonal_factor(const Eigen::SparseMatrix<double>& A);
+  // After a failed factorisation: the last factor stays; with none yet, A's diagonal goes down.
+  void fall_back_to_diagonal(const Eigen::SparseMatrix<double>& A);
 
   mutable OpenClDevice device_;
   bool cg_per_group_ = true;                // SF_CG_PER_GROUP: CG kernels a group per sigma (GPU)
@@ -102,9 +105,16 @@ class OpenClEnsemble : public DeviceEnsemble {
   // instead of two): valid until anything is written or re-centred.
   mutable std::vector<unsigned char> observation_bytes_;
   mutable bool observations_ready_ = false;
-  // CG's preconditioner on the CPU form (opencl_uses_factor): one sparse Cholesky factor of
-  // the representative's system, shared by all (SF_FACTOR); null: Jacobi.
+  // CG's preconditioner on the CPU form (opencl_uses_factor): sparse Cholesky factors (SF_FACTOR),
+  // made on this one analysis; null: Jacobi.
   std::unique_ptr<FactorisedPreconditioner> factor_;
+  // Copies of L's values: 1 (one factor of the mean sigma point, shared), or S (each sigma
+  // point its own, of its own system: SF_FACTOR_PER_SIGMA; DeviceOptions::own_factors_bytes).
+  int factor_copies_ = 1;
+  // Sigma points per block of copies: entry k of sigma point s at
+  // (s / block) nonzeros block + k block + s % block (factor_value_index).
+  int factor_block_ = 1;
+  std::size_t factor_value_index(int s, std::size_t k, std::size_t nonzeros) const;
   // What the factor's buffers hold: nothing yet, the diagonal stand-in, or a factor (whose
   // pattern and ordering later refreshes keep).
   enum class FactorOnDevice { none, diagonal, factor };

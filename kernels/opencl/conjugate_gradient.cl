@@ -334,12 +334,20 @@ void cg_direction(uint S, uint node_count, int max_iterations, __global const re
  * constant where they are inlined, so their loops have a fixed length. */
 #define SF_BLOCK_MAX SF_SIGMA_BLOCK
 
-/* CG's preconditioner on a CPU: Jacobi, or with SF_FACTOR = 1 a sparse Cholesky factor of the
- * mean sigma point's system made on the host (FactorisedPreconditioner, the CPU back end's),
- * shared by every sigma point: z = P^T L^-T L^-1 P r, L by columns, the diagonal first in each.
- * The block's sigma points are innermost, so each entry of L is read once for the block; the
- * un-permuting pass adds r.z to sum_rz (one per sigma point of the block). */
+/* CG's preconditioner on a CPU: Jacobi, or with SF_FACTOR = 1 sparse Cholesky factors made on
+ * the host (FactorisedPreconditioner, the CPU back end's): z = P^T L^-T L^-1 P r, L by
+ * columns, the diagonal first in each. One factor of the mean sigma point's system shared by
+ * every sigma point, or with SF_FACTOR_PER_SIGMA = 1 each sigma point's own (the same pattern
+ * and ordering; entry k of sigma point s at k S + s, or in cg_solve's blocks of their own
+ * vectors block by block, below). The block's sigma points are innermost,
+ * so each entry of a shared L is read once for the block; the un-permuting pass adds r.z to
+ * sum_rz (one per sigma point of the block). */
 #if SF_FACTOR
+#  if SF_FACTOR_PER_SIGMA
+#    define SF_L(k, b) factor_values[(size_t)(k) * S + first + (b)]
+#  else
+#    define SF_L(k, b) factor_values[k]
+#  endif
 /* The factor's buffers as the last arguments of the kernels and helpers that use them. */
 #  define SF_FACTOR_ARGUMENTS                                                                \
     , __global const int *restrict factor_columns, __global const int *restrict factor_rows, \
@@ -358,16 +366,15 @@ static inline __attribute__((always_inline)) void sf_block_factor_solve(
   }
   for (uint j = 0; j < rows; ++j) { /* L y' = y: each solved entry out of the rows below */
     size_t at = (size_t)j * S + first;
-    real diagonal = factor_values[factor_columns[j]];
+    const int diagonal = factor_columns[j];
     real solved[SF_BLOCK_MAX];
     for (uint b = 0; b < count; ++b) {
-      solved[b] = y[at + b] / diagonal;
+      solved[b] = y[at + b] / SF_L(diagonal, b);
       y[at + b] = solved[b];
     }
     for (int k = factor_columns[j] + 1; k < factor_columns[j + 1]; ++k) {
-      real value = factor_values[k];
       __global real* restrict below = y + (size_t)factor_rows[k] * S + first;
-      for (uint b = 0; b < count; ++b) below[b] -= value * solved[b];
+      for (uint b = 0; b < count; ++b) below[b] -= SF_L(k, b) * solved[b];
     }
   }
   for (uint j = rows; j-- > 0;) { /* L^T x = y', from the last row up */
@@ -380,22 +387,19 @@ static inline __attribute__((always_inline)) void sf_block_factor_solve(
     int k = factor_columns[j] + 1;
     const int end = factor_columns[j + 1];
     for (; k + 1 < end; k += 2) {
-      real value = factor_values[k];
-      real other_value = factor_values[k + 1];
       __global const real* restrict below = y + (size_t)factor_rows[k] * S + first;
       __global const real* restrict other_below = y + (size_t)factor_rows[k + 1] * S + first;
       for (uint b = 0; b < count; ++b) {
-        sum[b] += value * below[b];
-        other_sum[b] += other_value * other_below[b];
+        sum[b] += SF_L(k, b) * below[b];
+        other_sum[b] += SF_L(k + 1, b) * other_below[b];
       }
     }
     if (k < end) {
-      real value = factor_values[k];
       __global const real* restrict below = y + (size_t)factor_rows[k] * S + first;
-      for (uint b = 0; b < count; ++b) sum[b] += value * below[b];
+      for (uint b = 0; b < count; ++b) sum[b] += SF_L(k, b) * below[b];
     }
-    real diagonal = factor_values[factor_columns[j]];
-    for (uint b = 0; b < count; ++b) y[at + b] = (y[at + b] - (sum[b] + other_sum[b])) / diagonal;
+    const int diagonal = factor_columns[j];
+    for (uint b = 0; b < count; ++b) y[at + b] = (y[at + b] - (sum[b] + other_sum[b])) / SF_L(diagonal, b);
   }
   for (uint i = 0; i < rows; ++i) { /* z, un-permuted, and r.z in row order */
     size_t to = (size_t)i * S + first;
@@ -712,7 +716,13 @@ __kernel void cg_solve(uint S, uint element_count, uint node_count, int max_iter
       own_inverse_diagonal[own_at] = inverse_diagonal[at];
 #  endif
     }
-#  if SF_FACTOR
+#  if SF_FACTOR_PER_SIGMA
+  /* Each block's own factors follow each other: the block's entry k of its sigma point i at
+   * k SF_CG_SOLVE_BLOCK + i (factor_columns[rows] is L's entry count). */
+#    define SF_OWN_FACTOR_PASS , factor_columns, factor_rows,                                  \
+        factor_values + (size_t)block * (size_t)factor_columns[rows] * SF_CG_SOLVE_BLOCK,     \
+        factor_order, factor_work + (size_t)block * size
+#  elif SF_FACTOR
 #    define SF_OWN_FACTOR_PASS , factor_columns, factor_rows, factor_values, factor_order, \
         factor_work + (size_t)block * size
 #  else

@@ -46,15 +46,18 @@ TEST(ChooseBackend, WithoutAGpuOpenClOnTheCpuUpToItsBound) {
   EXPECT_EQ(choose_backend(kPoclOnly, kCpuDevicePairs / 8 - 1, 8).backend, "cpu");
 }
 
-// Sigma points that differ by estimated region moduli: OpenCL's one shared factor
-// preconditions them less well, and the liver's filter step with 5 to 61 region moduli ran
-// 1.2-2.3x slower on OpenCL than on the CPU back end (stop 47); from kCpuDevicePairs pairs
+// Sigma points that differ by estimated region moduli: where OpenCL would share one factor
+// among them (beyond kOwnFactorPairs) it preconditions them less well, and the CPU back end
+// is faster (stop 49); up to it each has its own on OpenCL too; from kCpuDevicePairs pairs
 // OpenCL stays (the CPU back end then shares one factor too).
-TEST(ChooseBackend, WithoutAGpuRegionModuliGoToTheCpuBackEnd) {
-  const BackendDecision d = choose_backend(kPoclOnly, 596, 17, 13);
+TEST(ChooseBackend, WithoutAGpuRegionModuliGoToTheCpuBackEndWhereOpenClWouldShareAFactor) {
+  const BackendDecision d = choose_backend(kPoclOnly, 4768, 17, 13);
   EXPECT_EQ(d.backend, "cpu");
   EXPECT_NE(d.reason.find("13 region moduli"), std::string::npos) << d.reason;
-  EXPECT_EQ(choose_backend(kPoclOnly, 596, 17, 0).backend, "opencl");
+  EXPECT_EQ(choose_backend(kPoclOnly, 596, 17, 13).backend, "opencl") << "own factors";
+  EXPECT_EQ(choose_backend(kPoclOnly, 596, 65, 61).backend, "opencl") << "own factors, the largest measured";
+  EXPECT_EQ(choose_backend(kPoclOnly, 596, 129, 61).backend, "cpu");
+  EXPECT_EQ(choose_backend(kPoclOnly, 4768, 17, 0).backend, "opencl");
   EXPECT_EQ(choose_backend(kPoclOnly, 38144, 33, 29).backend, "opencl") << "38144 x 33 pairs";
   EXPECT_EQ(choose_backend(kBothGpus, 4768, 17, 13).backend, "opencl") << "a GPU's choice is unchanged";
 }
