@@ -97,9 +97,9 @@ OpenClEnsemble::OpenClEnsemble(const Model& model, EstimatedParameters estimated
                         factor_->nonzeros());
     // Each sigma point its own factor where the S copies of L's values stay small enough for a
     // CPU's cache: the sigma points of a filter step differ (by the covariance's spread, and by
-    // region moduli), and the mean's factor took 5.5 CG iterations a step on the liver where
-    // each CPU sigma point's own took 2.6 (bench/RESULTS.md, stop 49). Beyond the cache a
-    // solve's time is reading L, which the shared factor reads once for a block.
+    // region moduli), and on the liver's filter step the mean's factor took 5.6 CG iterations
+    // a step where their own took 2.3 (bench/RESULTS.md, stop 49). Beyond the cache a solve's
+    // time is reading L, which the shared factor reads once for a block.
     if (S_ > 1 && static_cast<std::size_t>(S_) * factor_->nonzeros() * device_.real_size() <= options.own_factors_bytes)
       factor_copies_ = S_;
     // The copies in the layout of the blocks that solve with them (conjugate_gradient.cl): cg_solve's
