@@ -34,6 +34,12 @@ enum class KernelForm { automatic, cpu, gpu };
 // other yet).
 enum class Preconditioner { automatic, jacobi, factorised };
 
+// Own factors pay from this many sigma points (bench/RESULTS.md, stop 49, the liver's filter
+// step on PoCL): at S = 4 they halved the CG iterations but not the time (1.36-1.54 ms against
+// 1.05-1.27 shared: S factorisations a refresh), at S = 17 5.6 against 7.2 ms, at S = 65 24
+// against 45.
+constexpr int kOwnFactorsFromSigmaPoints = 16;
+
 struct DeviceOptions {
   int device = 0;                   // index in `sigmafem devices`' list for the back end
   Precision precision = Precision::single;
@@ -43,9 +49,10 @@ struct DeviceOptions {
   // cg_partitions() in host/ensemble/device_limits.h); 0 chooses by the mesh's size.
   int cg_partitions = 0;
   Preconditioner preconditioner = Preconditioner::automatic;
-  // OpenCL's CPU form with a factor: each sigma point gets its own (of its own system) where
-  // the S copies of L's values take at most this many bytes, so that they stay in a CPU's
-  // cache; else one factor of the mean sigma point, shared (0: always shared).
+  // OpenCL's CPU form with a factor: each sigma point gets its own (of its own system), from
+  // kOwnFactorsFromSigmaPoints, where the S copies of L's values take at most this many
+  // bytes, so that they stay in a CPU's cache; else one factor of the mean sigma point, shared
+  // (0: always shared).
   std::size_t own_factors_bytes = std::size_t{8} << 20;
   // The CPU back end's worker threads: 0, the machine's cores (over MPI ranks, shared among
   // the ranks on one machine: estimation_job.cpp).

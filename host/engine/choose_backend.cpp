@@ -1,5 +1,6 @@
 #include "host/engine/choose_backend.h"
 
+#include "host/common/device_options.h"
 #include "host/opencl/opencl_device.h"
 #include "host/vulkan/vulkan_device.h"
 
@@ -24,11 +25,11 @@ BackendDecision choose_backend(const GpuPresence& gpus, long long elements, int 
   if (gpus.opencl.empty() && gpus.vulkan.empty()) {
     const std::string bounds = "up to " + std::to_string(kCpuDeviceElements) +
                                " tetrahedra or from " + std::to_string(kCpuDevicePairs) + " pairs";
-    if (!gpus.opencl_cpu.empty() && pairs > kOwnFactorPairs && pairs < kCpuDevicePairs && estimated_regions > 0)
+    const bool own_factors = sigma_count >= kOwnFactorsFromSigmaPoints && pairs <= kOwnFactorPairs;
+    if (!gpus.opencl_cpu.empty() && !own_factors && pairs < kCpuDevicePairs && estimated_regions > 0)
       return {"cpu", "auto: no GPU; " + size + " with " + std::to_string(estimated_regions) +
                      " region moduli estimated: the CPU back end's own factors precondition sigma points "
-                     "that differ by them better than OpenCL's shared one (from " +
-                     std::to_string(kOwnFactorPairs) + " pairs)"};
+                     "that differ by them better than OpenCL's shared one"};
     if (!gpus.opencl_cpu.empty() && (elements <= kCpuDeviceElements || pairs >= kCpuDevicePairs))
       return {"opencl", "auto: no GPU; " + size + " on the CPU device " + gpus.opencl_cpu +
                             ", faster there than the CPU back end (" + bounds + ")"};

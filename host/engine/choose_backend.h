@@ -16,8 +16,8 @@
 // the mean sigma point's preconditions them less well (10-13 CG iterations against 3.5-4.8
 // for the CPU back end's own), and the liver's filter step with 13 and 61 region moduli took
 // 8.9 and 56 ms on OpenCL against 7.8 and 27 on the CPU back end (bench/RESULTS.md, stop 49).
-// Where each sigma point gets its own factor on OpenCL (up to kOwnFactorPairs, estimated) it
-// took 5.3 and 30 ms. Otherwise the CPU back end.
+// Where each sigma point gets its own factor on OpenCL (from 16 sigma points, up to
+// kOwnFactorPairs, estimated) it took 5.6 and 24 ms. Otherwise the CPU back end.
 #pragma once
 
 #include <string>
@@ -33,9 +33,10 @@ constexpr long long kGpuPairs = 16384;
 // or from this many element-sigma pairs (between 38144 x 4, slower, and 38144 x 16, faster).
 constexpr long long kCpuDeviceElements = 16384;
 constexpr long long kCpuDevicePairs = 262144;
-// Up to this many element-sigma pairs OpenCL's sigma points get factors of their own
-// (DeviceOptions::own_factors_bytes; L has 44 entries per tetrahedron on the 596 liver, 94 on
-// the 4768 one): the 596-tetrahedron liver at S = 65, the largest ensemble measured with them.
+// Up to this many element-sigma pairs, and from kOwnFactorsFromSigmaPoints, OpenCL's sigma
+// points get factors of their own (DeviceOptions::own_factors_bytes; L has 44 entries per
+// tetrahedron on the 596 liver, 94 on the 4768 one): the 596-tetrahedron liver at S = 65, the
+// largest ensemble measured with them.
 constexpr long long kOwnFactorPairs = 596 * 65;
 
 // Device 0 of each device back end when it is a GPU: its name, "" when it is not a GPU or

@@ -96,11 +96,13 @@ OpenClEnsemble::OpenClEnsemble(const Model& model, EstimatedParameters estimated
     check_device_memory(device_.real_size(), info.name, info.global_memory, info.max_allocation,
                         factor_->nonzeros());
     // Each sigma point its own factor where the S copies of L's values stay small enough for a
-    // CPU's cache: the sigma points of a filter step differ (by the covariance's spread, and by
-    // region moduli), and on the liver's filter step the mean's factor took 5.6 CG iterations
-    // a step where their own took 2.3 (bench/RESULTS.md, stop 49). Beyond the cache a solve's
-    // time is reading L, which the shared factor reads once for a block.
-    if (S_ > 1 && static_cast<std::size_t>(S_) * factor_->nonzeros() * device_.real_size() <= options.own_factors_bytes)
+    // CPU's cache, and from kOwnFactorsFromSigmaPoints: sigma points that differ (by the
+    // covariance's spread, and by region moduli) are preconditioned less well by the mean's
+    // factor (the liver's filter step with 13 region moduli, S = 17: 12.7 CG iterations shared,
+    // 2.8 own; bench/RESULTS.md, stop 49). Beyond the cache a solve's time is reading L, which
+    // the shared factor reads once for a block.
+    if (S_ >= kOwnFactorsFromSigmaPoints &&
+        static_cast<std::size_t>(S_) * factor_->nonzeros() * device_.real_size() <= options.own_factors_bytes)
       factor_copies_ = S_;
     // The copies in the layout of the blocks that solve with them (conjugate_gradient.cl): cg_solve's
     // blocks of their own vectors one after the other, else all S interleaved.

@@ -343,10 +343,16 @@ void cg_direction(uint S, uint node_count, int max_iterations, __global const re
  * so each entry of a shared L is read once for the block; the un-permuting pass adds r.z to
  * sum_rz (one per sigma point of the block). */
 #if SF_FACTOR
+/* Entry k of L for the block: a value loaded once (shared), or where the block's own values
+ * of it start (SF_FACTOR_PER_SIGMA); SF_L_OF(entry, b) is sigma point first + b's. */
 #  if SF_FACTOR_PER_SIGMA
-#    define SF_L(k, b) factor_values[(size_t)(k) * S + first + (b)]
+typedef __global const real* sf_entry;
+#    define SF_L_AT(k) (factor_values + (size_t)(k) * S + first)
+#    define SF_L_OF(entry, b) (entry)[b]
 #  else
-#    define SF_L(k, b) factor_values[k]
+typedef real sf_entry;
+#    define SF_L_AT(k) (factor_values[k])
+#    define SF_L_OF(entry, b) (entry)
 #  endif
 /* The factor's buffers as the last arguments of the kernels and helpers that use them. */
 #  define SF_FACTOR_ARGUMENTS                                                                \
@@ -366,15 +372,16 @@ static inline __attribute__((always_inline)) void sf_block_factor_solve(
   }
   for (uint j = 0; j < rows; ++j) { /* L y' = y: each solved entry out of the rows below */
     size_t at = (size_t)j * S + first;
-    const int diagonal = factor_columns[j];
+    const sf_entry diagonal = SF_L_AT(factor_columns[j]);
     real solved[SF_BLOCK_MAX];
     for (uint b = 0; b < count; ++b) {
-      solved[b] = y[at + b] / SF_L(diagonal, b);
+      solved[b] = y[at + b] / SF_L_OF(diagonal, b);
       y[at + b] = solved[b];
     }
     for (int k = factor_columns[j] + 1; k < factor_columns[j + 1]; ++k) {
+      const sf_entry value = SF_L_AT(k);
       __global real* restrict below = y + (size_t)factor_rows[k] * S + first;
-      for (uint b = 0; b < count; ++b) below[b] -= SF_L(k, b) * solved[b];
+      for (uint b = 0; b < count; ++b) below[b] -= SF_L_OF(value, b) * solved[b];
     }
   }
   for (uint j = rows; j-- > 0;) { /* L^T x = y', from the last row up */
@@ -387,19 +394,22 @@ static inline __attribute__((always_inline)) void sf_block_factor_solve(
     int k = factor_columns[j] + 1;
     const int end = factor_columns[j + 1];
     for (; k + 1 < end; k += 2) {
+      const sf_entry value = SF_L_AT(k);
+      const sf_entry other_value = SF_L_AT(k + 1);
       __global const real* restrict below = y + (size_t)factor_rows[k] * S + first;
       __global const real* restrict other_below = y + (size_t)factor_rows[k + 1] * S + first;
       for (uint b = 0; b < count; ++b) {
-        sum[b] += SF_L(k, b) * below[b];
-        other_sum[b] += SF_L(k + 1, b) * other_below[b];
+        sum[b] += SF_L_OF(value, b) * below[b];
+        other_sum[b] += SF_L_OF(other_value, b) * other_below[b];
       }
     }
     if (k < end) {
+      const sf_entry value = SF_L_AT(k);
       __global const real* restrict below = y + (size_t)factor_rows[k] * S + first;
-      for (uint b = 0; b < count; ++b) sum[b] += SF_L(k, b) * below[b];
+      for (uint b = 0; b < count; ++b) sum[b] += SF_L_OF(value, b) * below[b];
     }
-    const int diagonal = factor_columns[j];
-    for (uint b = 0; b < count; ++b) y[at + b] = (y[at + b] - (sum[b] + other_sum[b])) / SF_L(diagonal, b);
+    const sf_entry diagonal = SF_L_AT(factor_columns[j]);
+    for (uint b = 0; b < count; ++b) y[at + b] = (y[at + b] - (sum[b] + other_sum[b])) / SF_L_OF(diagonal, b);
   }
   for (uint i = 0; i < rows; ++i) { /* z, un-permuted, and r.z in row order */
     size_t to = (size_t)i * S + first;

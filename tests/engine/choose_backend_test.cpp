@@ -47,7 +47,8 @@ TEST(ChooseBackend, WithoutAGpuOpenClOnTheCpuUpToItsBound) {
 }
 
 // Sigma points that differ by estimated region moduli: where OpenCL would share one factor
-// among them (beyond kOwnFactorPairs) it preconditions them less well, and the CPU back end
+// among them (below kOwnFactorsFromSigmaPoints or beyond kOwnFactorPairs) it preconditions
+// them less well, and the CPU back end
 // is faster (stop 49); up to it each has its own on OpenCL too; from kCpuDevicePairs pairs
 // OpenCL stays (the CPU back end then shares one factor too).
 TEST(ChooseBackend, WithoutAGpuRegionModuliGoToTheCpuBackEndWhereOpenClWouldShareAFactor) {
@@ -55,6 +56,7 @@ TEST(ChooseBackend, WithoutAGpuRegionModuliGoToTheCpuBackEndWhereOpenClWouldShar
   EXPECT_EQ(d.backend, "cpu");
   EXPECT_NE(d.reason.find("13 region moduli"), std::string::npos) << d.reason;
   EXPECT_EQ(choose_backend(kPoclOnly, 596, 17, 13).backend, "opencl") << "own factors";
+  EXPECT_EQ(choose_backend(kPoclOnly, 596, 12, 8).backend, "cpu") << "too few sigma points for own factors";
   EXPECT_EQ(choose_backend(kPoclOnly, 596, 65, 61).backend, "opencl") << "own factors, the largest measured";
   EXPECT_EQ(choose_backend(kPoclOnly, 596, 129, 61).backend, "cpu");
   EXPECT_EQ(choose_backend(kPoclOnly, 4768, 17, 0).backend, "opencl");
