@@ -526,6 +526,9 @@ TEST_F(CliTest, InfoDescribesTheShippedScenarios) {
     EXPECT_NE(run.output.find("material E 5000 Pa, nu 0.45, density 1000 kg/m^3, qr element rotations"),
               std::string::npos)
         << run.output;
+    // The mesh file's labels, which regions may select by `label` (one physical group here).
+    EXPECT_NE(run.output.find("mesh labels (for regions' \"label\"): 1 ("), std::string::npos) << run.output;
+    EXPECT_NE(run.output.find(") from physical groups"), std::string::npos) << run.output;
   }
   const CommandRun cube =
       run_sigmafem("info " + (fs::path(SIGMAFEM_SOURCE_DIR) / "scenarios" / "truth_cube.json").string());
