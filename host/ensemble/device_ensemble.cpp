@@ -59,13 +59,11 @@ void DeviceEnsemble::set_parameters(const Eigen::MatrixXd& theta) {
   check_parameter_matrix(theta, parameter_count(), sigma_count(), who_);
   step_constants_.set_region_scales(parameters_from_theta(model_, estimated_, theta, S_, ligament_k_));
   upload_ligament_k();
-  representative_theta_ = theta.rowwise().mean();
   theta_ = theta;
 }
 
 void DeviceEnsemble::set_physics_effects(const std::vector<PhysicsEffects>& effects) {
   step_constants_.set_physics_effects(effects, who_);
-  representative_effects_ = effects.at(0);
   effects_ = effects;
 }
 
@@ -85,12 +83,14 @@ Eigen::SparseMatrix<double> DeviceEnsemble::system_at(const Eigen::VectorXd& the
 
 Eigen::SparseMatrix<double> DeviceEnsemble::representative_system(const Eigen::VectorXd& x,
                                                                   const Eigen::VectorXd& v) const {
-  return system_at(representative_theta_, representative_effects_, x, v);
+  // The sigma points' mean parameters and sigma point 0's effects (none set yet: the model's).
+  const Eigen::VectorXd theta = theta_.size() > 0 ? Eigen::VectorXd(theta_.rowwise().mean()) : Eigen::VectorXd();
+  return system_at(theta, effects_.empty() ? PhysicsEffects{} : effects_.front(), x, v);
 }
 
 Eigen::SparseMatrix<double> DeviceEnsemble::sigma_system(int s, const Eigen::VectorXd& x, const Eigen::VectorXd& v) const {
-  const Eigen::VectorXd theta = theta_.cols() == S_ ? Eigen::VectorXd(theta_.col(s)) : representative_theta_;
-  return system_at(theta, effects_.empty() ? representative_effects_ : effects_.at(static_cast<std::size_t>(s)), x, v);
+  const Eigen::VectorXd theta = theta_.size() > 0 ? Eigen::VectorXd(theta_.col(s)) : Eigen::VectorXd();
+  return system_at(theta, effects_.empty() ? PhysicsEffects{} : effects_.at(static_cast<std::size_t>(s)), x, v);
 }
 
 Eigen::SparseMatrix<double> DeviceEnsemble::representative_system() const {

@@ -125,10 +125,8 @@ class DeviceEnsemble : public SimulationEnsemble {
 
  private:
   std::vector<double> column_of(DeviceBuffer buffer, std::size_t rows, int s) const;
-  Eigen::VectorXd representative_theta_;        // the sigma points' mean parameters (none yet: the model's)
-  PhysicsEffects representative_effects_;       // and its effects
   Eigen::MatrixXd theta_;                       // each sigma point's parameters (none yet: the model's)
-  std::vector<PhysicsEffects> effects_;         // and effects (none: the representative's)
+  std::vector<PhysicsEffects> effects_;         // and effects (none yet: none)
   // The implicit-Euler matrix of parameters `theta` (empty: the model's) and `effects` at
   // state (x, v), assembled on the host by the representative simulation.
   Eigen::SparseMatrix<double> system_at(const Eigen::VectorXd& theta, const PhysicsEffects& effects,
