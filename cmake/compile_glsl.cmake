@@ -1,6 +1,7 @@
 # The Vulkan shaders: every entry shader of kernels/vulkan/ compiled by glslang to SPIR-V at
-# build time, in single and double precision, and embedded in the program as uint32 words
-# (cmake/embed_spirv.cmake), so that the program needs no shader files at run time.
+# build time in three variants (single and double precision, and single with texel reads,
+# -DSF_TEXEL_READS: kernels/vulkan/ensemble_layout.h), and embedded in the program as uint32
+# words (cmake/embed_spirv.cmake), so that the program needs no shader files at run time.
 # An entry is NAME:SOURCE[:DEFINE]: kernels/vulkan/SOURCE.comp compiled with -DDEFINE (one
 # file may hold several entry shaders, chosen with -D switches). glslang defines VULKAN
 # itself (kernels/shared/dialect.h's Vulkan branch). Rebuilt when a source or any header of
@@ -29,11 +30,13 @@ function(sigmafem_compile_glsl output)
       list(GET _parts 2 _define)
       set(_defines "-D${_define}")
     endif()
-    foreach(_precision single double)
+    foreach(_precision single double single_texel)
       set(_spv ${PROJECT_BINARY_DIR}/generated/spirv/${_name}_${_precision}.spv)
       set(_precision_define "")
       if(_precision STREQUAL "double")
         set(_precision_define "-DSF_USE_DOUBLE")
+      elseif(_precision STREQUAL "single_texel")
+        set(_precision_define "-DSF_TEXEL_READS")
       endif()
       add_custom_command(
         OUTPUT ${_spv}

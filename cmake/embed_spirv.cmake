@@ -1,6 +1,6 @@
 # Writes a C++ source with SPIR-V modules as uint32 arrays and the table kVulkanShaders
 # (host/vulkan/vulkan_shaders.h). Run as:
-#   cmake -DOUTPUT=out.cpp -DSHADERS="name:single:a.spv;name:double:b.spv" -P this
+#   cmake -DOUTPUT=out.cpp -DSHADERS="name:single:a.spv;name:double:b.spv;name:single_texel:c.spv" -P this
 cmake_minimum_required(VERSION 3.18)
 
 set(_arrays "")
@@ -21,12 +21,14 @@ foreach(_shader IN LISTS SHADERS)
   # SPIR-V is a stream of little-endian words: bytes b0 b1 b2 b3 make 0xb3b2b1b0.
   string(REGEX REPLACE "(..)(..)(..)(..)" "0x\\4\\3\\2\\1u," _values "${_hex}")
   string(APPEND _arrays "const std::uint32_t k_${_name}_${_precision}[] = {${_values}};\n")
+  set(_double "false")
+  set(_texel "false")
   if(_precision STREQUAL "double")
     set(_double "true")
-  else()
-    set(_double "false")
+  elseif(_precision STREQUAL "single_texel")
+    set(_texel "true")
   endif()
-  string(APPEND _table "    {\"${_name}\", ${_double}, k_${_name}_${_precision}, ${_words}},\n")
+  string(APPEND _table "    {\"${_name}\", ${_double}, ${_texel}, k_${_name}_${_precision}, ${_words}},\n")
   math(EXPR _index "${_index} + 1")
 endforeach()
 file(WRITE "${OUTPUT}.tmp"

@@ -23,7 +23,9 @@ enum class SolveLaunch { automatic, per_iteration, whole_solve };
 // The form of the OpenCL kernels (host/opencl/opencl_ensemble.cpp): the CPU form (element
 // chunks, blocks of sigma points per work-item), the GPU form (a work-item per element and
 // sigma point, a work-group per sigma point in CG), or the one for the device's type. Forcing
-// the GPU form on PoCL lets the tests run it where there is no GPU.
+// the GPU form on PoCL lets the tests run it where there is no GPU. The Vulkan shaders' CPU
+// form reads their read-only arrays through texel buffers, the GPU form through storage
+// buffers (vulkan_texel_reads, host/vulkan/vulkan_ensemble.h).
 enum class KernelForm { automatic, cpu, gpu };
 
 // CG's preconditioner: Jacobi (the oracle's and the device kernels'), or sparse Cholesky
@@ -44,7 +46,7 @@ struct DeviceOptions {
   int device = 0;                   // index in `sigmafem devices`' list for the back end
   Precision precision = Precision::single;
   SolveLaunch solve_launch = SolveLaunch::automatic;
-  KernelForm kernel_form = KernelForm::automatic;   // OpenCL only
+  KernelForm kernel_form = KernelForm::automatic;
   // Work-groups per sigma point in CG on a GPU (OpenCL's GPU form, Vulkan on a GPU;
   // cg_partitions() in host/ensemble/device_limits.h); 0 chooses by the mesh's size.
   int cg_partitions = 0;

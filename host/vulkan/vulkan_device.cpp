@@ -1,7 +1,9 @@
 #include "host/vulkan/vulkan_device.h"
 
 #include <algorithm>
+#include <cstdlib>
 #include <cstring>
+#include <iostream>
 
 #include "host/vulkan/vulkan_instance.h"
 #include "host/vulkan/vulkan_shaders.h"
@@ -43,6 +45,9 @@ VulkanDevice::VulkanDevice(int index, Precision precision) : precision_(precisio
         found = true;
       }
     if (!found) throw DeviceError("Vulkan device " + info_.name + " has no compute queue");
+    const bool profile = std::getenv("SIGMAFEM_VULKAN_PROFILE") != nullptr &&
+                         families[queue_family_].timestampValidBits > 0;
+    timestamp_seconds_ = 1e-9 * static_cast<double>(properties.limits.timestampPeriod);
 
     const float priority = 1.0f;
     VkDeviceQueueCreateInfo queue{};
@@ -77,15 +82,25 @@ VulkanDevice::VulkanDevice(int index, Precision precision) : precision_(precisio
     check(api_->vkCreateFence(device_, &fence, nullptr, &fence_), "creating a fence");
 
     // Enough for the ensemble's descriptor sets (about twenty, at most 25 buffers each; about
-    // 240 buffers in all).
-    VkDescriptorPoolSize sizes{VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, 1024};
+    // 240 buffers in all, of either kind).
+    const VkDescriptorPoolSize sizes[2] = {{VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, 1024},
+                                           {VK_DESCRIPTOR_TYPE_UNIFORM_TEXEL_BUFFER, 1024}};
     VkDescriptorPoolCreateInfo descriptors{};
     descriptors.sType = VK_STRUCTURE_TYPE_DESCRIPTOR_POOL_CREATE_INFO;
     descriptors.maxSets = 64;
-    descriptors.poolSizeCount = 1;
-    descriptors.pPoolSizes = &sizes;
+    descriptors.poolSizeCount = 2;
+    descriptors.pPoolSizes = sizes;
     check(api_->vkCreateDescriptorPool(device_, &descriptors, nullptr, &descriptor_pool_),
           "creating a descriptor pool");
+
+    if (profile) {
+      VkQueryPoolCreateInfo queries{};
+      queries.sType = VK_STRUCTURE_TYPE_QUERY_POOL_CREATE_INFO;
+      queries.queryType = VK_QUERY_TYPE_TIMESTAMP;
+      queries.queryCount = 2 * kProfiledDispatches;
+      check(api_->vkCreateQueryPool(device_, &queries, nullptr, &profile_queries_),
+            "creating the profile's timestamp queries");
+    }
 
     reserve_read_back(4096);
   } catch (...) {
@@ -94,17 +109,23 @@ VulkanDevice::VulkanDevice(int index, Precision precision) : precision_(precisio
   }
 }
 
-VulkanDevice::~VulkanDevice() { release(); }
+VulkanDevice::~VulkanDevice() {
+  print_profile();
+  release();
+}
 
 void VulkanDevice::release() {
   if (device_) {
     api_->vkDeviceWaitIdle(device_);
+    if (profile_queries_) api_->vkDestroyQueryPool(device_, profile_queries_, nullptr);
     for (const VulkanKernel& k : kernels_) {
       api_->vkDestroyPipeline(device_, k.pipeline, nullptr);
       api_->vkDestroyPipelineLayout(device_, k.layout, nullptr);
       api_->vkDestroyDescriptorSetLayout(device_, k.set_layout, nullptr);
     }
     kernels_.clear();
+    for (const TexelView& v : views_) api_->vkDestroyBufferView(device_, v.view, nullptr);
+    views_.clear();
     for (const auto& [buffer, memory] : buffers_) {
       api_->vkDestroyBuffer(device_, buffer, nullptr);
       api_->vkFreeMemory(device_, memory, nullptr);
@@ -168,8 +189,8 @@ VulkanBuffer VulkanDevice::buffer(std::size_t bytes, const char* what) {
   VkBufferCreateInfo info{};
   info.sType = VK_STRUCTURE_TYPE_BUFFER_CREATE_INFO;
   info.size = bytes;
-  info.usage = VK_BUFFER_USAGE_STORAGE_BUFFER_BIT | VK_BUFFER_USAGE_TRANSFER_SRC_BIT |
-               VK_BUFFER_USAGE_TRANSFER_DST_BIT;
+  info.usage = VK_BUFFER_USAGE_STORAGE_BUFFER_BIT | VK_BUFFER_USAGE_UNIFORM_TEXEL_BUFFER_BIT |
+               VK_BUFFER_USAGE_TRANSFER_SRC_BIT | VK_BUFFER_USAGE_TRANSFER_DST_BIT;
   VulkanBuffer result;
   result.bytes = bytes;
   check(api_->vkCreateBuffer(device_, &info, nullptr, &result.buffer), std::string("creating ") + what);
@@ -238,12 +259,15 @@ void VulkanDevice::download(const VulkanBuffer& buffer, void* data, std::size_t 
 VulkanKernel VulkanDevice::kernel(const char* name, int bindings, std::uint32_t group_size,
                                   std::uint32_t partitions) {
   const bool want_double = precision_ == Precision::double_precision;
+  const EmbeddedShader* found = nullptr;
   for (std::size_t i = 0; i < kVulkanShaderCount; ++i) {
     const EmbeddedShader& shader = kVulkanShaders[i];
-    if (shader.double_precision == want_double && std::strcmp(shader.name, name) == 0)
-      return kernel_from_spirv(name, shader.words, shader.word_count, bindings, group_size,
-                               partitions);
+    if (shader.double_precision != want_double || std::strcmp(shader.name, name) != 0) continue;
+    if (found == nullptr || shader.texel_reads == texel_reads_) found = &shader;
   }
+  if (found != nullptr)
+    return kernel_from_spirv(name, found->words, found->word_count, bindings, group_size,
+                             partitions);
   throw DeviceError(std::string("no embedded Vulkan shader '") + name + "' (" +
                     (want_double ? "double" : "single") +
                     " precision): the build did not compile it from kernels/vulkan/");
@@ -260,13 +284,24 @@ VulkanKernel VulkanDevice::kernel_from_spirv(const std::string& name, const std:
   VulkanKernel k;
   k.name = name;
   k.bindings = bindings;
+  // Each binding as the shader declares it; one the shader does not use stays a storage buffer.
+  k.kinds.assign(static_cast<std::size_t>(bindings), SpirvBinding::storage_buffer);
+  try {
+    for (const auto& [binding, kind] : spirv_bindings(words, word_count))
+      if (binding < k.kinds.size()) k.kinds[binding] = kind;
+  } catch (const std::invalid_argument& e) {
+    throw DeviceError("the Vulkan shader " + name + " failed to load on " + info_.name + ": " +
+                      e.what() + "; rebuild sigmafem");
+  }
   VkShaderModule module = VK_NULL_HANDLE;
   try {
     std::vector<VkDescriptorSetLayoutBinding> slots(bindings);
     for (int b = 0; b < bindings; ++b) {
       slots[b] = {};
       slots[b].binding = static_cast<std::uint32_t>(b);
-      slots[b].descriptorType = VK_DESCRIPTOR_TYPE_STORAGE_BUFFER;
+      slots[b].descriptorType = k.kinds[b] == SpirvBinding::storage_buffer
+                                    ? VK_DESCRIPTOR_TYPE_STORAGE_BUFFER
+                                    : VK_DESCRIPTOR_TYPE_UNIFORM_TEXEL_BUFFER;
       slots[b].descriptorCount = 1;
       slots[b].stageFlags = VK_SHADER_STAGE_COMPUTE_BIT;
     }
@@ -333,19 +368,51 @@ VkDescriptorSet VulkanDevice::bind(const VulkanKernel& kernel, const std::vector
   check(api_->vkAllocateDescriptorSets(device_, &allocate, &set),
         "allocating the descriptor set of " + kernel.name);
   std::vector<VkDescriptorBufferInfo> infos(buffers.size());
+  std::vector<VkBufferView> views(buffers.size(), VK_NULL_HANDLE);
   std::vector<VkWriteDescriptorSet> writes(buffers.size());
   for (std::size_t b = 0; b < buffers.size(); ++b) {
-    infos[b] = {buffers[b].buffer, 0, VK_WHOLE_SIZE};
     writes[b] = {};
     writes[b].sType = VK_STRUCTURE_TYPE_WRITE_DESCRIPTOR_SET;
     writes[b].dstSet = set;
     writes[b].dstBinding = static_cast<std::uint32_t>(b);
     writes[b].descriptorCount = 1;
-    writes[b].descriptorType = VK_DESCRIPTOR_TYPE_STORAGE_BUFFER;
-    writes[b].pBufferInfo = &infos[b];
+    if (kernel.kinds[b] == SpirvBinding::storage_buffer) {
+      infos[b] = {buffers[b].buffer, 0, VK_WHOLE_SIZE};
+      writes[b].descriptorType = VK_DESCRIPTOR_TYPE_STORAGE_BUFFER;
+      writes[b].pBufferInfo = &infos[b];
+    } else {
+      views[b] = texel_view(buffers[b], kernel.kinds[b], kernel.name);
+      writes[b].descriptorType = VK_DESCRIPTOR_TYPE_UNIFORM_TEXEL_BUFFER;
+      writes[b].pTexelBufferView = &views[b];
+    }
   }
   api_->vkUpdateDescriptorSets(device_, static_cast<std::uint32_t>(writes.size()), writes.data(), 0, nullptr);
   return set;
+}
+
+VkBufferView VulkanDevice::texel_view(const VulkanBuffer& buffer, SpirvBinding kind,
+                                      const std::string& kernel) {
+  const VkFormat format = kind == SpirvBinding::float_texels ? VK_FORMAT_R32_SFLOAT
+                          : kind == SpirvBinding::int_texels ? VK_FORMAT_R32_SINT
+                                                             : VK_FORMAT_R32_UINT;
+  for (const TexelView& v : views_)
+    if (v.buffer == buffer.buffer && v.format == format) return v.view;
+  // Every texel of these formats is 4 bytes.
+  if (buffer.bytes / 4 > info_.max_texel_elements)
+    throw DeviceError("the Vulkan shader " + kernel + " reads a buffer of " +
+                      std::to_string(buffer.bytes / 4) + " texels; " + info_.name +
+                      " allows " + std::to_string(info_.max_texel_elements) +
+                      " (maxTexelBufferElements); use fewer sigma points");
+  VkBufferViewCreateInfo create{};
+  create.sType = VK_STRUCTURE_TYPE_BUFFER_VIEW_CREATE_INFO;
+  create.buffer = buffer.buffer;
+  create.format = format;
+  create.offset = 0;
+  create.range = VK_WHOLE_SIZE;
+  VkBufferView view = VK_NULL_HANDLE;
+  check(api_->vkCreateBufferView(device_, &create, nullptr, &view), "creating a texel view for " + kernel);
+  views_.push_back({buffer.buffer, format, view});
+  return view;
 }
 
 VkCommandBuffer VulkanDevice::begin() {
@@ -354,6 +421,10 @@ VkCommandBuffer VulkanDevice::begin() {
   begin_info.sType = VK_STRUCTURE_TYPE_COMMAND_BUFFER_BEGIN_INFO;
   begin_info.flags = VK_COMMAND_BUFFER_USAGE_ONE_TIME_SUBMIT_BIT;
   check(api_->vkBeginCommandBuffer(command_buffer_, &begin_info), "recording a command buffer");
+  if (profile_queries_) {
+    api_->vkCmdResetQueryPool(command_buffer_, profile_queries_, 0, 2 * kProfiledDispatches);
+    profiled_.clear();
+  }
   return command_buffer_;
 }
 
@@ -367,7 +438,14 @@ void VulkanDevice::dispatch(VkCommandBuffer cmd, const VulkanKernel& kernel, VkD
   // Past the device's limit on groups per dimension, a 2-D grid (sf_global_id() flattens it).
   const std::uint32_t x = std::min(groups, max_group_count_);
   const std::uint32_t y = (groups + x - 1) / x;
+  const bool timed = profile_queries_ && profiled_.size() < kProfiledDispatches;
+  const std::uint32_t query = 2 * static_cast<std::uint32_t>(profiled_.size());
+  if (timed) api_->vkCmdWriteTimestamp(cmd, VK_PIPELINE_STAGE_TOP_OF_PIPE_BIT, profile_queries_, query);
   api_->vkCmdDispatch(cmd, x, y, 1);
+  if (timed) {
+    api_->vkCmdWriteTimestamp(cmd, VK_PIPELINE_STAGE_BOTTOM_OF_PIPE_BIT, profile_queries_, query + 1);
+    profiled_.push_back(&kernel.name);
+  }
 }
 
 void VulkanDevice::barrier(VkCommandBuffer cmd) {
@@ -424,6 +502,36 @@ void VulkanDevice::submit_and_wait(VkCommandBuffer cmd) {
   check(api_->vkQueueSubmit(queue_, 1, &submit, fence_), "submitting to the Vulkan queue");
   check(api_->vkWaitForFences(device_, 1, &fence_, VK_TRUE, UINT64_MAX), "waiting for the device");
   check(api_->vkResetFences(device_, 1, &fence_), "resetting a fence");
+  collect_profile();
+}
+
+void VulkanDevice::collect_profile() {
+  if (!profile_queries_ || profiled_.empty()) return;
+  std::vector<std::uint64_t> ticks(2 * profiled_.size());
+  check(api_->vkGetQueryPoolResults(device_, profile_queries_, 0,
+                                    static_cast<std::uint32_t>(ticks.size()),
+                                    ticks.size() * sizeof(std::uint64_t), ticks.data(),
+                                    sizeof(std::uint64_t),
+                                    VK_QUERY_RESULT_64_BIT | VK_QUERY_RESULT_WAIT_BIT),
+        "reading the profile's timestamps");
+  for (std::size_t i = 0; i < profiled_.size(); ++i) {
+    KernelTime& time = profile_[*profiled_[i]];
+    time.seconds += timestamp_seconds_ * static_cast<double>(ticks[2 * i + 1] - ticks[2 * i]);
+    ++time.dispatches;
+    if (i > 0)
+      profile_between_ += timestamp_seconds_ * static_cast<double>(ticks[2 * i] - ticks[2 * i - 1]);
+  }
+  profiled_.clear();
+}
+
+void VulkanDevice::print_profile() const {
+  if (profile_.empty()) return;
+  std::cerr << "Vulkan shader times on " << info_.name << " (SIGMAFEM_VULKAN_PROFILE):\n";
+  for (const auto& [name, time] : profile_)
+    std::cerr << "  " << name << ": " << time.dispatches << " dispatches, " << time.seconds
+              << " s, " << 1e6 * time.seconds / static_cast<double>(time.dispatches)
+              << " us each\n";
+  std::cerr << "  between dispatches (barriers, copies, updates): " << profile_between_ << " s\n";
 }
 
 }  // namespace sigmafem

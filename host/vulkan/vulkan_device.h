@@ -4,6 +4,10 @@
 // storage buffers, compute pipelines from the SPIR-V embedded at build time
 // (host/vulkan/vulkan_shaders.h), one reusable command buffer and a fence.
 //
+// Profile: with SIGMAFEM_VULKAN_PROFILE set, every dispatch is timed on the device (timestamp
+// queries) and a table of each shader's dispatches and time is printed on stderr when the
+// device is released, with the time between them: where the time goes.
+//
 // Validation: with SIGMAFEM_VULKAN_VALIDATION=1 and VK_LAYER_KHRONOS_validation installed,
 // the layer is switched on (with synchronization validation) and every message it sends is
 // printed on stderr and counted (vulkan_validation_message_count()), so tests assert none.
@@ -13,12 +17,14 @@
 
 #include <cstddef>
 #include <cstdint>
+#include <map>
 #include <memory>
 #include <string>
 #include <vector>
 
 #include "host/common/device_error.h"
 #include "host/common/device_options.h"
+#include "host/vulkan/spirv_bindings.h"
 
 namespace sigmafem {
 
@@ -30,6 +36,7 @@ struct VulkanDeviceInfo {
   bool has_fp64 = false;                  // shaderFloat64: --precision double is available
   unsigned long long memory = 0;          // bytes of the largest device-local heap
   unsigned long long max_buffer = 0;      // bytes, the largest storage buffer a shader sees
+  unsigned long long max_texel_elements = 0;  // texels, the largest texel buffer view
 };
 
 // Every Vulkan device, in the loader's order. Empty when there is no loader or no driver
@@ -43,20 +50,23 @@ bool vulkan_validation_available();
 
 struct VulkanApi;  // the loader's function table (vulkan_instance.h)
 
-// A storage buffer in device memory. Owned by the VulkanDevice that made it.
+// A buffer in device memory, bound to shaders as a storage buffer or as a uniform texel buffer
+// (by what each shader declares). Owned by the VulkanDevice that made it.
 struct VulkanBuffer {
   VkBuffer buffer = VK_NULL_HANDLE;
   VkDeviceSize bytes = 0;
 };
 
-// A compute pipeline: one entry shader, `bindings` storage buffers at bindings 0..n-1 of
-// set 0, and 16 bytes of push constants. Owned by the VulkanDevice that made it.
+// A compute pipeline: one entry shader, `bindings` buffers at bindings 0..n-1 of set 0 (each
+// a storage buffer or a uniform texel buffer, as the SPIR-V declares it), and 16 bytes of
+// push constants. Owned by the VulkanDevice that made it.
 struct VulkanKernel {
   std::string name;
   VkPipeline pipeline = VK_NULL_HANDLE;
   VkPipelineLayout layout = VK_NULL_HANDLE;
   VkDescriptorSetLayout set_layout = VK_NULL_HANDLE;
   int bindings = 0;
+  std::vector<SpirvBinding> kinds;   // by binding
 };
 
 // A device with its queue, ready to run the embedded shaders.
@@ -79,7 +89,13 @@ class VulkanDevice {
   void upload(const VulkanBuffer& buffer, const void* data, std::size_t bytes);
   void download(const VulkanBuffer& buffer, void* data, std::size_t bytes);
 
-  // The pipeline of embedded shader `name` in this device's precision. `group_size` > 0 sets
+  // Whether kernel() takes the shaders compiled with texel reads (float32 only; the kernels
+  // made before the call keep their variant). Off by default.
+  void set_texel_reads(bool on) { texel_reads_ = on && precision_ == Precision::single; }
+  bool texel_reads() const { return texel_reads_; }
+
+  // The pipeline of embedded shader `name` in this device's precision (and with texel reads
+  // when set and the shader has that variant). `group_size` > 0 sets
   // specialization constant 0 (the work-group size of the CG shaders), `partitions` > 0 (with
   // it) constant 1 (the CG shaders' partitions per sigma point). Throws DeviceError when the
   // shader is not embedded, is not SPIR-V or the driver rejects it.
@@ -89,7 +105,9 @@ class VulkanDevice {
   VulkanKernel kernel_from_spirv(const std::string& name, const std::uint32_t* words,
                                  std::size_t word_count, int bindings, std::uint32_t group_size,
                                  std::uint32_t partitions = 0);
-  // A descriptor set with `buffers` at bindings 0..n-1 for `kernel`.
+  // A descriptor set with `buffers` at bindings 0..n-1 for `kernel`; a texel binding gets a
+  // view of its buffer (made once per buffer and format). Throws DeviceError when a buffer
+  // bound as texels holds more than the device's maxTexelBufferElements.
   VkDescriptorSet bind(const VulkanKernel& kernel, const std::vector<VulkanBuffer>& buffers);
 
   // Recording into the device's one reusable command buffer: begin(), then dispatches,
@@ -136,6 +154,14 @@ class VulkanDevice {
   VkDescriptorPool descriptor_pool_ = VK_NULL_HANDLE;
   std::vector<std::pair<VkBuffer, VkDeviceMemory>> buffers_;   // all buffers made here
   std::vector<VulkanKernel> kernels_;                          // all pipelines made here
+  struct TexelView {
+    VkBuffer buffer;
+    VkFormat format;
+    VkBufferView view;
+  };
+  std::vector<TexelView> views_;                               // all texel views made here
+  VkBufferView texel_view(const VulkanBuffer& buffer, SpirvBinding kind, const std::string& kernel);
+  bool texel_reads_ = false;
   // Host-visible buffers, mapped for their lifetime: staging for upload/download, and the
   // read-back area.
   struct HostBuffer {
@@ -153,6 +179,21 @@ class VulkanDevice {
                      std::size_t bytes);
   HostBuffer staging_;
   HostBuffer read_back_;
+
+  // SIGMAFEM_VULKAN_PROFILE: a timestamp before and after each dispatch of a command buffer
+  // (up to kProfiledDispatches of them), read after its wait.
+  static constexpr std::uint32_t kProfiledDispatches = 4096;
+  VkQueryPool profile_queries_ = VK_NULL_HANDLE;
+  double timestamp_seconds_ = 0.0;                   // seconds per timestamp tick
+  std::vector<const std::string*> profiled_;         // the kernels of this command buffer's dispatches
+  struct KernelTime {
+    double seconds = 0.0;
+    long long dispatches = 0;
+  };
+  std::map<std::string, KernelTime> profile_;
+  double profile_between_ = 0.0;                     // seconds between a submission's dispatches
+  void collect_profile();
+  void print_profile() const;
 };
 
 // The name of a VkResult ("VK_ERROR_OUT_OF_DEVICE_MEMORY"), for messages.

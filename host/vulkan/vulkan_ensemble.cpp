@@ -17,6 +17,12 @@ std::uint32_t groups_for(std::size_t items) {
 
 }  // namespace
 
+bool vulkan_texel_reads(KernelForm form, const std::string& device_type, Precision precision,
+                        std::size_t largest_bytes, unsigned long long max_texel_elements) {
+  const bool cpu_form = form == KernelForm::cpu || (form == KernelForm::automatic && device_type == "cpu");
+  return cpu_form && precision == Precision::single && largest_bytes / 4 <= max_texel_elements;
+}
+
 VulkanEnsemble::VulkanEnsemble(const Model& model, EstimatedParameters estimated,
                                ObservedPoints observed, int sigma_count,
                                const DeviceOptions& options)
@@ -41,8 +47,10 @@ VulkanEnsemble::VulkanEnsemble(const Model& model, EstimatedParameters estimated
   cg_group_ = info.type == "cpu" ? 8 : 64;
 
   // The partitions' buffers are bound but unused with one partition.
+  std::size_t largest = 0;
   for (const DeviceBufferSpec& spec : buffer_specs({0, cg_partitions_})) {
     const std::size_t bytes = take_device_bytes(spec, device_.real_size());
+    largest = std::max(largest, bytes);
     buffers_.push_back(device_.buffer(bytes, spec.what));
     if (spec.integer) device_.upload(buffers_.back(), spec.integers.data(), bytes);
     if (!spec.reals.empty()) write_reals(spec.id, spec.reals);
@@ -51,6 +59,9 @@ VulkanEnsemble::VulkanEnsemble(const Model& model, EstimatedParameters estimated
   const std::size_t observation_rows = std::max<std::size_t>(1, observed_.size()) * 3;
   device_.reserve_read_back(3 * 4 * static_cast<std::size_t>(S_) +
                             (2 + observation_rows) * S_ * device_.real_size());
+
+  device_.set_texel_reads(vulkan_texel_reads(options.kernel_form, info.type, options.precision,
+                                             largest, info.max_texel_elements));
 
   using B = DeviceBuffer;
   auto kernel = [&](const char* name, DeviceKernel k) {

@@ -18,6 +18,7 @@
 #pragma once
 
 #include <Eigen/Core>
+#include <string>
 #include <vector>
 
 #include "device_layout.h"
@@ -26,6 +27,14 @@
 #include "host/vulkan/vulkan_device.h"
 
 namespace sigmafem {
+
+// The form of the Vulkan shaders: the CPU form reads the arrays a shader only reads through
+// uniform texel buffers (lavapipe gathers them 3-5x faster than storage-buffer loads:
+// kernels/vulkan/ensemble_layout.h), the GPU form through storage buffers. Automatic is the
+// CPU form on a CPU device. Texel reads need float32 and every buffer within the device's
+// texel limit (largest_bytes / 4 <= max_texel_elements); without them, the GPU form.
+bool vulkan_texel_reads(KernelForm form, const std::string& device_type, Precision precision,
+                        std::size_t largest_bytes, unsigned long long max_texel_elements);
 
 class VulkanEnsemble : public DeviceEnsemble {
  public:
@@ -39,6 +48,8 @@ class VulkanEnsemble : public DeviceEnsemble {
   void predicted_observations(Eigen::MatrixXd& y) const override;
   void recenter(const Recentering& recentering) override;
   const VulkanDeviceInfo& device_info() const { return device_.info(); }
+  // Whether the shaders read their read-only arrays through texel buffers (the CPU form).
+  bool texel_reads() const { return device_.texel_reads(); }
   // Host waits (command-buffer submissions) of the last advance().
   int last_step_waits() const { return last_step_waits_; }
 

@@ -202,6 +202,7 @@ VulkanDeviceInfo describe_vulkan_device(const VulkanApi& api, VkPhysicalDevice d
     if (memory.memoryHeaps[h].flags & VK_MEMORY_HEAP_DEVICE_LOCAL_BIT)
       info.memory = std::max<unsigned long long>(info.memory, memory.memoryHeaps[h].size);
   info.max_buffer = properties.limits.maxStorageBufferRange;
+  info.max_texel_elements = properties.limits.maxTexelBufferElements;
   return info;
 }
 

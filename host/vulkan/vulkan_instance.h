@@ -30,6 +30,8 @@ namespace sigmafem {
   X(vkGetDeviceQueue)                        \
   X(vkCreateBuffer)                          \
   X(vkDestroyBuffer)                         \
+  X(vkCreateBufferView)                      \
+  X(vkDestroyBufferView)                     \
   X(vkGetBufferMemoryRequirements)           \
   X(vkAllocateMemory)                        \
   X(vkFreeMemory)                            \
@@ -65,7 +67,12 @@ namespace sigmafem {
   X(vkDestroyFence)                          \
   X(vkWaitForFences)                         \
   X(vkResetFences)                           \
-  X(vkDeviceWaitIdle)
+  X(vkDeviceWaitIdle)                        \
+  X(vkCreateQueryPool)                       \
+  X(vkDestroyQueryPool)                      \
+  X(vkCmdResetQueryPool)                     \
+  X(vkCmdWriteTimestamp)                     \
+  X(vkGetQueryPoolResults)
 
 struct VulkanApi {
   void* library = nullptr;

@@ -1,5 +1,5 @@
 // The Vulkan ensemble's shaders, compiled from kernels/vulkan/ to SPIR-V at build time and
-// embedded in the program (cmake/compile_glsl.cmake): one entry per shader and precision.
+// embedded in the program (cmake/compile_glsl.cmake): one entry per shader and variant.
 #pragma once
 
 #include <cstddef>
@@ -10,6 +10,8 @@ namespace sigmafem {
 struct EmbeddedShader {
   const char* name;              // the entry shader: "element_product", "cg_start", ...
   bool double_precision;         // compiled with -DSF_USE_DOUBLE
+  bool texel_reads;              // compiled with -DSF_TEXEL_READS (float32): read-only arrays
+                                 // are uniform texel buffers (kernels/vulkan/ensemble_layout.h)
   const std::uint32_t* words;    // the SPIR-V module
   std::size_t word_count;
 };

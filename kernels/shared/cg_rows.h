@@ -13,9 +13,9 @@
 /* The warm start's row, with q = A x there: r = b - q, z = M^-1 r, d = z; b.b, r.r, r.z. */
 #define SF_CG_START_ROW(at, q_value, b_, inverse_diagonal_, r_, z_, d_, sum_bb, sum_rr, sum_rz) \
   {                                                                                            \
-    SF_REAL bi_ = b_[at];                                                                      \
+    SF_REAL bi_ = SF_LOAD(b_, at);                                                             \
     SF_REAL ri_ = bi_ - (q_value);                                                             \
-    SF_REAL zi_ = inverse_diagonal_[at] * ri_;                                                 \
+    SF_REAL zi_ = SF_LOAD(inverse_diagonal_, at) * ri_;                                        \
     r_[at] = ri_;                                                                              \
     z_[at] = zi_;                                                                              \
     d_[at] = zi_;                                                                              \
@@ -28,8 +28,8 @@
 #define SF_CG_UPDATE_ROW(at, alpha, x_, r_, z_, d_, q_, inverse_diagonal_, sum_rr, sum_rz) \
   {                                                                                       \
     x_[at] += (alpha) * d_[at];                                                           \
-    SF_REAL ri_ = r_[at] - (alpha) * q_[at];                                              \
-    SF_REAL zi_ = inverse_diagonal_[at] * ri_;                                            \
+    SF_REAL ri_ = r_[at] - (alpha) * SF_LOAD(q_, at);                                     \
+    SF_REAL zi_ = SF_LOAD(inverse_diagonal_, at) * ri_;                                   \
     r_[at] = ri_;                                                                         \
     z_[at] = zi_;                                                                         \
     sum_rr += ri_ * ri_;                                                                  \

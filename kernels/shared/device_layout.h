@@ -22,12 +22,12 @@
 /* Element e's rest state (element.h's grad[12], vlambda, vmu) and its four nodes (uint). */
 #define SF_LOAD_ELEMENT(rest, nodes, e, grad, vlambda, vmu, corner_nodes)            \
   SF_UNROLL for (uint i_ = 0u; i_ < 12u; ++i_) grad[i_] =                            \
-      rest[SF_INDEX(e) * SF_REST_STRIDE + i_];                                         \
-  vlambda = rest[SF_INDEX(e) * SF_REST_STRIDE + 12u];                                  \
-  vmu = rest[SF_INDEX(e) * SF_REST_STRIDE + 13u];                                      \
-  SF_UNROLL for (uint c_ = 0u; c_ < 4u; ++c_) corner_nodes[c_] = SF_UINT(nodes[4u * (e) + c_]);
+      SF_LOAD(rest, SF_INDEX(e) * SF_REST_STRIDE + i_);                                \
+  vlambda = SF_LOAD(rest, SF_INDEX(e) * SF_REST_STRIDE + 12u);                         \
+  vmu = SF_LOAD(rest, SF_INDEX(e) * SF_REST_STRIDE + 13u);                             \
+  SF_UNROLL for (uint c_ = 0u; c_ < 4u; ++c_) corner_nodes[c_] = SF_UINT(SF_LOAD(nodes, 4u * (e) + c_));
 /* Element e's region slot (step_constants.h, SF_REGION_SCALES). */
-#define SF_REGION_SLOT(rest, e) SF_UINT(rest[SF_INDEX(e) * SF_REST_STRIDE + SF_REST_REGION_SLOT])
+#define SF_REGION_SLOT(rest, e) SF_UINT(SF_LOAD(rest, SF_INDEX(e) * SF_REST_STRIDE + SF_REST_REGION_SLOT))
 /* Sigma point s's Lame terms of element e from its rest state's vlambda and vmu: lambda times
  * the sigma point's lambda_scale, both times its scale of the element's region slot. */
 #define SF_SIGMA_LAME(rest, c, e, s, S, vlambda, vmu, sigma_lambda, sigma_mu)                 \
@@ -40,10 +40,10 @@
 #define SF_GATHER_CORNERS(v, corner_nodes, s, S, out)                                \
   SF_UNROLL for (uint c_ = 0u; c_ < 4u; ++c_)                                          \
     SF_UNROLL for (uint k_ = 0u; k_ < 3u; ++k_)                                        \
-      out[3u * c_ + k_] = v[SF_INDEX(3u * corner_nodes[c_] + k_) * (S) + (s)];
+      out[3u * c_ + k_] = SF_LOAD(v, SF_INDEX(3u * corner_nodes[c_] + k_) * (S) + (s));
 /* Element e's frame for sigma point s, loaded and stored. */
 #define SF_LOAD_FRAME(frames, e, s, S, frame) \
-  SF_UNROLL for (uint i_ = 0u; i_ < 9u; ++i_) frame[i_] = frames[(SF_INDEX(9u) * (e) + i_) * (S) + (s)];
+  SF_UNROLL for (uint i_ = 0u; i_ < 9u; ++i_) frame[i_] = SF_LOAD(frames, (SF_INDEX(9u) * (e) + i_) * (S) + (s));
 #define SF_STORE_FRAME(frames, e, s, S, frame) \
   SF_UNROLL for (uint i_ = 0u; i_ < 9u; ++i_) frames[(SF_INDEX(9u) * (e) + i_) * (S) + (s)] = frame[i_];
 /* 12 corner values of element e for sigma point s, stored. */

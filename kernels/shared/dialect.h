@@ -5,7 +5,8 @@
  * passes arrays by value with a direction), SF_STRUCT(name) a struct type (OpenCL C needs the
  * keyword, GLSL forbids it), SF_INDEX_TYPE and SF_INDEX(x) the type that indexes a buffer
  * (size_t, or GLSL's 32-bit uint), SF_UINT(x) a conversion to uint, SF_ISFINITE (GLSL has no
- * isfinite). */
+ * isfinite), SF_LOAD(a, i) a read of a buffer that the kernel only reads (a[i]; in a Vulkan
+ * shader compiled with SF_TEXEL_READS a texel fetch, kernels/vulkan/ensemble_layout.h). */
 #ifndef SIGMAFEM_DIALECT_H
 #define SIGMAFEM_DIALECT_H
 
@@ -25,6 +26,7 @@
 #  define SF_INDEX_TYPE std::size_t
 #  define SF_INDEX(x) static_cast<std::size_t>(x)
 #  define SF_UINT(x) static_cast<unsigned int>(x)
+#  define SF_LOAD(a, i) (a)[i]
 typedef unsigned int uint;
 #elif defined(__OPENCL_VERSION__) /* OpenCL C on PoCL or a GPU driver */
 #  ifndef SF_REAL
@@ -45,6 +47,7 @@ typedef unsigned int uint;
 #  define SF_INDEX_TYPE size_t
 #  define SF_INDEX(x) ((size_t)(x))
 #  define SF_UINT(x) ((uint)(x))
+#  define SF_LOAD(a, i) (a)[i]
 #elif defined(VULKAN) /* GLSL through glslang for Vulkan */
 #  ifndef SF_REAL
 #    define SF_REAL float
@@ -61,6 +64,11 @@ typedef unsigned int uint;
 #  define SF_INDEX_TYPE uint
 #  define SF_INDEX(x) uint(x)
 #  define SF_UINT(x) uint(x)
+#  if defined(SF_TEXEL_READS)
+#    define SF_LOAD(a, i) sf_texel(a, uint(i))
+#  else
+#    define SF_LOAD(a, i) a[i]
+#  endif
 #else
 #  error "dialect.h: expected C++, OpenCL C or Vulkan GLSL"
 #endif

@@ -24,12 +24,12 @@
     sum[0] = SF_LIT(0);                                                        \
     sum[1] = SF_LIT(0);                                                        \
     sum[2] = SF_LIT(0);                                                        \
-    int end_ = incidence_offsets_[(n) + 1];                                    \
-    for (int i_ = incidence_offsets_[n]; i_ < end_; ++i_) {                    \
-      SF_INDEX_TYPE base_ = SF_INDEX(3 * incidence_[i_]) * (S) + (s);          \
-      sum[0] += values_[base_];                                                \
-      sum[1] += values_[base_ + (S)];                                          \
-      sum[2] += values_[base_ + 2 * (S)];                                      \
+    int end_ = SF_LOAD(incidence_offsets_, (n) + 1);                           \
+    for (int i_ = SF_LOAD(incidence_offsets_, n); i_ < end_; ++i_) {           \
+      SF_INDEX_TYPE base_ = SF_INDEX(3 * SF_LOAD(incidence_, i_)) * (S) + (s); \
+      sum[0] += SF_LOAD(values_, base_);                                       \
+      sum[1] += SF_LOAD(values_, base_ + (S));                                 \
+      sum[2] += SF_LOAD(values_, base_ + 2 * (S));                             \
     }                                                                          \
   }
 
@@ -38,10 +38,10 @@
 #define SF_NODE_SPRING(ligament_offsets_, ligament_of_node_, ligament_k_, control_k_, n, s, S, \
                        spring)                                                                 \
   {                                                                                            \
-    spring = control_k_[n];                                                                    \
-    int end_ = ligament_offsets_[(n) + 1];                                                     \
-    for (int i_ = ligament_offsets_[n]; i_ < end_; ++i_)                                       \
-      spring += ligament_k_[SF_INDEX(ligament_of_node_[i_]) * (S) + (s)];                      \
+    spring = SF_LOAD(control_k_, n);                                                           \
+    int end_ = SF_LOAD(ligament_offsets_, (n) + 1);                                            \
+    for (int i_ = SF_LOAD(ligament_offsets_, n); i_ < end_; ++i_)                              \
+      spring += SF_LOAD(ligament_k_, SF_INDEX(SF_LOAD(ligament_of_node_, i_)) * (S) + (s));    \
   }
 
 /* What a sigma point's step constants give its node rows. */
@@ -60,7 +60,7 @@ struct SfNodeConstants {
 /* Loads sigma point s's node constants from the step constants buffer c_. */
 #define SF_LOAD_NODE_CONSTANTS(c_, s, S, out)                                  \
   {                                                                            \
-    out.h = c_[SF_H];                                                          \
+    out.h = SF_LOAD(c_, SF_H);                                                 \
     out.mass_factor = SF_SIGMA_CONSTANT(c_, SF_MASS_FACTOR, s, S);             \
     out.stiffness_factor = SF_SIGMA_CONSTANT(c_, SF_STIFFNESS_FACTOR, s, S);   \
     out.rayleigh_mass = SF_SIGMA_CONSTANT(c_, SF_RAYLEIGH_MASS, s, S);         \

@@ -18,8 +18,9 @@ SF_FN SF_REAL sf_observed_coordinate(SF_IN(weight, 4), SF_IN(corner, 4)) {
  * device buffers (4 corner nodes and weights per point; x sigma-innermost). */
 #define SF_LOAD_OBSERVED_POINT(nodes, weights, x, k, axis, s, S, weight, corner)          \
   for (uint c_ = 0u; c_ < 4u; ++c_) {                                                     \
-    weight[c_] = weights[4u * (k) + c_];                                                  \
-    corner[c_] = x[(SF_INDEX(3u) * SF_INDEX(nodes[4u * (k) + c_]) + (axis)) * (S) + (s)]; \
+    weight[c_] = SF_LOAD(weights, 4u * (k) + c_);                                         \
+    corner[c_] =                                                                          \
+        SF_LOAD(x, (SF_INDEX(3u) * SF_INDEX(SF_LOAD(nodes, 4u * (k) + c_)) + (axis)) * (S) + (s)); \
   }
 
 #endif /* SIGMAFEM_OBSERVATION_GATHER_H */

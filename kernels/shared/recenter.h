@@ -14,30 +14,53 @@
 #include "dialect.h"
 #include "step_constants.h"
 
-/* L_j += dx I_js for sigma point s's difference dx from sigma point 0 and its directions. */
-SF_FN void sf_recenter_add(SF_REAL dx, SF_IN(direction, SF_MAX_PARAMETERS), uint p,
-                           SF_INOUT(L, SF_MAX_PARAMETERS)) {
-  for (uint j = 0; j < p; ++j) L[j] += dx * direction[j];
-}
-
-/* X_hat from sigma point 0's value x0 and the sum of the differences; scales L by alpha. */
-SF_FN SF_REAL sf_recentred_mean(SF_REAL x0, SF_REAL alpha, SF_REAL sum,
-                                SF_IN(correction, SF_MAX_PARAMETERS), uint p,
-                                SF_INOUT(L, SF_MAX_PARAMETERS)) {
-  SF_REAL mean = x0 + alpha * sum;
-  for (uint j = 0; j < p; ++j) {
-    L[j] *= alpha;
-    mean += L[j] * correction[j];
+/* Re-samples the row whose S values start at x[base] and v[base], for p parameters.
+ * scalars: [0] alpha, [1 .. p] the correction; directions, weights: p x S, [j * S + s].
+ * L and Lv: the caller's arrays of at least p reals (SF_MAX_PARAMETERS). A macro, not
+ * functions: GLSL passes arrays by value, and lavapipe spent 7.6 ms of the liver's filter
+ * step copying them (bench/RESULTS.md, stop 50). */
+#define SF_RECENTER_ROW(scalars, directions, weights, x, v, base, S, p, L, Lv)         \
+  {                                                                                  \
+    for (uint j_ = 0u; j_ < (p); ++j_) {                                             \
+      L[j_] = SF_LIT(0);                                                             \
+      Lv[j_] = SF_LIT(0);                                                            \
+    }                                                                                \
+    SF_REAL x0_ = x[base];                                                           \
+    SF_REAL v0_ = v[base];                                                           \
+    SF_REAL sum_ = SF_LIT(0);                                                        \
+    SF_REAL sum_v_ = SF_LIT(0);                                                      \
+    for (uint s_ = 0u; s_ < (S); ++s_) {                                             \
+      SF_REAL dx_ = x[(base) + s_] - x0_;                                            \
+      SF_REAL dv_ = v[(base) + s_] - v0_;                                            \
+      sum_ += dx_;                                                                   \
+      sum_v_ += dv_;                                                                 \
+      for (uint j_ = 0u; j_ < (p); ++j_) {                                           \
+        SF_REAL direction_ = SF_LOAD(directions, j_ * (S) + s_);                     \
+        L[j_] += dx_ * direction_;                                                   \
+        Lv[j_] += dv_ * direction_;                                                  \
+      }                                                                              \
+    }                                                                                \
+    SF_REAL alpha_ = SF_LOAD(scalars, 0u);                                           \
+    SF_REAL x_hat_ = x0_ + alpha_ * sum_;                                            \
+    SF_REAL v_hat_ = v0_ + alpha_ * sum_v_;                                          \
+    for (uint j_ = 0u; j_ < (p); ++j_) {                                             \
+      SF_REAL correction_ = SF_LOAD(scalars, 1u + j_);                               \
+      L[j_] *= alpha_;                                                               \
+      Lv[j_] *= alpha_;                                                              \
+      x_hat_ += L[j_] * correction_;                                                 \
+      v_hat_ += Lv[j_] * correction_;                                                \
+    }                                                                                \
+    for (uint s_ = 0u; s_ < (S); ++s_) {                                             \
+      SF_REAL x_new_ = x_hat_;                                                       \
+      SF_REAL v_new_ = v_hat_;                                                       \
+      for (uint j_ = 0u; j_ < (p); ++j_) {                                           \
+        SF_REAL weight_ = SF_LOAD(weights, j_ * (S) + s_);                           \
+        x_new_ += L[j_] * weight_;                                                   \
+        v_new_ += Lv[j_] * weight_;                                                  \
+      }                                                                              \
+      x[(base) + s_] = x_new_;                                                       \
+      v[(base) + s_] = v_new_;                                                       \
+    }                                                                                \
   }
-  return mean;
-}
-
-/* Sigma point s's new value from X_hat, L and its weights W_js. */
-SF_FN SF_REAL sf_resampled(SF_REAL mean, SF_IN(L, SF_MAX_PARAMETERS),
-                           SF_IN(weight, SF_MAX_PARAMETERS), uint p) {
-  SF_REAL value = mean;
-  for (uint j = 0; j < p; ++j) value += L[j] * weight[j];
-  return value;
-}
 
 #endif /* SIGMAFEM_RECENTER_H */

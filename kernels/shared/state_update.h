@@ -9,7 +9,7 @@
 
 #define SF_STATE_UPDATE_ROW(at, s, h, bb, dv, x, v)      \
   {                                                      \
-    if (bb[s] == SF_LIT(0)) dv[at] = SF_LIT(0);          \
+    if (SF_LOAD(bb, s) == SF_LIT(0)) dv[at] = SF_LIT(0); \
     SF_REAL velocity_ = v[at] + dv[at];                  \
     v[at] = velocity_;                                   \
     x[at] += (h) * velocity_;                            \

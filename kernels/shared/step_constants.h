@@ -36,6 +36,6 @@
 #define SF_MAX_PARAMETERS 64
 
 /* Constant k of sigma point s, with S sigma points, in the buffer c. */
-#define SF_SIGMA_CONSTANT(c, k, s, S) ((c)[SF_STEP_CONSTANTS + (k) * (S) + (s)])
+#define SF_SIGMA_CONSTANT(c, k, s, S) (SF_LOAD(c, SF_STEP_CONSTANTS + (k) * (S) + (s)))
 
 #endif /* SIGMAFEM_STEP_CONSTANTS_H */

@@ -76,10 +76,10 @@ void sf_partition_nodes(uint p, out uint begin, out uint end) {
 
 #if defined(SF_START_FAMILY)
 /* One descriptor set for the three start shaders: the node rows' buffers (node_assembly.h), then these. */
-layout(std430, binding = SF_CG_START_ELEMENT_OUT) restrict readonly buffer ElementOut { real element_out[]; };
-layout(std430, binding = SF_CG_START_RHS) restrict readonly buffer B { real b[]; };
-layout(std430, binding = SF_CG_START_INVERSE_DIAGONAL) restrict readonly buffer InverseDiagonal { real inverse_diagonal[]; };
-layout(std430, binding = SF_CG_START_DV) restrict readonly buffer X { real x[]; };
+SF_READ_REALS(SF_CG_START_ELEMENT_OUT, element_out)
+SF_READ_REALS(SF_CG_START_RHS, b)
+SF_READ_REALS(SF_CG_START_INVERSE_DIAGONAL, inverse_diagonal)
+SF_READ_REALS(SF_CG_START_DV, x)
 layout(std430, binding = SF_CG_START_R) restrict writeonly buffer R { real r[]; };
 layout(std430, binding = SF_CG_START_Z) restrict writeonly buffer Z { real z[]; };
 layout(std430, binding = SF_CG_START_D) restrict writeonly buffer D { real d[]; };
@@ -104,12 +104,12 @@ void sf_start_rows(uint s, uint S, uint begin, uint end, out real sum_bb, out re
   for (uint n = begin + gl_LocalInvocationID.x; n < end; n += gl_WorkGroupSize.x) {
     real spring;
     SF_SPRING_OF(n, s, S, spring)
-    real m = sf_solver_mass(mass[n], spring);
+    real m = sf_solver_mass(SF_LOAD(mass, n), spring);
     real Kd[3];
     SF_CORNER_SUMS(element_out, incidence_offsets, incidence, n, s, S, Kd)
     for (uint k = 0u; k < 3u; ++k) {
       uint row = (3u * n + k) * S + s;
-      real q = SF_SYSTEM_ROW(c, s, S, Kd[k], spring, m, x[row]);
+      real q = SF_SYSTEM_ROW(c, s, S, Kd[k], spring, m, SF_LOAD(x, row));
       SF_CG_START_ROW(row, q, b, inverse_diagonal, r, z, d, sum_bb, sum_rr, sum_rz)
     }
   }
@@ -121,7 +121,7 @@ void sf_start_rows(uint s, uint S, uint begin, uint end, out real sum_bb, out re
 /* Sigma point s's scalars after the warm start; whether it iterates (cg_rows.h). */
 bool sf_start_scalars(uint s, real sum_bb, real sum_rr, real sum_rz) {
   bool breakdown = sf_cg_start_breakdown(sum_bb, sum_rr);
-  bool done = sf_cg_start_converged(breakdown, sum_bb, sum_rr, c[SF_CG_TOLERANCE2]);
+  bool done = sf_cg_start_converged(breakdown, sum_bb, sum_rr, SF_LOAD(c, SF_CG_TOLERANCE2));
   bb[s] = sum_bb;
   rr[s] = sum_rr;
   rz[s] = sum_rz;
@@ -177,14 +177,14 @@ void main() {
 #  endif
 
 #else /* the iteration's shaders: one descriptor set for the four */
-layout(std430, binding = SF_CG_ITERATION_CONSTANTS) restrict readonly buffer C { real c[]; };
-layout(std430, binding = SF_CG_ITERATION_INVERSE_DIAGONAL) restrict readonly buffer InverseDiagonal { real inverse_diagonal[]; };
+SF_READ_REALS(SF_CG_ITERATION_CONSTANTS, c)
+SF_READ_REALS(SF_CG_ITERATION_INVERSE_DIAGONAL, inverse_diagonal)
 layout(std430, binding = SF_CG_ITERATION_DV) restrict buffer X { real x[]; };
 layout(std430, binding = SF_CG_ITERATION_R) restrict buffer R { real r[]; };
 layout(std430, binding = SF_CG_ITERATION_Z) restrict buffer Z { real z[]; };
 layout(std430, binding = SF_CG_ITERATION_D) restrict buffer D { real d[]; };
-layout(std430, binding = SF_CG_ITERATION_Q) restrict readonly buffer Q { real q[]; };
-layout(std430, binding = SF_CG_ITERATION_BB) restrict readonly buffer BB { real bb[]; };
+SF_READ_REALS(SF_CG_ITERATION_Q, q)
+SF_READ_REALS(SF_CG_ITERATION_BB, bb)
 layout(std430, binding = SF_CG_ITERATION_RR) restrict buffer RR { real rr[]; };
 layout(std430, binding = SF_CG_ITERATION_RZ) restrict buffer RZ { real rz[]; };
 layout(std430, binding = SF_CG_ITERATION_ACTIVE) restrict buffer Active { uint active_flags[]; };
@@ -201,7 +201,7 @@ real sf_dq_rows(uint s, uint S, uint begin, uint end) {
   for (uint n = begin + gl_LocalInvocationID.x; n < end; n += gl_WorkGroupSize.x)
     for (uint k = 0u; k < 3u; ++k) {
       uint row = (3u * n + k) * S + s;
-      sum_dq += d[row] * q[row];
+      sum_dq += d[row] * SF_LOAD(q, row);
     }
   return sf_group_sum(sum_dq);
 }
@@ -230,7 +230,9 @@ void sf_direction_rows(uint s, uint S, uint begin, uint end, real beta) {
 }
 
 /* The stop test of cg_rows.h with sigma point s's |b|^2 and the push constants' cap. */
-bool sf_done(uint s, real sum_rr) { return sf_cg_converged(sum_rr, c[SF_CG_TOLERANCE2], bb[s]); }
+bool sf_done(uint s, real sum_rr) {
+  return sf_cg_converged(sum_rr, SF_LOAD(c, SF_CG_TOLERANCE2), SF_LOAD(bb, s));
+}
 bool sf_stop(bool done, real sum_rr, int count) {
   return sf_cg_stops(done, sum_rr, count, sf_push.max_iterations);
 }

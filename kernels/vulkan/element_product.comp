@@ -8,13 +8,13 @@
 #include "ensemble_layout.h"
 
 layout(local_size_x = SF_ITEMS_PER_GROUP) in;
-layout(std430, binding = SF_ELEMENT_PRODUCT_ELEMENT_NODES) restrict readonly buffer Nodes { int nodes[]; };
-layout(std430, binding = SF_ELEMENT_PRODUCT_ELEMENT_REST) restrict readonly buffer Rest { real rest[]; };
-layout(std430, binding = SF_ELEMENT_PRODUCT_FRAMES) restrict readonly buffer Frames { real frames[]; };
-layout(std430, binding = SF_ELEMENT_PRODUCT_D) restrict readonly buffer D { real d[]; };
-layout(std430, binding = SF_ELEMENT_PRODUCT_ACTIVE) restrict readonly buffer Active { uint active_flags[]; };
+SF_READ_INTS(SF_ELEMENT_PRODUCT_ELEMENT_NODES, nodes)
+SF_READ_REALS(SF_ELEMENT_PRODUCT_ELEMENT_REST, rest)
+SF_READ_REALS(SF_ELEMENT_PRODUCT_FRAMES, frames)
+SF_READ_REALS(SF_ELEMENT_PRODUCT_D, d)
+SF_READ_UINTS(SF_ELEMENT_PRODUCT_ACTIVE, active_flags)
 layout(std430, binding = SF_ELEMENT_PRODUCT_ELEMENT_OUT) restrict writeonly buffer ElementOut { real element_out[]; };
-layout(std430, binding = SF_ELEMENT_PRODUCT_CONSTANTS) restrict readonly buffer C { real c[]; };
+SF_READ_REALS(SF_ELEMENT_PRODUCT_CONSTANTS, c)
 
 void main() {
   uint S = sf_push.S;
@@ -22,7 +22,7 @@ void main() {
   if (gid >= sf_push.count * S) return;
   uint e = gid / S;
   uint s = gid % S;
-  if (active_flags[s] == 0u) return; /* this sigma point's CG is done */
+  if (SF_LOAD(active_flags, s) == 0u) return; /* this sigma point's CG is done */
   real grad[12];
   real vlambda;
   real vmu;

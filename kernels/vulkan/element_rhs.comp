@@ -10,12 +10,12 @@
 #include "ensemble_layout.h"
 
 layout(local_size_x = SF_ITEMS_PER_GROUP) in;
-layout(std430, binding = SF_ELEMENT_RHS_ELEMENT_NODES) restrict readonly buffer Nodes { int nodes[]; };
-layout(std430, binding = SF_ELEMENT_RHS_ELEMENT_REST) restrict readonly buffer Rest { real rest[]; };
+SF_READ_INTS(SF_ELEMENT_RHS_ELEMENT_NODES, nodes)
+SF_READ_REALS(SF_ELEMENT_RHS_ELEMENT_REST, rest)
 layout(std430, binding = SF_ELEMENT_RHS_FRAMES) restrict writeonly buffer Frames { real frames[]; };
-layout(std430, binding = SF_ELEMENT_RHS_X) restrict readonly buffer X { real x[]; };
-layout(std430, binding = SF_ELEMENT_RHS_V) restrict readonly buffer V { real v[]; };
-layout(std430, binding = SF_ELEMENT_RHS_CONSTANTS) restrict readonly buffer C { real c[]; };
+SF_READ_REALS(SF_ELEMENT_RHS_X, x)
+SF_READ_REALS(SF_ELEMENT_RHS_V, v)
+SF_READ_REALS(SF_ELEMENT_RHS_CONSTANTS, c)
 layout(std430, binding = SF_ELEMENT_RHS_ELEMENT_OUT) restrict writeonly buffer ElementOut { real element_out[]; };
 layout(std430, binding = SF_ELEMENT_RHS_ELEMENT_DIAGONAL) restrict writeonly buffer ElementDiagonal { real element_diagonal[]; };
 
@@ -38,7 +38,7 @@ void main() {
   real force[12];
   real product[12];
   SF_GATHER_CORNERS(x, corner_nodes, s, S, corner)
-  sf_element_rotation(grad, corner, c[SF_POLAR_ROTATION], frame);
+  sf_element_rotation(grad, corner, SF_LOAD(c, SF_POLAR_ROTATION), frame);
   SF_STORE_FRAME(frames, e, s, S, frame)
   sf_element_force(frame, grad, sigma_lambda, sigma_mu, corner, force);
   SF_GATHER_CORNERS(v, corner_nodes, s, S, corner)

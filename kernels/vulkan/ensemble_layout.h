@@ -17,6 +17,32 @@
 /* GLSL has no typedef. */
 #define real SF_REAL
 
+/* The arrays a shader only reads, declared with SF_READ_REALS/INTS/UINTS(binding, name) and
+ * read with SF_LOAD(name, index) (dialect.h): storage buffers, or, in the float32 shaders
+ * compiled with SF_TEXEL_READS (the CPU form, for lavapipe), uniform texel buffers. llvmpipe
+ * turns every storage-buffer load at an address that differs between its 8 lanes into a
+ * loop over the lanes with a branch and a bounds check each; a texel fetch is one gather
+ * with a bounds mask: 3-5x faster loads there (bench/RESULTS.md, stop 50). The host binds
+ * each binding by what the SPIR-V declares (host/vulkan/spirv_bindings.h). */
+#if defined(SF_TEXEL_READS)
+#  if defined(SF_USE_DOUBLE)
+#    error "SF_TEXEL_READS: float32 shaders only (texel formats have no 64-bit float)"
+#  endif
+#  define SF_READ_REALS(slot, name) layout(binding = slot) uniform samplerBuffer name;
+#  define SF_READ_INTS(slot, name) layout(binding = slot) uniform isamplerBuffer name;
+#  define SF_READ_UINTS(slot, name) layout(binding = slot) uniform usamplerBuffer name;
+float sf_texel(samplerBuffer b, uint i) { return texelFetch(b, int(i)).x; }
+int sf_texel(isamplerBuffer b, uint i) { return texelFetch(b, int(i)).x; }
+uint sf_texel(usamplerBuffer b, uint i) { return texelFetch(b, int(i)).x; }
+#else
+#  define SF_READ_REALS(slot, name) \
+    layout(std430, binding = slot) restrict readonly buffer name##_buffer { real name[]; };
+#  define SF_READ_INTS(slot, name) \
+    layout(std430, binding = slot) restrict readonly buffer name##_buffer { int name[]; };
+#  define SF_READ_UINTS(slot, name) \
+    layout(std430, binding = slot) restrict readonly buffer name##_buffer { uint name[]; };
+#endif
+
 #define SF_UINT_FIELD(name) uint name;
 #define SF_INT_FIELD(name) int name;
 layout(push_constant) uniform SfPush { SF_PUSH_CONSTANTS(SF_UINT_FIELD, SF_INT_FIELD) } sf_push;

@@ -7,14 +7,14 @@
 #include "ensemble_layout.h"
 #include "node_rows.h"
 
-layout(std430, binding = SF_NODE_CONSTANTS) restrict readonly buffer C { real c[]; };
-layout(std430, binding = SF_NODE_INCIDENCE_OFFSETS) restrict readonly buffer IncidenceOffsets { int incidence_offsets[]; };
-layout(std430, binding = SF_NODE_INCIDENCE) restrict readonly buffer Incidence { int incidence[]; };
-layout(std430, binding = SF_NODE_LIGAMENT_OFFSETS) restrict readonly buffer LigamentOffsets { int ligament_offsets[]; };
-layout(std430, binding = SF_NODE_LIGAMENT_OF_NODE) restrict readonly buffer LigamentOfNode { int ligament_of_node[]; };
-layout(std430, binding = SF_NODE_LIGAMENT_K) restrict readonly buffer LigamentK { real ligament_k[]; };
-layout(std430, binding = SF_NODE_CONTROL_K) restrict readonly buffer ControlK { real control_k[]; };
-layout(std430, binding = SF_NODE_MASS) restrict readonly buffer Mass { real mass[]; };
+SF_READ_REALS(SF_NODE_CONSTANTS, c)
+SF_READ_INTS(SF_NODE_INCIDENCE_OFFSETS, incidence_offsets)
+SF_READ_INTS(SF_NODE_INCIDENCE, incidence)
+SF_READ_INTS(SF_NODE_LIGAMENT_OFFSETS, ligament_offsets)
+SF_READ_INTS(SF_NODE_LIGAMENT_OF_NODE, ligament_of_node)
+SF_READ_REALS(SF_NODE_LIGAMENT_K, ligament_k)
+SF_READ_REALS(SF_NODE_CONTROL_K, control_k)
+SF_READ_REALS(SF_NODE_MASS, mass)
 
 /* The spring on node n for sigma point s, from the buffers above. */
 #define SF_SPRING_OF(n, s, S, spring) \

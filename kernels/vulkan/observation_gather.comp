@@ -7,9 +7,9 @@
 #include "observation_gather.h"
 
 layout(local_size_x = SF_ITEMS_PER_GROUP) in;
-layout(std430, binding = SF_OBSERVATION_GATHER_OBSERVED_NODES) restrict readonly buffer Nodes { int nodes[]; };
-layout(std430, binding = SF_OBSERVATION_GATHER_OBSERVED_WEIGHTS) restrict readonly buffer Weights { real weights[]; };
-layout(std430, binding = SF_OBSERVATION_GATHER_X) restrict readonly buffer X { real x[]; };
+SF_READ_INTS(SF_OBSERVATION_GATHER_OBSERVED_NODES, nodes)
+SF_READ_REALS(SF_OBSERVATION_GATHER_OBSERVED_WEIGHTS, weights)
+SF_READ_REALS(SF_OBSERVATION_GATHER_X, x)
 layout(std430, binding = SF_OBSERVATION_GATHER_OBSERVATIONS) restrict writeonly buffer Y { real y[]; };
 
 void main() {

@@ -97,10 +97,12 @@ std::vector<BackendCase> backend_cases() {
   // on meshes of more than about 340 nodes; these meshes would get one partition).
   cases.push_back({"opencl", Precision::single, "OpenClSingleGpuFormPartitions",
                    SolveLaunch::automatic, KernelForm::gpu, 3});
+  // Vulkan as it runs on a CPU device (lavapipe): float32 shaders with texel reads.
   cases.push_back({"vulkan", Precision::single, "VulkanSingle"});
-  // Vulkan's CG in partitions too (a GPU's choice on large meshes; lavapipe's never).
-  cases.push_back({"vulkan", Precision::single, "VulkanSinglePartitions", SolveLaunch::automatic,
-                   KernelForm::automatic, 3});
+  // Vulkan as a GPU runs it: storage-buffer reads and CG in partitions (a GPU's choice on
+  // large meshes), forced on whatever device is there.
+  cases.push_back({"vulkan", Precision::single, "VulkanSingleGpuFormPartitions", SolveLaunch::automatic,
+                   KernelForm::gpu, 3});
   cases.push_back({"vulkan", Precision::double_precision, "VulkanDouble"});
   return cases;
 }

@@ -1,0 +1,78 @@
+#include "host/vulkan/spirv_bindings.h"
+
+#include <stdexcept>
+#include <string>
+#include <unordered_map>
+
+namespace sigmafem {
+namespace {
+
+// The few SPIR-V opcodes, decorations and enumerants that say what a binding is (the SPIR-V
+// specification, sections 3.32 and 3.14).
+constexpr std::uint32_t kMagic = 0x07230203;
+constexpr std::uint32_t kOpTypeInt = 21, kOpTypeFloat = 22, kOpTypeImage = 25;
+constexpr std::uint32_t kOpTypeSampledImage = 27, kOpTypePointer = 32, kOpVariable = 59;
+constexpr std::uint32_t kOpDecorate = 71;
+constexpr std::uint32_t kDecorationBinding = 33, kDecorationDescriptorSet = 34;
+constexpr std::uint32_t kDimBuffer = 5;
+
+}  // namespace
+
+std::map<std::uint32_t, SpirvBinding> spirv_bindings(const std::uint32_t* words, std::size_t count) {
+  if (words == nullptr || count < 5 || words[0] != kMagic)
+    throw std::invalid_argument("not a SPIR-V module (bad header)");
+  std::unordered_map<std::uint32_t, std::uint32_t> binding_of, set_of;
+  std::unordered_map<std::uint32_t, std::uint32_t> pointee;       // pointer type -> type
+  std::unordered_map<std::uint32_t, std::uint32_t> variable_type; // variable -> pointer type
+  std::unordered_map<std::uint32_t, std::uint32_t> sampled_image; // sampled image -> image
+  std::unordered_map<std::uint32_t, std::uint32_t> buffer_image;  // buffer image -> sampled type
+  std::unordered_map<std::uint32_t, SpirvBinding> scalar_kind;    // 32-bit scalar types
+  for (std::size_t at = 5; at < count;) {
+    const std::uint32_t length = words[at] >> 16, opcode = words[at] & 0xffffu;
+    if (length == 0 || at + length > count)
+      throw std::invalid_argument("SPIR-V instruction at word " + std::to_string(at) +
+                                  " runs past the module's end");
+    const std::uint32_t* operand = words + at + 1;
+    const std::uint32_t operands = length - 1;
+    if (opcode == kOpDecorate && operands >= 3 && operand[1] == kDecorationBinding)
+      binding_of[operand[0]] = operand[2];
+    else if (opcode == kOpDecorate && operands >= 3 && operand[1] == kDecorationDescriptorSet)
+      set_of[operand[0]] = operand[2];
+    else if (opcode == kOpTypeFloat && operands >= 2 && operand[1] == 32)
+      scalar_kind[operand[0]] = SpirvBinding::float_texels;
+    else if (opcode == kOpTypeInt && operands >= 3 && operand[1] == 32)
+      scalar_kind[operand[0]] = operand[2] ? SpirvBinding::int_texels : SpirvBinding::uint_texels;
+    else if (opcode == kOpTypeImage && operands >= 3 && operand[2] == kDimBuffer)
+      buffer_image[operand[0]] = operand[1];
+    else if (opcode == kOpTypeSampledImage && operands >= 2)
+      sampled_image[operand[0]] = operand[1];
+    else if (opcode == kOpTypePointer && operands >= 3)
+      pointee[operand[0]] = operand[2];
+    else if (opcode == kOpVariable && operands >= 2)
+      variable_type[operand[1]] = operand[0];
+    at += length;
+  }
+  // What a variable's pointee is: a sampled buffer image of 32-bit texels, or else storage.
+  auto find = [](const auto& map, std::uint32_t key, std::uint32_t& value) {
+    const auto it = map.find(key);
+    if (it == map.end()) return false;
+    value = it->second;
+    return true;
+  };
+  std::map<std::uint32_t, SpirvBinding> result;
+  for (const auto& [variable, binding] : binding_of) {
+    std::uint32_t set = 0;
+    if (find(set_of, variable, set) && set != 0) continue;
+    SpirvBinding kind = SpirvBinding::storage_buffer;
+    std::uint32_t pointer = 0, type = 0, image = 0, texel = 0;
+    if (find(variable_type, variable, pointer) && find(pointee, pointer, type) &&
+        find(sampled_image, type, image) && find(buffer_image, image, texel)) {
+      const auto it = scalar_kind.find(texel);
+      if (it != scalar_kind.end()) kind = it->second;
+    }
+    result[binding] = kind;
+  }
+  return result;
+}
+
+}  // namespace sigmafem

@@ -1,0 +1,25 @@
+// What each binding of a SPIR-V compute module's descriptor set 0 is, read from the module
+// itself, so that the host lays out and fills a shader's descriptor set as the shader
+// declares it: the shaders compiled with texel reads (kernels/vulkan/ensemble_layout.h) read
+// some arrays through uniform texel buffers, the others through storage buffers.
+#pragma once
+
+#include <cstddef>
+#include <cstdint>
+#include <map>
+
+namespace sigmafem {
+
+enum class SpirvBinding {
+  storage_buffer,   // a std430 buffer block (or anything that is not a texel buffer)
+  float_texels,     // uniform samplerBuffer: R32_SFLOAT texels
+  int_texels,       // uniform isamplerBuffer: R32_SINT
+  uint_texels,      // uniform usamplerBuffer: R32_UINT
+};
+
+// Binding number -> kind, for the variables of descriptor set 0 that carry a Binding
+// decoration. Throws std::invalid_argument when the words are not a well-formed SPIR-V
+// module (no magic number, an instruction that runs past the end, a zero word count).
+std::map<std::uint32_t, SpirvBinding> spirv_bindings(const std::uint32_t* words, std::size_t count);
+
+}  // namespace sigmafem

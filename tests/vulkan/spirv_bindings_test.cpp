@@ -1,0 +1,75 @@
+// The bindings a shader declares, read from its SPIR-V (host/vulkan/spirv_bindings.h): the
+// embedded element_product in its two float32 variants, and modules that are not SPIR-V.
+#include "host/vulkan/spirv_bindings.h"
+
+#include <gtest/gtest.h>
+
+#include <cstring>
+#include <stdexcept>
+#include <vector>
+
+#include "device_layout.h"
+#include "host/vulkan/vulkan_shaders.h"
+
+namespace sigmafem {
+namespace {
+
+const EmbeddedShader& embedded(const char* name, bool double_precision, bool texel_reads) {
+  for (std::size_t i = 0; i < kVulkanShaderCount; ++i) {
+    const EmbeddedShader& shader = kVulkanShaders[i];
+    if (std::strcmp(shader.name, name) == 0 && shader.double_precision == double_precision &&
+        shader.texel_reads == texel_reads)
+      return shader;
+  }
+  throw std::logic_error(std::string("no embedded shader ") + name);
+}
+
+TEST(SpirvBindings, TheTexelVariantReadsItsReadOnlyArraysAsTexelsOfTheirType) {
+  const EmbeddedShader& shader = embedded("element_product", false, true);
+  const auto bindings = spirv_bindings(shader.words, shader.word_count);
+  EXPECT_EQ(bindings.at(SF_ELEMENT_PRODUCT_ELEMENT_NODES), SpirvBinding::int_texels);
+  EXPECT_EQ(bindings.at(SF_ELEMENT_PRODUCT_ELEMENT_REST), SpirvBinding::float_texels);
+  EXPECT_EQ(bindings.at(SF_ELEMENT_PRODUCT_FRAMES), SpirvBinding::float_texels);
+  EXPECT_EQ(bindings.at(SF_ELEMENT_PRODUCT_D), SpirvBinding::float_texels);
+  EXPECT_EQ(bindings.at(SF_ELEMENT_PRODUCT_ACTIVE), SpirvBinding::uint_texels);
+  EXPECT_EQ(bindings.at(SF_ELEMENT_PRODUCT_CONSTANTS), SpirvBinding::float_texels);
+  // What the shader writes stays a storage buffer.
+  EXPECT_EQ(bindings.at(SF_ELEMENT_PRODUCT_ELEMENT_OUT), SpirvBinding::storage_buffer);
+}
+
+TEST(SpirvBindings, TheStorageVariantsReadStorageBuffersOnly) {
+  for (const bool double_precision : {false, true}) {
+    const EmbeddedShader& shader = embedded("element_product", double_precision, false);
+    const auto bindings = spirv_bindings(shader.words, shader.word_count);
+    EXPECT_EQ(bindings.size(), 7u);
+    for (const auto& [binding, kind] : bindings)
+      EXPECT_EQ(kind, SpirvBinding::storage_buffer) << "binding " << binding;
+  }
+}
+
+TEST(SpirvBindings, EveryShaderHasATexelVariantWithTheSameBindings) {
+  for (std::size_t i = 0; i < kVulkanShaderCount; ++i) {
+    const EmbeddedShader& shader = kVulkanShaders[i];
+    if (shader.double_precision || shader.texel_reads) continue;
+    const EmbeddedShader& texel = embedded(shader.name, false, true);
+    const auto storage = spirv_bindings(shader.words, shader.word_count);
+    const auto texels = spirv_bindings(texel.words, texel.word_count);
+    ASSERT_EQ(storage.size(), texels.size()) << shader.name;
+    for (const auto& [binding, kind] : storage) EXPECT_EQ(texels.count(binding), 1u) << shader.name;
+  }
+}
+
+TEST(SpirvBindings, WordsThatAreNotSpirvAreRefused) {
+  const std::vector<std::uint32_t> garbage = {0xdeadbeef, 1, 2, 3, 4, 5};
+  EXPECT_THROW(spirv_bindings(garbage.data(), garbage.size()), std::invalid_argument);
+  EXPECT_THROW(spirv_bindings(nullptr, 0), std::invalid_argument);
+  // A header, then an instruction of 9 words with 2 left.
+  const std::vector<std::uint32_t> truncated = {0x07230203, 0x00010000, 0, 10, 0, (9u << 16) | 71u, 1};
+  EXPECT_THROW(spirv_bindings(truncated.data(), truncated.size()), std::invalid_argument);
+  // An instruction of length 0 would never end.
+  const std::vector<std::uint32_t> endless = {0x07230203, 0x00010000, 0, 10, 0, 71u};
+  EXPECT_THROW(spirv_bindings(endless.data(), endless.size()), std::invalid_argument);
+}
+
+}  // namespace
+}  // namespace sigmafem
