@@ -1,7 +1,7 @@
 # The Vulkan shaders: every entry shader of kernels/vulkan/ compiled by glslang to SPIR-V at
-# build time in three variants (single and double precision, and single with texel reads,
-# -DSF_TEXEL_READS: kernels/vulkan/ensemble_layout.h), and embedded in the program as uint32
-# words (cmake/embed_spirv.cmake), so that the program needs no shader files at run time.
+# build time in four variants (single and double precision, each with storage reads or with
+# texel reads, -DSF_TEXEL_READS: kernels/vulkan/ensemble_layout.h), and embedded as uint32
+# words in the program (cmake/embed_spirv.cmake), so that it needs no shader files at run time.
 # An entry is NAME:SOURCE[:DEFINE]: kernels/vulkan/SOURCE.comp compiled with -DDEFINE (one
 # file may hold several entry shaders, chosen with -D switches). glslang defines VULKAN
 # itself (kernels/shared/dialect.h's Vulkan branch). Rebuilt when a source or any header of
@@ -30,13 +30,14 @@ function(sigmafem_compile_glsl output)
       list(GET _parts 2 _define)
       set(_defines "-D${_define}")
     endif()
-    foreach(_precision single double single_texel)
+    foreach(_precision single double single_texel double_texel)
       set(_spv ${PROJECT_BINARY_DIR}/generated/spirv/${_name}_${_precision}.spv)
       set(_precision_define "")
-      if(_precision STREQUAL "double")
-        set(_precision_define "-DSF_USE_DOUBLE")
-      elseif(_precision STREQUAL "single_texel")
-        set(_precision_define "-DSF_TEXEL_READS")
+      if(_precision MATCHES "^double")
+        list(APPEND _precision_define "-DSF_USE_DOUBLE")
+      endif()
+      if(_precision MATCHES "_texel$")
+        list(APPEND _precision_define "-DSF_TEXEL_READS")
       endif()
       add_custom_command(
         OUTPUT ${_spv}

@@ -1,6 +1,6 @@
 # Writes a C++ source with SPIR-V modules as uint32 arrays and the table kVulkanShaders
 # (host/vulkan/vulkan_shaders.h). Run as:
-#   cmake -DOUTPUT=out.cpp -DSHADERS="name:single:a.spv;name:double:b.spv;name:single_texel:c.spv" -P this
+#   cmake -DOUTPUT=out.cpp -DSHADERS="name:single:a.spv;name:double:b.spv;name:single_texel:c.spv;name:double_texel:d.spv" -P this
 cmake_minimum_required(VERSION 3.18)
 
 set(_arrays "")
@@ -23,9 +23,10 @@ foreach(_shader IN LISTS SHADERS)
   string(APPEND _arrays "const std::uint32_t k_${_name}_${_precision}[] = {${_values}};\n")
   set(_double "false")
   set(_texel "false")
-  if(_precision STREQUAL "double")
+  if(_precision MATCHES "^double")
     set(_double "true")
-  elseif(_precision STREQUAL "single_texel")
+  endif()
+  if(_precision MATCHES "_texel$")
     set(_texel "true")
   endif()
   string(APPEND _table "    {\"${_name}\", ${_double}, ${_texel}, k_${_name}_${_precision}, ${_words}},\n")

@@ -14,7 +14,8 @@ enum class SpirvBinding {
   storage_buffer,   // a std430 buffer block (or anything that is not a texel buffer)
   float_texels,     // uniform samplerBuffer: R32_SFLOAT texels
   int_texels,       // uniform isamplerBuffer: R32_SINT
-  uint_texels,      // uniform usamplerBuffer: R32_UINT
+  uint_texels,      // uniform usamplerBuffer: R32_UINT (in a float64 shader, R32G32_UINT:
+                    // a double's two halves; kernels/vulkan/ensemble_layout.h)
 };
 
 // Binding number -> kind, for the variables of descriptor set 0 that carry a Binding

@@ -392,15 +392,18 @@ VkDescriptorSet VulkanDevice::bind(const VulkanKernel& kernel, const std::vector
 
 VkBufferView VulkanDevice::texel_view(const VulkanBuffer& buffer, SpirvBinding kind,
                                       const std::string& kernel) {
+  // A float64 shader's unsigned texels are its doubles (kernels/vulkan/ensemble_layout.h).
+  const bool doubles = kind == SpirvBinding::uint_texels && precision_ == Precision::double_precision;
   const VkFormat format = kind == SpirvBinding::float_texels ? VK_FORMAT_R32_SFLOAT
                           : kind == SpirvBinding::int_texels ? VK_FORMAT_R32_SINT
+                          : doubles                          ? VK_FORMAT_R32G32_UINT
                                                              : VK_FORMAT_R32_UINT;
   for (const TexelView& v : views_)
     if (v.buffer == buffer.buffer && v.format == format) return v.view;
-  // Every texel of these formats is 4 bytes.
-  if (buffer.bytes / 4 > info_.max_texel_elements)
+  const std::size_t texels = buffer.bytes / (doubles ? 8 : 4);
+  if (texels > info_.max_texel_elements)
     throw DeviceError("the Vulkan shader " + kernel + " reads a buffer of " +
-                      std::to_string(buffer.bytes / 4) + " texels; " + info_.name +
+                      std::to_string(texels) + " texels; " + info_.name +
                       " allows " + std::to_string(info_.max_texel_elements) +
                       " (maxTexelBufferElements); use fewer sigma points");
   VkBufferViewCreateInfo create{};

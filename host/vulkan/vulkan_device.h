@@ -89,9 +89,9 @@ class VulkanDevice {
   void upload(const VulkanBuffer& buffer, const void* data, std::size_t bytes);
   void download(const VulkanBuffer& buffer, void* data, std::size_t bytes);
 
-  // Whether kernel() takes the shaders compiled with texel reads (float32 only; the kernels
-  // made before the call keep their variant). Off by default.
-  void set_texel_reads(bool on) { texel_reads_ = on && precision_ == Precision::single; }
+  // Whether kernel() takes the shaders compiled with texel reads (the kernels made before the
+  // call keep their variant). Off by default.
+  void set_texel_reads(bool on) { texel_reads_ = on; }
   bool texel_reads() const { return texel_reads_; }
 
   // The pipeline of embedded shader `name` in this device's precision (and with texel reads

@@ -17,10 +17,10 @@ std::uint32_t groups_for(std::size_t items) {
 
 }  // namespace
 
-bool vulkan_texel_reads(KernelForm form, const std::string& device_type, Precision precision,
+bool vulkan_texel_reads(KernelForm form, const std::string& device_type,
                         std::size_t largest_bytes, unsigned long long max_texel_elements) {
   const bool cpu_form = form == KernelForm::cpu || (form == KernelForm::automatic && device_type == "cpu");
-  return cpu_form && precision == Precision::single && largest_bytes / 4 <= max_texel_elements;
+  return cpu_form && largest_bytes / 4 <= max_texel_elements;
 }
 
 VulkanEnsemble::VulkanEnsemble(const Model& model, EstimatedParameters estimated,
@@ -60,8 +60,8 @@ VulkanEnsemble::VulkanEnsemble(const Model& model, EstimatedParameters estimated
   device_.reserve_read_back(3 * 4 * static_cast<std::size_t>(S_) +
                             (2 + observation_rows) * S_ * device_.real_size());
 
-  device_.set_texel_reads(vulkan_texel_reads(options.kernel_form, info.type, options.precision,
-                                             largest, info.max_texel_elements));
+  device_.set_texel_reads(vulkan_texel_reads(options.kernel_form, info.type, largest,
+                                             info.max_texel_elements));
 
   using B = DeviceBuffer;
   auto kernel = [&](const char* name, DeviceKernel k) {

@@ -31,9 +31,9 @@ namespace sigmafem {
 // The form of the Vulkan shaders: the CPU form reads the arrays a shader only reads through
 // uniform texel buffers (lavapipe gathers them 3-5x faster than storage-buffer loads:
 // kernels/vulkan/ensemble_layout.h), the GPU form through storage buffers. Automatic is the
-// CPU form on a CPU device. Texel reads need float32 and every buffer within the device's
-// texel limit (largest_bytes / 4 <= max_texel_elements); without them, the GPU form.
-bool vulkan_texel_reads(KernelForm form, const std::string& device_type, Precision precision,
+// CPU form on a CPU device. Texel reads need every buffer within the device's texel limit
+// (largest_bytes / 4 <= max_texel_elements); without that, the GPU form.
+bool vulkan_texel_reads(KernelForm form, const std::string& device_type,
                         std::size_t largest_bytes, unsigned long long max_texel_elements);
 
 class VulkanEnsemble : public DeviceEnsemble {

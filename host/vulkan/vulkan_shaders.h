@@ -10,8 +10,8 @@ namespace sigmafem {
 struct EmbeddedShader {
   const char* name;              // the entry shader: "element_product", "cg_start", ...
   bool double_precision;         // compiled with -DSF_USE_DOUBLE
-  bool texel_reads;              // compiled with -DSF_TEXEL_READS (float32): read-only arrays
-                                 // are uniform texel buffers (kernels/vulkan/ensemble_layout.h)
+  bool texel_reads;              // compiled with -DSF_TEXEL_READS: read-only arrays are
+                                 // uniform texel buffers (kernels/vulkan/ensemble_layout.h)
   const std::uint32_t* words;    // the SPIR-V module
   std::size_t word_count;
 };

@@ -18,16 +18,22 @@
 #define real SF_REAL
 
 /* The arrays a shader only reads, declared with SF_READ_REALS/INTS/UINTS(binding, name) and
- * read with SF_LOAD(name, index) (dialect.h): storage buffers, or, in the float32 shaders
- * compiled with SF_TEXEL_READS (the CPU form, for lavapipe), uniform texel buffers. llvmpipe
- * turns every storage-buffer load at an address that differs between its 8 lanes into a
- * loop over the lanes with a branch and a bounds check each; a texel fetch is one gather
- * with a bounds mask: 3-5x faster loads there (bench/RESULTS.md, stop 50). The host binds
- * each binding by what the SPIR-V declares (host/vulkan/spirv_bindings.h). */
-#if defined(SF_TEXEL_READS)
-#  if defined(SF_USE_DOUBLE)
-#    error "SF_TEXEL_READS: float32 shaders only (texel formats have no 64-bit float)"
-#  endif
+ * read with SF_LOAD(name, index) (dialect.h): storage buffers, or, in the shaders compiled
+ * with SF_TEXEL_READS (the CPU form, for lavapipe), uniform texel buffers. llvmpipe turns
+ * every storage-buffer load at an address that differs between its 8 lanes into a loop over
+ * the lanes with a branch and a bounds check each; a texel fetch is one gather with a bounds
+ * mask: 3-5x faster loads there (bench/RESULTS.md, stop 50). The host binds each binding by
+ * what the SPIR-V declares (host/vulkan/spirv_bindings.h): a samplerBuffer is R32_SFLOAT
+ * texels, an isamplerBuffer R32_SINT, a usamplerBuffer R32_UINT, or in a float64 shader
+ * R32G32_UINT, a double's two halves (no texel format holds a 64-bit float), so float64
+ * shaders read their unsigned arrays as int. */
+#if defined(SF_TEXEL_READS) && defined(SF_USE_DOUBLE)
+#  define SF_READ_REALS(slot, name) layout(binding = slot) uniform usamplerBuffer name;
+#  define SF_READ_INTS(slot, name) layout(binding = slot) uniform isamplerBuffer name;
+#  define SF_READ_UINTS(slot, name) layout(binding = slot) uniform isamplerBuffer name;
+double sf_texel(usamplerBuffer b, uint i) { return packDouble2x32(texelFetch(b, int(i)).xy); }
+int sf_texel(isamplerBuffer b, uint i) { return texelFetch(b, int(i)).x; }
+#elif defined(SF_TEXEL_READS)
 #  define SF_READ_REALS(slot, name) layout(binding = slot) uniform samplerBuffer name;
 #  define SF_READ_INTS(slot, name) layout(binding = slot) uniform isamplerBuffer name;
 #  define SF_READ_UINTS(slot, name) layout(binding = slot) uniform usamplerBuffer name;

@@ -1,5 +1,5 @@
 // The bindings a shader declares, read from its SPIR-V (host/vulkan/spirv_bindings.h): the
-// embedded element_product in its two float32 variants, and modules that are not SPIR-V.
+// embedded element_product in its variants, and modules that are not SPIR-V.
 #include "host/vulkan/spirv_bindings.h"
 
 #include <gtest/gtest.h>
@@ -35,6 +35,12 @@ TEST(SpirvBindings, TheTexelVariantReadsItsReadOnlyArraysAsTexelsOfTheirType) {
   EXPECT_EQ(bindings.at(SF_ELEMENT_PRODUCT_CONSTANTS), SpirvBinding::float_texels);
   // What the shader writes stays a storage buffer.
   EXPECT_EQ(bindings.at(SF_ELEMENT_PRODUCT_ELEMENT_OUT), SpirvBinding::storage_buffer);
+  // In float64 the reals are unsigned pairs (R32G32_UINT) and the unsigned flags ints.
+  const EmbeddedShader& doubles = embedded("element_product", true, true);
+  const auto double_bindings = spirv_bindings(doubles.words, doubles.word_count);
+  EXPECT_EQ(double_bindings.at(SF_ELEMENT_PRODUCT_ELEMENT_REST), SpirvBinding::uint_texels);
+  EXPECT_EQ(double_bindings.at(SF_ELEMENT_PRODUCT_ACTIVE), SpirvBinding::int_texels);
+  EXPECT_EQ(double_bindings.at(SF_ELEMENT_PRODUCT_ELEMENT_OUT), SpirvBinding::storage_buffer);
 }
 
 TEST(SpirvBindings, TheStorageVariantsReadStorageBuffersOnly) {
@@ -50,8 +56,8 @@ TEST(SpirvBindings, TheStorageVariantsReadStorageBuffersOnly) {
 TEST(SpirvBindings, EveryShaderHasATexelVariantWithTheSameBindings) {
   for (std::size_t i = 0; i < kVulkanShaderCount; ++i) {
     const EmbeddedShader& shader = kVulkanShaders[i];
-    if (shader.double_precision || shader.texel_reads) continue;
-    const EmbeddedShader& texel = embedded(shader.name, false, true);
+    if (shader.texel_reads) continue;
+    const EmbeddedShader& texel = embedded(shader.name, shader.double_precision, true);
     const auto storage = spirv_bindings(shader.words, shader.word_count);
     const auto texels = spirv_bindings(texel.words, texel.word_count);
     ASSERT_EQ(storage.size(), texels.size()) << shader.name;
