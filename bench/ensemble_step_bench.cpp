@@ -36,6 +36,7 @@ struct Backend {
   Preconditioner preconditioner = Preconditioner::jacobi;
   bool shared_factor = false;   // one factor for all sigma points, whatever its size (CPU, OpenCL)
   int cg_partitions = 0;        // OpenCL's GPU form: CG work-groups per sigma point (0: by mesh)
+  KernelForm kernel_form = KernelForm::automatic;
 };
 
 // The CPU back end with its default preconditioner (factors: one per sigma point within
@@ -75,6 +76,13 @@ const Backend kOpenClOneGroup{"opencl", Precision::single,
 const Backend kVulkanOneGroup{"vulkan", Precision::single,
                               "vulkan single, device 0, CG a work-group per sigma point",
                               SolveLaunch::automatic, Preconditioner::jacobi, false, 1};
+// The Vulkan shaders' two forms forced (kVulkan takes the device's): the CPU form's texel
+// reads and the GPU form's storage-buffer reads (kernels/vulkan/ensemble_layout.h).
+const Backend kVulkanTexelReads{"vulkan", Precision::single, "vulkan single, device 0, texel reads (CPU form)",
+                                SolveLaunch::automatic, Preconditioner::jacobi, false, 0, KernelForm::cpu};
+const Backend kVulkanStorageReads{"vulkan", Precision::single,
+                                  "vulkan single, device 0, storage reads (GPU form)", SolveLaunch::automatic,
+                                  Preconditioner::jacobi, false, 0, KernelForm::gpu};
 
 DeviceOptions device_options(const Backend& backend) {
   DeviceOptions options;
@@ -82,6 +90,7 @@ DeviceOptions device_options(const Backend& backend) {
   options.solve_launch = backend.solve_launch;
   options.preconditioner = backend.preconditioner;
   options.cg_partitions = backend.cg_partitions;
+  options.kernel_form = backend.kernel_form;
   if (backend.shared_factor) options.own_factors_bytes = 0;
   return options;
 }
@@ -302,6 +311,10 @@ BENCHMARK_CAPTURE(BM_ensemble_step, vulkan_one_group_liver_4768, kVulkanOneGroup
     ->Arg(16)->Arg(64)->Unit(benchmark::kMillisecond)->UseRealTime();
 BENCHMARK_CAPTURE(BM_ensemble_step, vulkan_liver_4768, kVulkan, std::string("liver"), 1)
     ->RangeMultiplier(2)->Range(1, 256)->Unit(benchmark::kMillisecond)->UseRealTime();
+BENCHMARK_CAPTURE(BM_ensemble_step, vulkan_texel_reads_liver_4768, kVulkanTexelReads, std::string("liver"), 1)
+    ->Arg(16)->Arg(64)->Unit(benchmark::kMillisecond)->UseRealTime();
+BENCHMARK_CAPTURE(BM_ensemble_step, vulkan_storage_reads_liver_4768, kVulkanStorageReads, std::string("liver"), 1)
+    ->Arg(16)->Arg(64)->Unit(benchmark::kMillisecond)->UseRealTime();
 BENCHMARK_CAPTURE(BM_ensemble_step, cpu_liver_4768, kCpu, std::string("liver"), 1)
     ->Arg(1)->Arg(4)->Arg(16)->Unit(benchmark::kMillisecond)->UseRealTime();
 BENCHMARK_CAPTURE(BM_ensemble_step, cpu_shared_liver_4768, kCpuShared, std::string("liver"), 1)
@@ -374,6 +387,10 @@ BENCHMARK_CAPTURE(BM_filter_step, opencl_per_iteration, kOpenClPerIteration, std
 BENCHMARK_CAPTURE(BM_filter_step, opencl_whole_solve, kOpenClWholeSolve, std::string("liver"))
     ->Unit(benchmark::kMillisecond)->UseRealTime();
 BENCHMARK_CAPTURE(BM_filter_step, vulkan, kVulkan, std::string("liver"))
+    ->Unit(benchmark::kMillisecond)->UseRealTime();
+BENCHMARK_CAPTURE(BM_filter_step, vulkan_texel_reads, kVulkanTexelReads, std::string("liver"))
+    ->Unit(benchmark::kMillisecond)->UseRealTime();
+BENCHMARK_CAPTURE(BM_filter_step, vulkan_storage_reads, kVulkanStorageReads, std::string("liver"))
     ->Unit(benchmark::kMillisecond)->UseRealTime();
 BENCHMARK_CAPTURE(BM_filter_step, cpu, kCpu, std::string("liver"))
     ->Unit(benchmark::kMillisecond)->UseRealTime();

@@ -39,6 +39,7 @@
 #include "host/reference/reference_simulation.h"
 #include "host/scenario/scenario.h"
 #include "host/vulkan/vulkan_device.h"
+#include "bench/bench_scenarios.h"
 #include "cpu_vulkan_skips.h"
 #include "requirement.h"
 #include "step_constants.h"
@@ -844,13 +845,7 @@ TEST_P(SixtyFourParameters, TheLargestEnsembleFollowsTheReference) {
   if (!why.empty()) SIGMAFEM_MISSING(why);
   Scenario scenario = conformance_scenario("liver");
   constexpr int kRegions = 61;
-  for (int r = 0; r < kRegions; ++r) {
-    Region region;
-    region.name = "r" + std::to_string(r);
-    for (int e = r; e < scenario.mesh.tetrahedron_count(); e += kRegions) region.elements.push_back(e);
-    region.young_modulus = scenario.material.young_modulus;
-    scenario.regions.push_back(region);
-  }
+  bench::add_interleaved_regions(scenario, kRegions);
   const Model model = make_model(scenario);
   std::vector<int> regions(kRegions);
   for (int r = 0; r < kRegions; ++r) regions[static_cast<std::size_t>(r)] = r;
