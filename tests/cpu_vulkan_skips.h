@@ -1,6 +1,7 @@
-// Vulkan on the CPU (Mesa's lavapipe, where CI runs the shaders) is 30-40x slower than PoCL
+// Vulkan on the CPU (Mesa's lavapipe, where CI runs the shaders) was 30-40x slower than PoCL
 // running the same kernels (bench/RESULTS.md: a liver filter step 134-215 ms against 4.9 ms
-// on the 2-core machine at stop 49), and its cases were 46% of the test command's test time.
+// on the 2-core machine at stop 49), and its cases were 46% of the test command's test time;
+// 17-21x with the texel reads of stop 50.
 // A Vulkan case that only repeats, on the same shaders, what another case checks there is
 // skipped on such a device, saying which case covers it; it runs where Vulkan is a GPU
 // (bench/gpu_checks.sh runs every device test there), or anywhere with
