@@ -70,9 +70,10 @@ OpenClEnsemble::OpenClEnsemble(const Model& model, EstimatedParameters estimated
   while (S_ % per_unit != 0) --per_unit;
   // The CG kernels' blocks work on the ensemble's rows, [row S + s]: blocks that share a
   // row's cache line write into each other's lines at every row, and two work-items doing so
-  // were slower than one doing both (bench/RESULTS.md, stop 46: the 38k liver's cg_iteration
-  // at S = 4 30 -> 18 ms, the 4768 liver's at S = 16 3.4 -> 2.1 ms). So a block per compute
-  // unit only where each fills whole cache lines (S = 32 and up in float), else one.
+  // were slower than one doing both (bench/RESULTS.md, stop 46, when the factor's work vector
+  // was shared too: the 38k liver's cg_iteration at S = 4 30 -> 18 ms, the 4768 liver's at
+  // S = 16 3.4 -> 2.1 ms). So a block per compute unit only where each fills whole cache lines
+  // (S = 32 and up in float), else one; with a factor, below.
   const unsigned line = info.cache_line > 0 ? info.cache_line : 64;
   cg_block_ = (per_unit * device_.real_size()) % line == 0 ? per_unit : S_;
   // cg_solve's blocks work on vectors of their own: a block per compute unit where each has
@@ -108,6 +109,11 @@ OpenClEnsemble::OpenClEnsemble(const Model& model, EstimatedParameters estimated
     // blocks of their own vectors one after the other, else all S interleaved.
     factor_block_ = whole_solve_ && solve_block_ < S_ ? solve_block_ : S_;
   }
+  // With a factor the solve is most of an iteration, and each block solves with a work vector
+  // of its own (conjugate_gradient.cl): a block per compute unit then pays at any S
+  // (bench/RESULTS.md, stop 50: the 117k box at S = 16 1155-1222 -> 648-826 ms a step, the 38k
+  // liver's filter step 199-210 -> 183-189 ms).
+  if (factor_) cg_block_ = per_unit;
   device_.build_program("-DSF_SIGMA_BLOCK=" + std::to_string(sigma_block_) +
                         " -DSF_ELEMENT_CHUNKS=" + std::to_string(element_chunks_) +
                         " -DSF_CG_PER_GROUP=" + std::to_string(cg_per_group_ ? 1 : 0) +

@@ -360,18 +360,24 @@ typedef real sf_entry;
         __global const real *restrict factor_values,                                        \
         __global const int *restrict factor_order, __global real *restrict factor_work
 #  define SF_FACTOR_PASS , factor_columns, factor_rows, factor_values, factor_order, factor_work
+/* The same for block `first` of the ensemble's blocks: its own rows x count of factor_work. */
+#  define SF_BLOCK_FACTOR_PASS(first, rows) \
+    , factor_columns, factor_rows, factor_values, factor_order, factor_work + (size_t)(first) * (rows)
 
+/* The work vector y is the block's own, [row * count + b] (factor_work, offset by the caller):
+ * blocks that wrote into each other's cache lines at every entry of L would be slower than one
+ * block doing all (bench/RESULTS.md, stop 46). */
 static inline __attribute__((always_inline)) void sf_block_factor_solve(
     uint first, uint count, uint S, uint rows, __global const real* restrict r,
     __global real* restrict z, real* restrict sum_rz SF_FACTOR_ARGUMENTS) {
   __global real* restrict y = factor_work;
   for (uint i = 0; i < rows; ++i) {
     size_t from = (size_t)i * S + first;
-    size_t to = (size_t)factor_order[i] * S + first;
+    size_t to = (size_t)factor_order[i] * count;
     for (uint b = 0; b < count; ++b) y[to + b] = r[from + b];
   }
   for (uint j = 0; j < rows; ++j) { /* L y' = y: each solved entry out of the rows below */
-    size_t at = (size_t)j * S + first;
+    size_t at = (size_t)j * count;
     const sf_entry diagonal = SF_L_AT(factor_columns[j]);
     real solved[SF_BLOCK_MAX];
     for (uint b = 0; b < count; ++b) {
@@ -380,12 +386,12 @@ static inline __attribute__((always_inline)) void sf_block_factor_solve(
     }
     for (int k = factor_columns[j] + 1; k < factor_columns[j + 1]; ++k) {
       const sf_entry value = SF_L_AT(k);
-      __global real* restrict below = y + (size_t)factor_rows[k] * S + first;
+      __global real* restrict below = y + (size_t)factor_rows[k] * count;
       for (uint b = 0; b < count; ++b) below[b] -= SF_L_OF(value, b) * solved[b];
     }
   }
   for (uint j = rows; j-- > 0;) { /* L^T x = y', from the last row up */
-    size_t at = (size_t)j * S + first;
+    size_t at = (size_t)j * count;
     /* Two partial sums, the entries taken in pairs: one sum's chain of dependent additions
      * was this loop's time on a small factor (the liver's, in cache). */
     real sum[SF_BLOCK_MAX];
@@ -396,8 +402,8 @@ static inline __attribute__((always_inline)) void sf_block_factor_solve(
     for (; k + 1 < end; k += 2) {
       const sf_entry value = SF_L_AT(k);
       const sf_entry other_value = SF_L_AT(k + 1);
-      __global const real* restrict below = y + (size_t)factor_rows[k] * S + first;
-      __global const real* restrict other_below = y + (size_t)factor_rows[k + 1] * S + first;
+      __global const real* restrict below = y + (size_t)factor_rows[k] * count;
+      __global const real* restrict other_below = y + (size_t)factor_rows[k + 1] * count;
       for (uint b = 0; b < count; ++b) {
         sum[b] += SF_L_OF(value, b) * below[b];
         other_sum[b] += SF_L_OF(other_value, b) * other_below[b];
@@ -405,7 +411,7 @@ static inline __attribute__((always_inline)) void sf_block_factor_solve(
     }
     if (k < end) {
       const sf_entry value = SF_L_AT(k);
-      __global const real* restrict below = y + (size_t)factor_rows[k] * S + first;
+      __global const real* restrict below = y + (size_t)factor_rows[k] * count;
       for (uint b = 0; b < count; ++b) sum[b] += SF_L_OF(value, b) * below[b];
     }
     const sf_entry diagonal = SF_L_AT(factor_columns[j]);
@@ -413,7 +419,7 @@ static inline __attribute__((always_inline)) void sf_block_factor_solve(
   }
   for (uint i = 0; i < rows; ++i) { /* z, un-permuted, and r.z in row order */
     size_t to = (size_t)i * S + first;
-    size_t from = (size_t)factor_order[i] * S + first;
+    size_t from = (size_t)factor_order[i] * count;
     for (uint b = 0; b < count; ++b) {
       real zi = y[from + b];
       z[to + b] = zi;
@@ -424,6 +430,7 @@ static inline __attribute__((always_inline)) void sf_block_factor_solve(
 #else
 #  define SF_FACTOR_ARGUMENTS
 #  define SF_FACTOR_PASS
+#  define SF_BLOCK_FACTOR_PASS(first, rows)
 #endif
 
 /* The warm start of the block first .. first + count - 1, given q = A x: r = b - q,
@@ -610,7 +617,8 @@ __kernel void cg_start(uint S, uint node_count, __global const real* restrict c,
    * vectorises the rows' loops over the block (stop 46: cg_solve 670-720 -> 600 us a launch
    * on the liver filter step). */
   sf_block_cg_start(first, SF_CG_BLOCK, SF_SIGMA_BLOCK, 3 * node_count, c, q, b, inverse_diagonal,
-                    r, z, d, bb, rr, rz, active, converged, iterations SF_FACTOR_PASS);
+                    r, z, d, bb, rr, rz, active, converged, iterations
+                    SF_BLOCK_FACTOR_PASS(first, 3 * node_count));
 }
 
 /* One iteration after element_product: q = A d (sf_block_node_product), then the update. */
@@ -639,7 +647,7 @@ __kernel void cg_iteration(uint S, uint node_count, int max_iterations,
                         mass, d, element_out, q);
   sf_block_cg_iteration(first, SF_CG_BLOCK, SF_SIGMA_BLOCK, 3 * node_count, max_iterations, c,
                         inverse_diagonal, x, r, z, d, q, bb, rr, rz, active, converged, iterations
-                        SF_FACTOR_PASS);
+                        SF_BLOCK_FACTOR_PASS(first, 3 * node_count));
 }
 
 /* cg_solve's work for one block (the sigma points first .. first + count - 1): the vectors

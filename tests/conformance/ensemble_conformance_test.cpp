@@ -89,6 +89,10 @@ std::vector<BackendCase> backend_cases() {
                    KernelForm::automatic, 0, Preconditioner::automatic, 0, 4});
   cases.push_back({"opencl", Precision::single, "OpenClSingleOwnFactorsWholeSolve", SolveLaunch::whole_solve,
                    KernelForm::automatic, 0, Preconditioner::automatic, DeviceOptions{}.own_factors_bytes, 16});
+  // And launched per iteration, in a block per compute unit, each solving with its own work
+  // vector (stop 50).
+  cases.push_back({"opencl", Precision::single, "OpenClSingleOwnFactors", SolveLaunch::per_iteration,
+                   KernelForm::automatic, 0, Preconditioner::automatic, DeviceOptions{}.own_factors_bytes, 16});
   // The GPU form of the OpenCL kernels (a work-item per element and sigma point, a work-group
   // per sigma point in CG), forced on whatever device is there: on PoCL it would otherwise
   // never run in the tests.
