@@ -447,7 +447,7 @@ void VulkanDevice::dispatch(VkCommandBuffer cmd, const VulkanKernel& kernel, VkD
   api_->vkCmdDispatch(cmd, x, y, 1);
   if (timed) {
     api_->vkCmdWriteTimestamp(cmd, VK_PIPELINE_STAGE_BOTTOM_OF_PIPE_BIT, profile_queries_, query + 1);
-    profiled_.push_back(&kernel.name);
+    profiled_.push_back(kernel.name);
   }
 }
 
@@ -517,12 +517,15 @@ void VulkanDevice::collect_profile() {
                                     sizeof(std::uint64_t),
                                     VK_QUERY_RESULT_64_BIT | VK_QUERY_RESULT_WAIT_BIT),
         "reading the profile's timestamps");
+  // A GPU may take a start timestamp before the last dispatch's end: such spans count as 0.
+  auto span = [&](std::uint64_t from, std::uint64_t to) {
+    return to > from ? timestamp_seconds_ * static_cast<double>(to - from) : 0.0;
+  };
   for (std::size_t i = 0; i < profiled_.size(); ++i) {
-    KernelTime& time = profile_[*profiled_[i]];
-    time.seconds += timestamp_seconds_ * static_cast<double>(ticks[2 * i + 1] - ticks[2 * i]);
+    KernelTime& time = profile_[profiled_[i]];
+    time.seconds += span(ticks[2 * i], ticks[2 * i + 1]);
     ++time.dispatches;
-    if (i > 0)
-      profile_between_ += timestamp_seconds_ * static_cast<double>(ticks[2 * i] - ticks[2 * i - 1]);
+    if (i > 0) profile_between_ += span(ticks[2 * i - 1], ticks[2 * i]);
   }
   profiled_.clear();
 }

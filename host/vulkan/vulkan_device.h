@@ -185,7 +185,7 @@ class VulkanDevice {
   static constexpr std::uint32_t kProfiledDispatches = 4096;
   VkQueryPool profile_queries_ = VK_NULL_HANDLE;
   double timestamp_seconds_ = 0.0;                   // seconds per timestamp tick
-  std::vector<const std::string*> profiled_;         // the kernels of this command buffer's dispatches
+  std::vector<std::string> profiled_;                // the shaders of this command buffer's dispatches
   struct KernelTime {
     double seconds = 0.0;
     long long dispatches = 0;

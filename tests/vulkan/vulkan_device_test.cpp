@@ -153,6 +153,31 @@ TEST_F(VulkanDeviceTest, AFilterCycleRunsCleanly) {
   }
 }
 
+// SIGMAFEM_VULKAN_PROFILE: every shader's dispatches timed on the device and listed on stderr
+// when the device goes, with the time between them.
+TEST_F(VulkanDeviceTest, TheProfileListsEveryShadersDispatches) {
+  const Scenario scenario = load_scenario(std::string(SIGMAFEM_SOURCE_DIR) + "/scenarios/box.json");
+  const Model model = make_model(scenario);
+  const char* before = std::getenv("SIGMAFEM_VULKAN_PROFILE");
+  const std::string saved = before ? before : "";
+  setenv("SIGMAFEM_VULKAN_PROFILE", "1", 1);
+  testing::internal::CaptureStderr();
+  {
+    VulkanEnsemble ensemble(model, scenario.filter->estimate, scenario.observations.nodes, 2, DeviceOptions{});
+    const StepReport report = ensemble.advance(
+        scenario.control.trajectory.position(scenario.time.dt, scenario.control.start));
+    EXPECT_EQ(report.unconverged_count(), 0);
+  }
+  const std::string printed = testing::internal::GetCapturedStderr();
+  if (before) setenv("SIGMAFEM_VULKAN_PROFILE", saved.c_str(), 1); else unsetenv("SIGMAFEM_VULKAN_PROFILE");
+  EXPECT_NE(printed.find("Vulkan shader times on"), std::string::npos) << printed;
+  // (CG's shaders are named by how a device runs it: cg_start, or cg_start_partials on a GPU.)
+  for (const char* shader : {"  element_rhs", "  node_rhs", "  element_product", "  cg_start", "  state_update"})
+    EXPECT_NE(printed.find(shader), std::string::npos) << shader << "\n" << printed;
+  EXPECT_NE(printed.find("between dispatches"), std::string::npos) << printed;
+  EXPECT_EQ(printed.find("nan"), std::string::npos) << printed;
+}
+
 // The form of the shaders: the CPU form (texel reads) on a CPU device by default or when asked,
 // when every buffer fits a texel view; else the GPU form.
 TEST(VulkanTexelReads, TheCpuFormWithinTheDevicesTexelLimit) {
