@@ -1,8 +1,9 @@
 /* ensemble_layout.h: what every Vulkan shader includes: the layout, slots and push constants
  * every back end shares (kernels/shared/device_layout.h) in GLSL's terms, and the index
- * helpers over its buffers. Buffers are std430 storage buffers in descriptor set 0, bound at
- * device_layout.h's slots (the CG shaders' bindings are their own: conjugate_gradient.comp).
- * Indices are 32-bit: the host checks every buffer against maxStorageBufferRange. */
+ * helpers over its buffers. Buffers are bound in descriptor set 0 at device_layout.h's slots
+ * (the CG shaders' bindings are their own: conjugate_gradient.comp): std430 storage buffers,
+ * or texel buffers for what a shader only reads (below). Indices are 32-bit: the host checks
+ * every buffer against maxStorageBufferRange. */
 #ifndef SIGMAFEM_VULKAN_ENSEMBLE_LAYOUT_H
 #define SIGMAFEM_VULKAN_ENSEMBLE_LAYOUT_H
 
