@@ -180,7 +180,8 @@ VkDeviceMemory VulkanDevice::allocate(VkMemoryRequirements needs, VkMemoryProper
 }
 
 VulkanBuffer VulkanDevice::buffer(std::size_t bytes, const char* what) {
-  bytes = std::max<std::size_t>(4, (bytes + 3) / 4 * 4);
+  // Whole 8-byte texels, so that a float64 shader's texel view (R32G32_UINT) covers it all.
+  bytes = std::max<std::size_t>(8, (bytes + 7) / 8 * 8);
   if (bytes > info_.max_buffer)
     throw DeviceError(std::string("out of device memory: ") + what + " needs " +
                       std::to_string(bytes >> 20) + " MiB in one buffer; " + info_.name +

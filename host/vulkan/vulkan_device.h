@@ -83,8 +83,8 @@ class VulkanDevice {
   std::size_t real_size() const { return sigmafem::real_size(precision_); }
   std::uint32_t max_group_count() const { return max_group_count_; }
 
-  // A device-local storage buffer of `bytes` (at least 4). Throws DeviceError naming `what`
-  // when the device has too little memory.
+  // A device-local buffer of `bytes` (rounded up to whole 8 bytes, at least 8). Throws
+  // DeviceError naming `what` when the device has too little memory.
   VulkanBuffer buffer(std::size_t bytes, const char* what);
   void upload(const VulkanBuffer& buffer, const void* data, std::size_t bytes);
   void download(const VulkanBuffer& buffer, void* data, std::size_t bytes);
