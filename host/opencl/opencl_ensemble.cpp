@@ -73,9 +73,9 @@ OpenClEnsemble::OpenClEnsemble(const Model& model, EstimatedParameters estimated
   // were slower than one doing both (bench/RESULTS.md, stop 46, when the factor's work vector
   // was shared too: the 38k liver's cg_iteration at S = 4 30 -> 18 ms, the 4768 liver's at
   // S = 16 3.4 -> 2.1 ms). So a block per compute unit only where each fills whole cache lines
-  // (S = 32 and up in float), else one; with a factor, below.
+  // (S = 32 and up in float), else one; with a factor at any S (below, where it is decided).
   const unsigned line = info.cache_line > 0 ? info.cache_line : 64;
-  cg_block_ = (per_unit * device_.real_size()) % line == 0 ? per_unit : S_;
+  const bool whole_lines = (per_unit * device_.real_size()) % line == 0;
   // cg_solve's blocks work on vectors of their own: a block per compute unit where each has
   // at least 4 sigma points, else one. Measured on PoCL, 2 cores (stop 46): the liver at S = 16
   // in two blocks of 8, an ensemble step 2.4-2.7 -> 1.4-1.6 ms (factor); the liver filter
@@ -113,7 +113,7 @@ OpenClEnsemble::OpenClEnsemble(const Model& model, EstimatedParameters estimated
   // of its own (conjugate_gradient.cl): a block per compute unit then pays at any S
   // (bench/RESULTS.md, stop 50: the 117k box at S = 16 1155-1222 -> 648-826 ms a step, the 38k
   // liver's filter step 199-210 -> 183-189 ms).
-  if (factor_) cg_block_ = per_unit;
+  cg_block_ = whole_lines || factor_ ? per_unit : S_;
   device_.build_program("-DSF_SIGMA_BLOCK=" + std::to_string(sigma_block_) +
                         " -DSF_ELEMENT_CHUNKS=" + std::to_string(element_chunks_) +
                         " -DSF_CG_PER_GROUP=" + std::to_string(cg_per_group_ ? 1 : 0) +

@@ -284,7 +284,6 @@ VulkanKernel VulkanDevice::kernel_from_spirv(const std::string& name, const std:
                       ": not a SPIR-V module (bad header); rebuild sigmafem");
   VulkanKernel k;
   k.name = name;
-  k.bindings = bindings;
   // Each binding as the shader declares it; one the shader does not use stays a storage buffer.
   k.kinds.assign(static_cast<std::size_t>(bindings), SpirvBinding::storage_buffer);
   try {
@@ -356,9 +355,9 @@ VulkanKernel VulkanDevice::kernel_from_spirv(const std::string& name, const std:
 }
 
 VkDescriptorSet VulkanDevice::bind(const VulkanKernel& kernel, const std::vector<VulkanBuffer>& buffers) {
-  if (static_cast<int>(buffers.size()) != kernel.bindings)
+  if (buffers.size() != kernel.kinds.size())
     throw std::logic_error("VulkanDevice::bind: " + kernel.name + " takes " +
-                           std::to_string(kernel.bindings) + " buffers, given " +
+                           std::to_string(kernel.kinds.size()) + " buffers, given " +
                            std::to_string(buffers.size()));
   VkDescriptorSetAllocateInfo allocate{};
   allocate.sType = VK_STRUCTURE_TYPE_DESCRIPTOR_SET_ALLOCATE_INFO;

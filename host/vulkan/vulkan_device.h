@@ -65,8 +65,7 @@ struct VulkanKernel {
   VkPipeline pipeline = VK_NULL_HANDLE;
   VkPipelineLayout layout = VK_NULL_HANDLE;
   VkDescriptorSetLayout set_layout = VK_NULL_HANDLE;
-  int bindings = 0;
-  std::vector<SpirvBinding> kinds;   // by binding
+  std::vector<SpirvBinding> kinds;   // each binding's kind, bindings 0..n-1
 };
 
 // A device with its queue, ready to run the embedded shaders.

@@ -28,19 +28,19 @@
  * texels, an isamplerBuffer R32_SINT, a usamplerBuffer R32_UINT, or in a float64 shader
  * R32G32_UINT, a double's two halves (no texel format holds a 64-bit float), so float64
  * shaders read their unsigned arrays as int. */
-#if defined(SF_TEXEL_READS) && defined(SF_USE_DOUBLE)
-#  define SF_READ_REALS(slot, name) layout(binding = slot) uniform usamplerBuffer name;
+#if defined(SF_TEXEL_READS)
 #  define SF_READ_INTS(slot, name) layout(binding = slot) uniform isamplerBuffer name;
-#  define SF_READ_UINTS(slot, name) layout(binding = slot) uniform isamplerBuffer name;
+int sf_texel(isamplerBuffer b, uint i) { return texelFetch(b, int(i)).x; }
+#  if defined(SF_USE_DOUBLE)
+#    define SF_READ_REALS(slot, name) layout(binding = slot) uniform usamplerBuffer name;
+#    define SF_READ_UINTS(slot, name) layout(binding = slot) uniform isamplerBuffer name;
 double sf_texel(usamplerBuffer b, uint i) { return packDouble2x32(texelFetch(b, int(i)).xy); }
-int sf_texel(isamplerBuffer b, uint i) { return texelFetch(b, int(i)).x; }
-#elif defined(SF_TEXEL_READS)
-#  define SF_READ_REALS(slot, name) layout(binding = slot) uniform samplerBuffer name;
-#  define SF_READ_INTS(slot, name) layout(binding = slot) uniform isamplerBuffer name;
-#  define SF_READ_UINTS(slot, name) layout(binding = slot) uniform usamplerBuffer name;
+#  else
+#    define SF_READ_REALS(slot, name) layout(binding = slot) uniform samplerBuffer name;
+#    define SF_READ_UINTS(slot, name) layout(binding = slot) uniform usamplerBuffer name;
 float sf_texel(samplerBuffer b, uint i) { return texelFetch(b, int(i)).x; }
-int sf_texel(isamplerBuffer b, uint i) { return texelFetch(b, int(i)).x; }
 uint sf_texel(usamplerBuffer b, uint i) { return texelFetch(b, int(i)).x; }
+#  endif
 #else
 #  define SF_READ_REALS(slot, name) \
     layout(std430, binding = slot) restrict readonly buffer name##_buffer { real name[]; };
