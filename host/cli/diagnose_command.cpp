@@ -118,7 +118,7 @@ Action add_diagnose_command(CLI::App& app) {
     const BackendDecision backend = resolve_backend(
         options->backend.backend, make_model(scenario),
         sigma_point_count(set, static_cast<int>(scenario.filter->estimate.size())),
-        /*estimated_regions=*/0);   // diagnose refuses parameter fields (above)
+        EstimatedParameters(scenario.filter->estimate));   // ligaments only: diagnose refuses parameter fields (above)
     diagnose_options.backend = report.backend = backend.backend;
     report.backend_reason = backend.reason;
     report.preconditioner = preconditioner_used(backend.backend, diagnose_options.device);

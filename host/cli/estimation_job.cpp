@@ -69,7 +69,7 @@ std::optional<json> run_estimation_job(const Scenario& scenario, const Estimatio
     throw InputError(std::to_string(world.size) + " MPI ranks for " + std::to_string(sigma_count) +
                      " sigma points: every rank needs at least one (run with -n " + std::to_string(sigma_count) +
                      " or fewer)");
-  const BackendDecision backend = resolve_backend(job.backend, model, sigma_count, static_cast<int>(estimated.regions.size()));
+  const BackendDecision backend = resolve_backend(job.backend, model, sigma_count, estimated);
   if (job.out && world.rank == 0) *job.out << "backend: " << backend.backend << " (" << backend.reason << ")\n" << std::flush;
   // A surface cloud (observations.surface_cloud): the ensemble observes the surface's nodes
   // and each frame's points are observed by their distance to it

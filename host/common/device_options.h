@@ -42,6 +42,14 @@ enum class Preconditioner { automatic, jacobi, factorised };
 // against 45.
 constexpr int kOwnFactorsFromSigmaPoints = 16;
 
+// The most spring rows times sigma points for which OpenCL's shared factor is corrected for
+// each sigma point's own springs (DeviceOptions::spring_correction; its kernels keep two
+// arrays of that many reals per work-item).
+constexpr std::size_t kSpringRowsTimesSigmaPoints = 4096;
+inline bool spring_correction_fits(std::size_t spring_rows, int sigma_count) {
+  return spring_rows > 0 && spring_rows * static_cast<std::size_t>(sigma_count) <= kSpringRowsTimesSigmaPoints;
+}
+
 struct DeviceOptions {
   int device = 0;                   // index in `sigmafem devices`' list for the back end
   Precision precision = Precision::single;
@@ -56,6 +64,10 @@ struct DeviceOptions {
   // bytes, so that they stay in a CPU's cache; else one factor of the mean sigma point, shared
   // (0: always shared).
   std::size_t own_factors_bytes = std::size_t{8} << 20;
+  // OpenCL's shared factor corrected for each sigma point's own springs at the estimated
+  // ligaments' rows (host/reference/spring_correction.h) where that is small enough; false:
+  // the factor alone (tests and benchmarks compare).
+  bool spring_correction = true;
   // The CPU back end's worker threads: 0, the machine's cores (over MPI ranks, shared among
   // the ranks on one machine: estimation_job.cpp).
   int cpu_threads = 0;

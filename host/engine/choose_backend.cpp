@@ -2,6 +2,7 @@
 
 #include "host/common/device_options.h"
 #include "host/opencl/opencl_device.h"
+#include "host/reference/spring_correction.h"
 #include "host/vulkan/vulkan_device.h"
 
 namespace sigmafem {
@@ -18,7 +19,7 @@ GpuPresence find_gpus() {
 }
 
 BackendDecision choose_backend(const GpuPresence& gpus, long long elements, int sigma_count,
-                               int estimated_regions) {
+                               int estimated_regions, std::size_t spring_rows) {
   const long long pairs = elements * sigma_count;
   const std::string size = std::to_string(elements) + " tetrahedra x " +
                            std::to_string(sigma_count) + " sigma points";
@@ -33,9 +34,14 @@ BackendDecision choose_backend(const GpuPresence& gpus, long long elements, int 
     if (!gpus.opencl_cpu.empty() && (elements <= kCpuDeviceElements || pairs >= kCpuDevicePairs))
       return {"opencl", "auto: no GPU; " + size + " on the CPU device " + gpus.opencl_cpu +
                             ", faster there than the CPU back end (" + bounds + ")"};
+    if (!gpus.opencl_cpu.empty() && estimated_regions == 0 && spring_correction_fits(spring_rows, sigma_count))
+      return {"opencl", "auto: no GPU; " + size + " on the CPU device " + gpus.opencl_cpu +
+                            ", whose shared factor is corrected for each sigma point's springs: faster "
+                            "there than the CPU back end"};
     if (!gpus.opencl_cpu.empty())
       return {"cpu", "auto: no GPU; " + size + ": the CPU back end is faster than OpenCL on the "
-                     "CPU device between its bounds (" + bounds + ")"};
+                     "CPU device between its bounds (" + bounds + ") where OpenCL's shared factor "
+                     "is not corrected for the sigma points' springs"};
     return {"cpu", "auto: no GPU; the CPU back end is the fastest without one"};
   }
   if (pairs < kGpuPairs)
@@ -46,9 +52,11 @@ BackendDecision choose_backend(const GpuPresence& gpus, long long elements, int 
 }
 
 BackendDecision resolve_backend(const std::string& backend, const Model& model, int sigma_count,
-                                int estimated_regions) {
+                                const EstimatedParameters& estimated) {
   if (backend != "auto") return {backend, "given"};
-  return choose_backend(find_gpus(), model.element_count(), sigma_count, estimated_regions);
+  return choose_backend(find_gpus(), model.element_count(), sigma_count,
+                        static_cast<int>(estimated.regions.size()),
+                        estimated_spring_rows(model, estimated).size());
 }
 
 }  // namespace sigmafem

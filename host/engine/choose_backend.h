@@ -17,11 +17,16 @@
 // for the CPU back end's own), and the liver's filter step with 13 and 61 region moduli took
 // 8.9 and 56 ms on OpenCL against 7.8 and 27 on the CPU back end (bench/RESULTS.md, stop 49).
 // Where each sigma point gets its own factor on OpenCL (from 16 sigma points, up to
-// kOwnFactorPairs, estimated) it took 5.6 and 24 ms. Otherwise the CPU back end.
+// kOwnFactorPairs, estimated) it took 5.6 and 24 ms. Between the bounds OpenCL still, where its
+// shared factor is corrected for each sigma point's springs (every parameter a ligament's, and
+// spring_correction_fits): the 38k liver's filter step then took 1.8 CG iterations and 71-79 ms
+// against the CPU back end's 97-100 ms (stop 51). Otherwise the CPU back end.
 #pragma once
 
+#include <cstddef>
 #include <string>
 
+#include "host/model/estimated_parameters.h"
 #include "host/model/model.h"
 
 namespace sigmafem {
@@ -54,13 +59,14 @@ struct BackendDecision {
 };
 
 // The choice for `elements` tetrahedra and `sigma_count` sigma points, of which
-// `estimated_regions` parameters are regions' Young's moduli, on these GPUs.
+// `estimated_regions` parameters are regions' Young's moduli, on these GPUs; `spring_rows`:
+// the rows of the estimated ligaments' nodes (estimated_spring_rows).
 BackendDecision choose_backend(const GpuPresence& gpus, long long elements, int sigma_count,
-                               int estimated_regions = 0);
+                               int estimated_regions = 0, std::size_t spring_rows = 0);
 
 // `backend` as given ("cpu", "opencl", "vulkan": reason "given"), or "auto" decided by
-// choose_backend on this machine's GPUs for the model.
+// choose_backend on this machine's GPUs for the model and what is estimated.
 BackendDecision resolve_backend(const std::string& backend, const Model& model, int sigma_count,
-                                int estimated_regions);
+                                const EstimatedParameters& estimated);
 
 }  // namespace sigmafem

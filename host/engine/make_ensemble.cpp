@@ -16,7 +16,7 @@ std::unique_ptr<SimulationEnsemble> make_ensemble(const std::string& backend, co
                                                   const ObservedPoints& observed, int sigma_count,
                                                   const DeviceOptions& options) {
   if (backend == "auto")
-    return make_ensemble(resolve_backend(backend, model, sigma_count, static_cast<int>(estimated.regions.size())).backend, model, estimated,
+    return make_ensemble(resolve_backend(backend, model, sigma_count, estimated).backend, model, estimated,
                          observed, sigma_count, options);
   if (backend == "cpu")
     return std::make_unique<CpuEnsemble>(model, estimated, observed, sigma_count, options.cpu_threads,

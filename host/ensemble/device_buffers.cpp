@@ -85,6 +85,7 @@ std::vector<DeviceBufferSpec> device_buffer_specs(const Model& model, const Obse
   // The factor's arrays, written at its first refresh (one element each without a factor).
   const std::size_t rows = sizes.factor_nonzeros > 0 ? 3 * static_cast<std::size_t>(nodes) : 0;
   const std::size_t factor_nonzeros = std::max<std::size_t>(1, sizes.factor_nonzeros);
+  const std::size_t spring_rows = static_cast<std::size_t>(sizes.spring_rows);
 
   const std::size_t groups = static_cast<std::size_t>(S) * sizes.cg_partitions;
   const std::size_t sigma = static_cast<std::size_t>(S);
@@ -142,6 +143,12 @@ std::vector<DeviceBufferSpec> device_buffer_specs(const Model& model, const Obse
       reals(B::factor_values, "the factor", factor_nonzeros * static_cast<std::size_t>(sizes.factor_copies)),
       integers(B::factor_order, "the factor", std::vector<int>(std::max<std::size_t>(1, rows), 0)),
       reals(B::factor_work, "the factor", rows * sigma),
+      integers(B::spring_at, "the factor's spring correction",
+               std::vector<int>(spring_rows > 0 ? rows + 1 : 1, 0)),
+      reals_of(B::spring_solves, "the factor's spring correction",
+               std::vector<double>(rows * spring_rows, 0.0)),
+      reals_of(B::spring_coupling, "the factor's spring correction",
+               std::vector<double>(spring_rows * spring_rows * sigma, 0.0)),
   };
   for (int i = 0; i < kDeviceBufferCount; ++i)   // the list above is in DeviceBuffer order
     if (specs[i].id != static_cast<DeviceBuffer>(i)) throw std::logic_error("device_buffer_specs: out of order");

@@ -49,6 +49,10 @@ enum class DeviceBuffer : int {
   // column's start, its rows and values, the diagonal first), the ordering, and a work vector
   // per sigma point (FactorisedPreconditioner).
   factor_columns, factor_rows, factor_values, factor_order, factor_work,
+  // The shared factor's correction for each sigma point's own springs (SpringCorrection): the
+  // count of the rows of L that V = L^-1 P E reaches, then those rows; V's values there by
+  // rows ([u m + j]); each sigma point's m x m coupling H ([(s m + j) m + k]).
+  spring_at, spring_solves, spring_coupling,
   count
 };
 constexpr int kDeviceBufferCount = static_cast<int>(DeviceBuffer::count);
@@ -69,6 +73,7 @@ struct DeviceBufferSizes {
   int cg_partitions = 1;          // CG work-groups per sigma point
   std::size_t factor_nonzeros = 0;   // of CG's factor, if it has one (0: Jacobi)
   int factor_copies = 1;             // of L's values: 1 shared, S when each sigma point has its own
+  int spring_rows = 0;               // m of the factor's SpringCorrection (0: none)
 };
 
 // Every buffer of an ensemble of `model` with S sigma points, in DeviceBuffer order. The

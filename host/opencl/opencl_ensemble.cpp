@@ -7,6 +7,7 @@
 
 #include "host/ensemble/device_readout.h"
 #include "device_layout.h"
+#include "step_constants.h"
 #include "host/ensemble/device_limits.h"
 
 namespace sigmafem {
@@ -108,6 +109,12 @@ OpenClEnsemble::OpenClEnsemble(const Model& model, EstimatedParameters estimated
     // The copies in the layout of the blocks that solve with them (conjugate_gradient.cl): cg_solve's
     // blocks of their own vectors one after the other, else all S interleaved.
     factor_block_ = whole_solve_ && solve_block_ < S_ ? solve_block_ : S_;
+    // The shared factor corrected for each sigma point's own springs at the estimated
+    // ligaments' rows (SpringCorrection), where the kernels' arrays of m x S stay small.
+    if (factor_copies_ == 1 && options.spring_correction) {
+      std::vector<int> rows = estimated_spring_rows(model_, estimated_);
+      if (spring_correction_fits(rows.size(), S_)) spring_rows_ = std::move(rows);
+    }
   }
   // With a factor the solve is most of an iteration, and each block solves with a work vector
   // of its own (conjugate_gradient.cl): a block per compute unit then pays at any S
@@ -124,6 +131,7 @@ OpenClEnsemble::OpenClEnsemble(const Model& model, EstimatedParameters estimated
                         " -DSF_CG_PARTITIONS=" + std::to_string(cg_partitions_) +
                         " -DSF_FACTOR=" + std::to_string(factor_ ? 1 : 0) +
                         " -DSF_FACTOR_PER_SIGMA=" + std::to_string(factor_copies_ > 1 ? 1 : 0) +
+                        " -DSF_SPRING_ROWS=" + std::to_string(spring_rows_.size()) +
                         " -DSF_POLAR_FRAMES=" +
                         std::to_string(model_.material.rotation == ElementRotation::polar ? 1 : 0));
 
@@ -135,7 +143,8 @@ OpenClEnsemble::OpenClEnsemble(const Model& model, EstimatedParameters estimated
     const std::size_t cg_solve_vectors = whole_solve_ && solve_block_ < S_ ? kCgSolveBlockVectors : 0;
     const DeviceBufferSizes sizes{std::max<std::size_t>(element_chunks_, cg_solve_vectors) * dof,
                                   cg_partitions_,
-                                  factor_ ? factor_->nonzeros() : 0, factor_copies_};
+                                  factor_ ? factor_->nonzeros() : 0, factor_copies_,
+                                  static_cast<int>(spring_rows_.size())};
     written_.resize(kDeviceBufferCount);
     write_done_.resize(written_.size());
     for (const DeviceBufferSpec& spec : buffer_specs(sizes)) {
@@ -179,7 +188,8 @@ OpenClEnsemble::OpenClEnsemble(const Model& model, EstimatedParameters estimated
     // The factor's buffers, last, where the CPU form's CG has them (SF_FACTOR).
     const std::vector<DeviceBuffer> factor =
         factor_ ? std::vector<DeviceBuffer>{B::factor_columns, B::factor_rows, B::factor_values,
-                                            B::factor_order, B::factor_work}
+                                            B::factor_order, B::factor_work, B::spring_at,
+                                            B::spring_solves, B::spring_coupling}
                 : std::vector<DeviceBuffer>{};
     std::vector<DeviceBuffer> start = {B::constants, B::q, B::rhs, B::inverse_diagonal, B::r, B::z,
                                        B::d, B::bb, B::rr, B::rz, B::active, B::converged,
@@ -261,7 +271,10 @@ std::vector<double> OpenClEnsemble::read_reals(DeviceBuffer id, std::size_t coun
   return from_device_reals(bytes.data(), count, device_.precision());
 }
 
-void OpenClEnsemble::upload_ligament_k() { write_reals(DeviceBuffer::ligament_k, ligament_k_); }
+void OpenClEnsemble::upload_ligament_k() {
+  write_reals(DeviceBuffer::ligament_k, ligament_k_);
+  coupling_stale_ = springs_.size() > 0;   // the springs' corrections follow the stiffnesses
+}
 
 void OpenClEnsemble::run(cl::Kernel& kernel, std::size_t items, std::size_t local) const {
   const std::size_t group = local > 0 ? local : SF_ITEMS_PER_GROUP;
@@ -340,8 +353,10 @@ StepReport OpenClEnsemble::advance(const Eigen::Vector3d& so_position) {
   StepReport report;
   const int factorisations_before = factorisations();
   try {
-    if (factor_ && factor_->due()) refresh_factor();
-    write_reals(DeviceBuffer::constants, step_constants_.next_step(model_, so_position));
+    const std::vector<double> constants = step_constants_.next_step(model_, so_position);
+    if (factor_ && factor_->due()) refresh_factor(constants);
+    write_reals(DeviceBuffer::constants, constants);
+    if (coupling_stale_) upload_spring_coupling(constants);
     run_elements(k_element_rhs_);
     run(k_node_rhs_, static_cast<std::size_t>(nodes_) * S_);
     conjugate_gradient();
@@ -369,13 +384,14 @@ StepReport OpenClEnsemble::advance(const Eigen::Vector3d& so_position) {
   return report;
 }
 
-void OpenClEnsemble::refresh_factor() {
+void OpenClEnsemble::refresh_factor(const std::vector<double>& constants) {
   std::vector<double> values;
   if (factor_copies_ == 1) {
     const Eigen::SparseMatrix<double> A = representative_system();
     if (!factor_->factorise(A)) return fall_back_to_diagonal(A);
     const Eigen::SparseMatrix<double>& L = factor_->lower();
     values.assign(L.valuePtr(), L.valuePtr() + L.nonZeros());
+    if (!spring_rows_.empty()) prepare_spring_correction(constants);
   } else {
     // Each sigma point's own system at its own state, factorised on the same analysis (the
     // pattern is the assembly's, the same for all).
@@ -400,6 +416,61 @@ void OpenClEnsemble::refresh_factor() {
   }
   write_reals(DeviceBuffer::factor_values, values);
   on_device_ = FactorOnDevice::factor;
+}
+
+std::vector<double> OpenClEnsemble::spring_diagonal(const std::vector<double>& constants, int s,
+                                                    const std::vector<double>& ligament_k) const {
+  // Sigma point s's stiffness factor h (h + a) times its springs of the estimated ligaments at
+  // each spring row (the other springs are the same for all, and cancel).
+  const double factor = constants[SF_STEP_CONSTANTS + SF_STIFFNESS_FACTOR * S_ + s];
+  std::vector<double> node_k(static_cast<std::size_t>(nodes_), 0.0);
+  for (int l : estimated_.ligaments)
+    for (int node : model_.ligaments[static_cast<std::size_t>(l)].nodes)
+      node_k[static_cast<std::size_t>(node)] += ligament_k[static_cast<std::size_t>(l) * S_ + s];
+  std::vector<double> diagonal(spring_rows_.size());
+  for (std::size_t j = 0; j < spring_rows_.size(); ++j)
+    diagonal[j] = factor * node_k[static_cast<std::size_t>(spring_rows_[j] / 3)];
+  return diagonal;
+}
+
+void OpenClEnsemble::prepare_spring_correction(const std::vector<double>& constants) {
+  springs_.prepare(*factor_, spring_rows_);
+  // The representative's springs: the sigma points' mean log-stiffnesses (as
+  // representative_system), and sigma point 0's stiffness factor (its effects).
+  std::vector<double> mean_k = ligament_k_;
+  for (int l : estimated_.ligaments) {
+    double log_sum = 0.0;
+    for (int s = 0; s < S_; ++s) log_sum += std::log(ligament_k_[static_cast<std::size_t>(l) * S_ + s]);
+    for (int s = 0; s < S_; ++s) mean_k[static_cast<std::size_t>(l) * S_ + s] = std::exp(log_sum / S_);
+  }
+  factorised_springs_ = spring_diagonal(constants, 0, mean_k);
+  const std::vector<int>& reached = springs_.reached();
+  std::vector<int> at = {static_cast<int>(reached.size())};
+  at.insert(at.end(), reached.begin(), reached.end());
+  write_integers(DeviceBuffer::spring_at, at.data(), at.size());
+  const Eigen::MatrixXd& V = springs_.reached_values();
+  std::vector<double> values(static_cast<std::size_t>(V.size()));   // by rows
+  for (Eigen::Index u = 0; u < V.rows(); ++u)
+    for (Eigen::Index j = 0; j < V.cols(); ++j) values[static_cast<std::size_t>(u * V.cols() + j)] = V(u, j);
+  write_reals(DeviceBuffer::spring_solves, values);
+  coupling_stale_ = true;
+}
+
+void OpenClEnsemble::upload_spring_coupling(const std::vector<double>& constants) {
+  const std::size_t m = spring_rows_.size();
+  std::vector<double> couplings(m * m * static_cast<std::size_t>(S_));
+  for (int s = 0; s < S_; ++s) {
+    const std::vector<double> own = spring_diagonal(constants, s, ligament_k_);
+    Eigen::VectorXd delta(static_cast<Eigen::Index>(m));
+    for (std::size_t j = 0; j < m; ++j) delta[static_cast<Eigen::Index>(j)] = own[j] - factorised_springs_[j];
+    const Eigen::MatrixXd H = springs_.coupling(delta);
+    for (std::size_t j = 0; j < m; ++j)
+      for (std::size_t k = 0; k < m; ++k)
+        couplings[(static_cast<std::size_t>(s) * m + j) * m + k] =
+            H(static_cast<Eigen::Index>(j), static_cast<Eigen::Index>(k));
+  }
+  write_reals(DeviceBuffer::spring_coupling, couplings);
+  coupling_stale_ = false;
 }
 
 std::size_t OpenClEnsemble::factor_value_index(int s, std::size_t k, std::size_t nonzeros) const {

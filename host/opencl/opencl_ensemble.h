@@ -18,6 +18,7 @@
 #include "host/model/model.h"
 #include "host/opencl/opencl_device.h"
 #include "host/reference/factorised_preconditioner.h"
+#include "host/reference/spring_correction.h"
 
 namespace sigmafem {
 
@@ -79,7 +80,16 @@ class OpenClEnsemble : public DeviceEnsemble {
   // point's from its own system, when it is due, and uploads it; with no factor yet and a
   // system that is not positive definite, uploads the representative's diagonal instead
   // (upload_diagonal_factor).
-  void refresh_factor();
+  void refresh_factor(const std::vector<double>& constants);
+  // The spring correction of a fresh shared factor (SpringCorrection): W and the rows' places
+  // go down, and the representative's springs are kept for the couplings.
+  void prepare_spring_correction(const std::vector<double>& constants);
+  // Each sigma point's coupling H for its springs against the representative's.
+  void upload_spring_coupling(const std::vector<double>& constants);
+  // h (h + a) times the estimated ligaments' springs at each spring row, for sigma point s of
+  // the step's constants and stiffnesses ligament_k ([l S + s]).
+  std::vector<double> spring_diagonal(const std::vector<double>& constants, int s,
+                                      const std::vector<double>& ligament_k) const;
   // A stand-in for the factor: L = sqrt(|diag A|), no reordering, so that z = r / |diag A|,
   // Jacobi's preconditioner, until a factorisation succeeds.
   void upload_diagonal_factor(const Eigen::SparseMatrix<double>& A);
@@ -117,6 +127,12 @@ class OpenClEnsemble : public DeviceEnsemble {
   std::size_t factor_value_index(int s, std::size_t k, std::size_t nonzeros) const;
   // What the factor's buffers hold: nothing yet, the diagonal stand-in, or a factor (whose
   // pattern and ordering later refreshes keep).
+  // The spring rows the shared factor is corrected at (empty: none), the correction, the
+  // representative's diagonal there when factorised, and whether the couplings are out of date.
+  std::vector<int> spring_rows_;
+  SpringCorrection springs_;
+  std::vector<double> factorised_springs_;
+  bool coupling_stale_ = false;
   enum class FactorOnDevice { none, diagonal, factor };
   FactorOnDevice on_device_ = FactorOnDevice::none;
 

@@ -358,11 +358,23 @@ typedef real sf_entry;
 #  define SF_FACTOR_ARGUMENTS                                                                \
     , __global const int *restrict factor_columns, __global const int *restrict factor_rows, \
         __global const real *restrict factor_values,                                        \
-        __global const int *restrict factor_order, __global real *restrict factor_work
-#  define SF_FACTOR_PASS , factor_columns, factor_rows, factor_values, factor_order, factor_work
+        __global const int *restrict factor_order, __global real *restrict factor_work,     \
+        __global const int *restrict spring_at, __global const real *restrict spring_solves, \
+        __global const real *restrict spring_coupling
+#  define SF_FACTOR_PASS \
+    , factor_columns, factor_rows, factor_values, factor_order, factor_work, spring_at, \
+        spring_solves, spring_coupling
 /* The same for block `first` of the ensemble's blocks: its own rows x count of factor_work. */
-#  define SF_BLOCK_FACTOR_PASS(first, rows) \
-    , factor_columns, factor_rows, factor_values, factor_order, factor_work + (size_t)(first) * (rows)
+#  define SF_BLOCK_FACTOR_PASS(first, rows)                                               \
+    , factor_columns, factor_rows, factor_values, factor_order,                           \
+        factor_work + (size_t)(first) * (rows), spring_at, spring_solves, spring_coupling
+/* SF_SPRING_ROWS = m > 0: the shared factor corrected for each sigma point's own springs at
+ * m rows (host/reference/spring_correction.h) between the substitutions: spring_at[0] rows of
+ * L that V = L^-1 P E reaches, at spring_at[1 ..], V there by rows ([u m + j], read once for
+ * the block), and each sigma point's m x m coupling H. */
+#  ifndef SF_SPRING_ROWS
+#    define SF_SPRING_ROWS 0
+#  endif
 
 /* The work vector y is the block's own, [row * count + b] (factor_work, offset by the caller):
  * blocks that wrote into each other's cache lines at every entry of L would be slower than one
@@ -390,6 +402,36 @@ static inline __attribute__((always_inline)) void sf_block_factor_solve(
       for (uint b = 0; b < count; ++b) below[b] -= SF_L_OF(value, b) * solved[b];
     }
   }
+#if SF_SPRING_ROWS
+  { /* Each sigma point's own springs: y' -= V H_(first + b) V^T y' on the rows V reaches. */
+    const int reached = spring_at[0];
+    real projected[SF_SPRING_ROWS][SF_BLOCK_MAX];
+    for (uint j = 0; j < SF_SPRING_ROWS; ++j)
+      for (uint b = 0; b < count; ++b) projected[j][b] = (real)0;
+    for (int u = 0; u < reached; ++u) {
+      __global const real* restrict at = y + (size_t)spring_at[1 + u] * count;
+      __global const real* restrict v = spring_solves + (size_t)u * SF_SPRING_ROWS;
+      for (uint j = 0; j < SF_SPRING_ROWS; ++j)
+        for (uint b = 0; b < count; ++b) projected[j][b] += v[j] * at[b];
+    }
+    real coupled[SF_SPRING_ROWS][SF_BLOCK_MAX];
+    for (uint b = 0; b < count; ++b) {
+      __global const real* restrict H =
+          spring_coupling + (size_t)(first + b) * SF_SPRING_ROWS * SF_SPRING_ROWS;
+      for (uint j = 0; j < SF_SPRING_ROWS; ++j) {
+        real sum = (real)0;
+        for (uint k = 0; k < SF_SPRING_ROWS; ++k) sum += H[j * SF_SPRING_ROWS + k] * projected[k][b];
+        coupled[j][b] = sum;
+      }
+    }
+    for (int u = 0; u < reached; ++u) {
+      __global real* restrict at = y + (size_t)spring_at[1 + u] * count;
+      __global const real* restrict v = spring_solves + (size_t)u * SF_SPRING_ROWS;
+      for (uint j = 0; j < SF_SPRING_ROWS; ++j)
+        for (uint b = 0; b < count; ++b) at[b] -= v[j] * coupled[j][b];
+    }
+  }
+#endif
   for (uint j = rows; j-- > 0;) { /* L^T x = y', from the last row up */
     size_t at = (size_t)j * count;
     /* Two partial sums, the entries taken in pairs: one sum's chain of dependent additions
@@ -739,10 +781,12 @@ __kernel void cg_solve(uint S, uint element_count, uint node_count, int max_iter
    * k SF_CG_SOLVE_BLOCK + i (factor_columns[rows] is L's entry count). */
 #    define SF_OWN_FACTOR_PASS , factor_columns, factor_rows,                                  \
         factor_values + (size_t)block * (size_t)factor_columns[rows] * SF_CG_SOLVE_BLOCK,     \
-        factor_order, factor_work + (size_t)block * size
+        factor_order, factor_work + (size_t)block * size, spring_at, spring_solves, spring_coupling
 #  elif SF_FACTOR
+  /* The block's sigma points are 0 .. count - 1 in the helpers: their couplings from first's. */
 #    define SF_OWN_FACTOR_PASS , factor_columns, factor_rows, factor_values, factor_order, \
-        factor_work + (size_t)block * size
+        factor_work + (size_t)block * size, spring_at, spring_solves,                      \
+        spring_coupling + (size_t)first * SF_SPRING_ROWS * SF_SPRING_ROWS
 #  else
 #    define SF_OWN_FACTOR_PASS
 #  endif

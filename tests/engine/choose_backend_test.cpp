@@ -1,5 +1,6 @@
 // `--backend auto` (host/engine/choose_backend.h): without a GPU, OpenCL on a CPU device up to
-// kCpuDeviceElements tetrahedra, else the CPU back end; with one, the CPU back end below
+// kCpuDeviceElements tetrahedra or where its shared factor is corrected for the sigma points'
+// springs, else the CPU back end; with one, the CPU back end below
 // kGpuPairs element-sigma pairs, OpenCL's GPU before Vulkan's above; a named back end is
 // taken as it is.
 #include "host/engine/choose_backend.h"
@@ -8,7 +9,9 @@
 
 #include <string>
 
+#include "host/common/device_options.h"
 #include "host/model/model.h"
+#include "host/reference/spring_correction.h"
 #include "host/scenario/scenario.h"
 #include "scenario_directory.h"
 
@@ -46,6 +49,26 @@ TEST(ChooseBackend, WithoutAGpuOpenClOnTheCpuUpToItsBound) {
   EXPECT_EQ(choose_backend(kPoclOnly, kCpuDevicePairs / 8 - 1, 8).backend, "cpu");
 }
 
+// Between the bounds OpenCL where its shared factor is corrected for each sigma point's
+// springs (the 38k liver's filter step, 27 spring rows at S = 4: 71-79 against 97-100 ms,
+// stop 51); not with region moduli, nor where the rows times sigma points do not fit.
+TEST(ChooseBackend, WithoutAGpuOpenClWhereItsFactorIsCorrectedForTheSprings) {
+  const BackendDecision d = choose_backend(kPoclOnly, 38144, 4, 0, 27);
+  EXPECT_EQ(d.backend, "opencl");
+  EXPECT_NE(d.reason.find("corrected for each sigma point's springs"), std::string::npos) << d.reason;
+  EXPECT_EQ(choose_backend(kPoclOnly, 38144, 4, 1, 27).backend, "cpu") << "a region modulus";
+  EXPECT_EQ(choose_backend(kPoclOnly, 38144, 4, 0, kSpringRowsTimesSigmaPoints / 4 + 1).backend, "cpu")
+      << "too many spring rows";
+  EXPECT_EQ(choose_backend(kNoGpu, 38144, 4, 0, 27).backend, "cpu") << "no OpenCL device at all";
+}
+
+TEST(ChooseBackend, TheLiverFinesSpringRowsAreCorrected) {
+  // resolve_backend's rows for the 38k liver: its three estimated ligaments' nine nodes.
+  const Scenario s = load_scenario(kScenarios + "liver_fine.json");
+  const Model model = make_model(s);
+  EXPECT_EQ(estimated_spring_rows(model, EstimatedParameters(s.filter->estimate)).size(), 27u);
+}
+
 // Sigma points that differ by estimated region moduli: where OpenCL would share one factor
 // among them (below kOwnFactorsFromSigmaPoints or beyond kOwnFactorPairs) it preconditions
 // them less well, and the CPU back end
@@ -80,14 +103,14 @@ TEST(ChooseBackend, AGpuFromEnoughWorkAndOpenClFirst) {
 TEST(ChooseBackend, ANamedBackEndIsTakenAsItIs) {
   const Model model = make_model(load_scenario(kScenarios + "box.json"));
   for (const char* name : {"cpu", "opencl", "vulkan"}) {
-    const BackendDecision d = resolve_backend(name, model, 4, 0);
+    const BackendDecision d = resolve_backend(name, model, 4, EstimatedParameters{});
     EXPECT_EQ(d.backend, name);
     EXPECT_EQ(d.reason, "given");
   }
   // auto here: a box filter (1344 x 4) is below the GPU's bound, and OpenCL's on a CPU
   // device (PoCL) when that is OpenCL's device 0.
   const GpuPresence here = find_gpus();
-  EXPECT_EQ(resolve_backend("auto", model, 4, 0).backend,
+  EXPECT_EQ(resolve_backend("auto", model, 4, EstimatedParameters{}).backend,
             here.opencl.empty() && here.vulkan.empty() && !here.opencl_cpu.empty() ? "opencl" : "cpu");
 }
 
