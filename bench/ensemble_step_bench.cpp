@@ -37,6 +37,7 @@ struct Backend {
   bool shared_factor = false;   // one factor for all sigma points, whatever its size (CPU, OpenCL)
   int cg_partitions = 0;        // OpenCL's GPU form: CG work-groups per sigma point (0: by mesh)
   KernelForm kernel_form = KernelForm::automatic;
+  bool spring_correction = true;   // OpenCL's shared factor corrected for the sigma points' springs
 };
 
 // The CPU back end with its default preconditioner (factors: one per sigma point within
@@ -69,6 +70,11 @@ const Backend kOpenClFactorised{"opencl", Precision::single,
 const Backend kOpenClSharedFactor{"opencl", Precision::single,
                                   "opencl single, device 0, one shared factor",
                                   SolveLaunch::automatic, Preconditioner::factorised, true};
+// The shared factor without its correction for each sigma point's springs, as before stop 51.
+const Backend kOpenClUncorrectedFactor{"opencl", Precision::single,
+                                       "opencl single, device 0, one shared factor, not corrected for the springs",
+                                       SolveLaunch::automatic, Preconditioner::factorised, true, 0,
+                                       KernelForm::automatic, false};
 // CG with one work-group per sigma point whatever the mesh (on a GPU: before partitions).
 const Backend kOpenClOneGroup{"opencl", Precision::single,
                               "opencl single, device 0, CG a work-group per sigma point",
@@ -92,6 +98,7 @@ DeviceOptions device_options(const Backend& backend) {
   options.cg_partitions = backend.cg_partitions;
   options.kernel_form = backend.kernel_form;
   if (backend.shared_factor) options.own_factors_bytes = 0;
+  options.spring_correction = backend.spring_correction;
   return options;
 }
 
@@ -297,6 +304,9 @@ BENCHMARK_CAPTURE(BM_ensemble_step, opencl_liver_4768, kOpenCl, std::string("liv
 BENCHMARK_CAPTURE(BM_ensemble_step, opencl_factorised_liver_4768, kOpenClFactorised,
                   std::string("liver"), 1)
     ->Arg(4)->Arg(16)->Unit(benchmark::kMillisecond)->UseRealTime();
+BENCHMARK_CAPTURE(BM_ensemble_step, opencl_uncorrected_factor_liver_4768, kOpenClUncorrectedFactor,
+                  std::string("liver"), 1)
+    ->Arg(16)->Unit(benchmark::kMillisecond)->UseRealTime();
 BENCHMARK_CAPTURE(BM_ensemble_step, opencl_per_iteration_liver_4768, kOpenClPerIteration,
                   std::string("liver"), 1)
     ->RangeMultiplier(2)->Range(1, 16)->Unit(benchmark::kMillisecond)->UseRealTime();
@@ -339,6 +349,8 @@ BENCHMARK_CAPTURE(BM_ensemble_step, cpu_liver_596, kCpu, std::string("liver"), 0
     ->Arg(16)->Unit(benchmark::kMillisecond)->UseRealTime();
 BENCHMARK_CAPTURE(BM_ensemble_step, opencl_factorised_liver_596, kOpenClFactorised, std::string("liver"), 0)
     ->Arg(16)->Unit(benchmark::kMillisecond)->UseRealTime();
+BENCHMARK_CAPTURE(BM_ensemble_step, opencl_shared_factor_liver_596, kOpenClSharedFactor, std::string("liver"), 0)
+    ->Arg(16)->Unit(benchmark::kMillisecond)->UseRealTime();
 BENCHMARK_CAPTURE(BM_ensemble_step, cpu_shared_liver_596, kCpuShared, std::string("liver"), 0)
     ->Arg(16)->Unit(benchmark::kMillisecond)->UseRealTime();
 BENCHMARK_CAPTURE(BM_ensemble_step, cpu_jacobi_liver_596, kCpuJacobi, std::string("liver"), 0)
@@ -359,6 +371,9 @@ BENCHMARK_CAPTURE(BM_ensemble_step, opencl_factorised_liver_fine_38144, kOpenClF
                   std::string("liver_fine"), 0)
     ->Arg(4)->Arg(16)->Unit(benchmark::kMillisecond)->UseRealTime();
 BENCHMARK_CAPTURE(BM_ensemble_step, cpu_shared_liver_fine_38144, kCpuShared, std::string("liver_fine"), 0)
+    ->Arg(16)->Unit(benchmark::kMillisecond)->UseRealTime();
+BENCHMARK_CAPTURE(BM_ensemble_step, opencl_uncorrected_factor_liver_fine_38144, kOpenClUncorrectedFactor,
+                  std::string("liver_fine"), 0)
     ->Arg(16)->Unit(benchmark::kMillisecond)->UseRealTime();
 BENCHMARK_CAPTURE(BM_ensemble_step, opencl_box_large_117240, kOpenCl, std::string("box_large"), 0)
     ->Arg(16)->Arg(64)->Unit(benchmark::kMillisecond)->UseRealTime();
@@ -381,6 +396,8 @@ BENCHMARK_CAPTURE(BM_filter_step, opencl, kOpenCl, std::string("liver"))
 BENCHMARK_CAPTURE(BM_filter_step, opencl_factorised, kOpenClFactorised, std::string("liver"))
     ->Unit(benchmark::kMillisecond)->UseRealTime();
 BENCHMARK_CAPTURE(BM_filter_step, opencl_shared_factor, kOpenClSharedFactor, std::string("liver"))
+    ->Unit(benchmark::kMillisecond)->UseRealTime();
+BENCHMARK_CAPTURE(BM_filter_step, opencl_uncorrected_factor, kOpenClUncorrectedFactor, std::string("liver"))
     ->Unit(benchmark::kMillisecond)->UseRealTime();
 BENCHMARK_CAPTURE(BM_filter_step, opencl_per_iteration, kOpenClPerIteration, std::string("liver"))
     ->Unit(benchmark::kMillisecond)->UseRealTime();
@@ -425,6 +442,9 @@ BENCHMARK_CAPTURE(BM_filter_step, opencl_liver_fine_38144, kOpenCl, std::string(
 BENCHMARK_CAPTURE(BM_filter_step, vulkan_liver_fine_38144, kVulkan, std::string("liver_fine"))
     ->Iterations(20)->Unit(benchmark::kMillisecond)->UseRealTime();
 BENCHMARK_CAPTURE(BM_filter_step, opencl_factorised_liver_fine_38144, kOpenClFactorised,
+                  std::string("liver_fine"))
+    ->Iterations(20)->Unit(benchmark::kMillisecond)->UseRealTime();
+BENCHMARK_CAPTURE(BM_filter_step, opencl_uncorrected_factor_liver_fine_38144, kOpenClUncorrectedFactor,
                   std::string("liver_fine"))
     ->Iterations(20)->Unit(benchmark::kMillisecond)->UseRealTime();
 BENCHMARK_CAPTURE(BM_filter_step, cpu_liver_fine_38144, kCpu, std::string("liver_fine"))

@@ -61,8 +61,9 @@ struct DeviceOptions {
   Preconditioner preconditioner = Preconditioner::automatic;
   // OpenCL's CPU form with a factor: each sigma point gets its own (of its own system), from
   // kOwnFactorsFromSigmaPoints, where the S copies of L's values take at most this many
-  // bytes, so that they stay in a CPU's cache; else one factor of the mean sigma point, shared
-  // (0: always shared).
+  // bytes, so that they stay in a CPU's cache, and where the sigma points differ by more than
+  // the springs a shared factor is corrected for (spring_correction); else one factor of the
+  // mean sigma point, shared (0: always shared).
   std::size_t own_factors_bytes = std::size_t{8} << 20;
   // OpenCL's shared factor corrected for each sigma point's own springs at the estimated
   // ligaments' rows (host/reference/spring_correction.h) where that is small enough; false:

@@ -97,24 +97,27 @@ OpenClEnsemble::OpenClEnsemble(const Model& model, EstimatedParameters estimated
     // values below add at most own_factors_bytes).
     check_device_memory(device_.real_size(), info.name, info.global_memory, info.max_allocation,
                         factor_->nonzeros());
+    // The shared factor is corrected for each sigma point's own springs at the estimated
+    // ligaments' rows (SpringCorrection) where the kernels' arrays of m x S stay small.
+    std::vector<int> spring_rows = estimated_spring_rows(model_, estimated_);
+    const bool corrected = options.spring_correction && spring_correction_fits(spring_rows.size(), S_);
     // Each sigma point its own factor where the S copies of L's values stay small enough for a
-    // CPU's cache, and from kOwnFactorsFromSigmaPoints: sigma points that differ (by the
-    // covariance's spread, and by region moduli) are preconditioned less well by the mean's
-    // factor (the liver's filter step with 13 region moduli, S = 17: 12.7 CG iterations shared,
-    // 2.8 own; bench/RESULTS.md, stop 49). Beyond the cache a solve's time is reading L, which
-    // the shared factor reads once for a block.
-    if (S_ >= kOwnFactorsFromSigmaPoints &&
+    // CPU's cache, from kOwnFactorsFromSigmaPoints, and where the sigma points differ by more
+    // than the springs the shared factor is corrected for: those that differ by region moduli
+    // are preconditioned less well by the mean's factor (the liver's filter step with 13
+    // region moduli, S = 17: 12.7 CG iterations shared, 2.8 own; bench/RESULTS.md, stop 49),
+    // while by springs alone the corrected one is as good and reads one L for a block (the
+    // liver at S = 16: 2.6 iterations and 1.2-1.3 ms a step against own factors' 2.2 and
+    // 2.0-2.9 ms; stop 51). Beyond the cache a solve's time is reading L, which the shared
+    // factor reads once for a block.
+    const bool springs_alone = corrected && estimated_.regions.empty();
+    if (!springs_alone && S_ >= kOwnFactorsFromSigmaPoints &&
         static_cast<std::size_t>(S_) * factor_->nonzeros() * device_.real_size() <= options.own_factors_bytes)
       factor_copies_ = S_;
+    if (factor_copies_ == 1 && corrected) spring_rows_ = std::move(spring_rows);
     // The copies in the layout of the blocks that solve with them (conjugate_gradient.cl): cg_solve's
     // blocks of their own vectors one after the other, else all S interleaved.
     factor_block_ = whole_solve_ && solve_block_ < S_ ? solve_block_ : S_;
-    // The shared factor corrected for each sigma point's own springs at the estimated
-    // ligaments' rows (SpringCorrection), where the kernels' arrays of m x S stay small.
-    if (factor_copies_ == 1 && options.spring_correction) {
-      std::vector<int> rows = estimated_spring_rows(model_, estimated_);
-      if (spring_correction_fits(rows.size(), S_)) spring_rows_ = std::move(rows);
-    }
   }
   // With a factor the solve is most of an iteration, and each block solves with a work vector
   // of its own (conjugate_gradient.cl): a block per compute unit then pays at any S

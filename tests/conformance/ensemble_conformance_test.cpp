@@ -63,6 +63,9 @@ struct BackendCase {
   // Only this many sigma points (0: the suite's S = 1, 4, 16 as the rules below allow), on
   // the liver alone.
   int only_liver_S = 0;
+  // DeviceOptions::spring_correction: false for the own factors' cases (sigma points that
+  // differ by springs alone share the corrected factor instead).
+  bool spring_correction = true;
 };
 
 // The back ends to check: OpenCL device 0 and Vulkan device 0, each in single and, where the
@@ -82,16 +85,24 @@ std::vector<BackendCase> backend_cases() {
                    KernelForm::automatic, 0, Preconditioner::automatic});
   cases.push_back({"opencl", Precision::double_precision, "OpenClDoubleDefaultWholeSolve",
                    SolveLaunch::whole_solve, KernelForm::automatic, 0, Preconditioner::automatic});
-  // The default's two layouts of the factors (stop 49): one shared (what meshes too large for
-  // each sigma point's own get), and each sigma point's own in cg_solve's blocks of their own
-  // vectors (S = 16 on two compute units: two blocks of 8).
+  // The default's layouts of the factors (stop 49): one shared (what meshes too large for
+  // each sigma point's own get, and since stop 51 what sigma points that differ by springs
+  // alone get, corrected for them), and each sigma point's own (region moduli estimated, or
+  // the correction off as here) in cg_solve's blocks of their own vectors (S = 16 on two
+  // compute units: two blocks of 8).
   cases.push_back({"opencl", Precision::single, "OpenClSingleSharedFactor", SolveLaunch::per_iteration,
                    KernelForm::automatic, 0, Preconditioner::automatic, 0, 4});
   cases.push_back({"opencl", Precision::single, "OpenClSingleOwnFactorsWholeSolve", SolveLaunch::whole_solve,
-                   KernelForm::automatic, 0, Preconditioner::automatic, DeviceOptions{}.own_factors_bytes, 16});
+                   KernelForm::automatic, 0, Preconditioner::automatic, DeviceOptions{}.own_factors_bytes, 16,
+                   false});
   // And launched per iteration, in a block per compute unit, each solving with its own work
   // vector (stop 50).
   cases.push_back({"opencl", Precision::single, "OpenClSingleOwnFactors", SolveLaunch::per_iteration,
+                   KernelForm::automatic, 0, Preconditioner::automatic, DeviceOptions{}.own_factors_bytes, 16,
+                   false});
+  // The shared factor corrected for each sigma point's springs at S = 16 in cg_solve's
+  // blocks of their own vectors (its couplings from the block's first sigma point's).
+  cases.push_back({"opencl", Precision::single, "OpenClSingleCorrectedFactorWholeSolve", SolveLaunch::whole_solve,
                    KernelForm::automatic, 0, Preconditioner::automatic, DeviceOptions{}.own_factors_bytes, 16});
   // The GPU form of the OpenCL kernels (a work-item per element and sigma point, a work-group
   // per sigma point in CG), forced on whatever device is there: on PoCL it would otherwise
@@ -124,6 +135,7 @@ DeviceOptions device_options(const BackendCase& c) {
   options.cg_partitions = c.cg_partitions;
   options.preconditioner = c.preconditioner;
   options.own_factors_bytes = c.own_factors_bytes;
+  options.spring_correction = c.spring_correction;
   return options;
 }
 
