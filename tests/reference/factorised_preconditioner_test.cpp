@@ -12,7 +12,7 @@
 #include "host/reference/conjugate_gradient.h"
 #include "host/reference/implicit_euler.h"
 #include "host/reference/reference_simulation.h"
-#include "tests/reference/structured_mesh.h"
+#include "tests/reference/held_box_system.h"
 
 namespace sigmafem {
 namespace {
@@ -32,19 +32,9 @@ class FactorisedPreconditionerTest : public ::testing::Test {
   }
   Eigen::Vector3d so(int step) const { return test::held_box_so(held_.model, step * held_.model.dt); }
   // The next step's system of `simulation` and a right-hand side for it.
-  struct System {
-    std::vector<Frame> frames;
-    Eigen::VectorXd springs, b;
-    std::unique_ptr<ImplicitEulerSystem> A;
-  };
+  using System = test::HeldBoxSystem;
   System next_system(const ReferenceSimulation& simulation, int step) const {
-    System s;
-    element_frames(held_.model, simulation.positions(), s.frames);
-    s.springs = simulation.node_springs();
-    s.A = std::make_unique<ImplicitEulerSystem>(held_.model, s.frames, s.springs);
-    s.b = s.A->right_hand_side(simulation.forces(simulation.positions(), s.frames, so(step)),
-                               simulation.velocities());
-    return s;
+    return test::held_box_system(held_, simulation, step);
   }
   test::HeldBox held_;
   std::unique_ptr<ReferenceSimulation> simulation_;
