@@ -93,6 +93,13 @@ Eigen::SparseMatrix<double> DeviceEnsemble::sigma_system(int s, const Eigen::Vec
   return system_at(theta, effects_.empty() ? PhysicsEffects{} : effects_.at(static_cast<std::size_t>(s)), x, v);
 }
 
+std::vector<double> DeviceEnsemble::representative_ligament_k() const {
+  std::vector<double> k = ligament_k_;
+  if (theta_.size() > 0)
+    parameters_from_theta(model_, estimated_, Eigen::MatrixXd(theta_.rowwise().mean().replicate(1, S_)), S_, k);
+  return k;
+}
+
 Eigen::SparseMatrix<double> DeviceEnsemble::representative_system() const {
   const std::size_t rows = 3 * static_cast<std::size_t>(nodes_);
   const auto mean = [&](DeviceBuffer buffer) -> Eigen::VectorXd {

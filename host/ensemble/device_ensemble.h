@@ -96,6 +96,9 @@ class DeviceEnsemble : public SimulationEnsemble {
   Eigen::SparseMatrix<double> sigma_system(int s, const Eigen::VectorXd& x, const Eigen::VectorXd& v) const;
   // The same at the sigma points' mean state.
   Eigen::SparseMatrix<double> representative_system() const;
+  // ligament_k_ with every sigma point's estimated ligaments at the representative's
+  // stiffnesses (the sigma points' mean log-stiffnesses, as representative_system has them).
+  std::vector<double> representative_ligament_k() const;
   // The step's solver report from CG's per-sigma results; notes the iterations for the next
   // step's first batch.
   StepReport step_report(const std::vector<std::int32_t>& iterations,

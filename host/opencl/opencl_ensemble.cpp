@@ -114,7 +114,7 @@ OpenClEnsemble::OpenClEnsemble(const Model& model, EstimatedParameters estimated
     if (!springs_alone && S_ >= kOwnFactorsFromSigmaPoints &&
         static_cast<std::size_t>(S_) * factor_->nonzeros() * device_.real_size() <= options.own_factors_bytes)
       factor_copies_ = S_;
-    if (factor_copies_ == 1 && corrected) spring_rows_ = std::move(spring_rows);
+    if (factor_copies_ == 1 && corrected) springs_ = SpringCorrection(std::move(spring_rows));
     // The copies in the layout of the blocks that solve with them (conjugate_gradient.cl): cg_solve's
     // blocks of their own vectors one after the other, else all S interleaved.
     factor_block_ = whole_solve_ && solve_block_ < S_ ? solve_block_ : S_;
@@ -134,7 +134,7 @@ OpenClEnsemble::OpenClEnsemble(const Model& model, EstimatedParameters estimated
                         " -DSF_CG_PARTITIONS=" + std::to_string(cg_partitions_) +
                         " -DSF_FACTOR=" + std::to_string(factor_ ? 1 : 0) +
                         " -DSF_FACTOR_PER_SIGMA=" + std::to_string(factor_copies_ > 1 ? 1 : 0) +
-                        " -DSF_SPRING_ROWS=" + std::to_string(spring_rows_.size()) +
+                        " -DSF_SPRING_ROWS=" + std::to_string(springs_.size()) +
                         " -DSF_POLAR_FRAMES=" +
                         std::to_string(model_.material.rotation == ElementRotation::polar ? 1 : 0));
 
@@ -147,7 +147,7 @@ OpenClEnsemble::OpenClEnsemble(const Model& model, EstimatedParameters estimated
     const DeviceBufferSizes sizes{std::max<std::size_t>(element_chunks_, cg_solve_vectors) * dof,
                                   cg_partitions_,
                                   factor_ ? factor_->nonzeros() : 0, factor_copies_,
-                                  static_cast<int>(spring_rows_.size())};
+                                  springs_.size()};
     written_.resize(kDeviceBufferCount);
     write_done_.resize(written_.size());
     for (const DeviceBufferSpec& spec : buffer_specs(sizes)) {
@@ -276,7 +276,7 @@ std::vector<double> OpenClEnsemble::read_reals(DeviceBuffer id, std::size_t coun
 
 void OpenClEnsemble::upload_ligament_k() {
   write_reals(DeviceBuffer::ligament_k, ligament_k_);
-  coupling_stale_ = springs_.size() > 0;   // the springs' corrections follow the stiffnesses
+  coupling_stale_ = springs_.prepared();   // the springs' corrections follow the stiffnesses
 }
 
 void OpenClEnsemble::run(cl::Kernel& kernel, std::size_t items, std::size_t local) const {
@@ -394,7 +394,7 @@ void OpenClEnsemble::refresh_factor(const std::vector<double>& constants) {
     if (!factor_->factorise(A)) return fall_back_to_diagonal(A);
     const Eigen::SparseMatrix<double>& L = factor_->lower();
     values.assign(L.valuePtr(), L.valuePtr() + L.nonZeros());
-    if (!spring_rows_.empty()) prepare_spring_correction(constants);
+    if (springs_.size() > 0) prepare_spring_correction(constants);
   } else {
     // Each sigma point's own system at its own state, factorised on the same analysis (the
     // pattern is the assembly's, the same for all).
@@ -430,23 +430,17 @@ std::vector<double> OpenClEnsemble::spring_diagonal(const std::vector<double>& c
   for (int l : estimated_.ligaments)
     for (int node : model_.ligaments[static_cast<std::size_t>(l)].nodes)
       node_k[static_cast<std::size_t>(node)] += ligament_k[static_cast<std::size_t>(l) * S_ + s];
-  std::vector<double> diagonal(spring_rows_.size());
-  for (std::size_t j = 0; j < spring_rows_.size(); ++j)
-    diagonal[j] = factor * node_k[static_cast<std::size_t>(spring_rows_[j] / 3)];
+  const std::vector<int>& rows = springs_.rows();
+  std::vector<double> diagonal(rows.size());
+  for (std::size_t j = 0; j < rows.size(); ++j) diagonal[j] = factor * node_k[static_cast<std::size_t>(rows[j] / 3)];
   return diagonal;
 }
 
 void OpenClEnsemble::prepare_spring_correction(const std::vector<double>& constants) {
-  springs_.prepare(*factor_, spring_rows_);
-  // The representative's springs: the sigma points' mean log-stiffnesses (as
-  // representative_system), and sigma point 0's stiffness factor (its effects).
-  std::vector<double> mean_k = ligament_k_;
-  for (int l : estimated_.ligaments) {
-    double log_sum = 0.0;
-    for (int s = 0; s < S_; ++s) log_sum += std::log(ligament_k_[static_cast<std::size_t>(l) * S_ + s]);
-    for (int s = 0; s < S_; ++s) mean_k[static_cast<std::size_t>(l) * S_ + s] = std::exp(log_sum / S_);
-  }
-  factorised_springs_ = spring_diagonal(constants, 0, mean_k);
+  springs_.prepare(*factor_);
+  // The representative's springs, with sigma point 0's stiffness factor (its effects, as
+  // representative_system has them).
+  factorised_springs_ = spring_diagonal(constants, 0, representative_ligament_k());
   const std::vector<int>& reached = springs_.reached();
   std::vector<int> at = {static_cast<int>(reached.size())};
   at.insert(at.end(), reached.begin(), reached.end());
@@ -460,7 +454,7 @@ void OpenClEnsemble::prepare_spring_correction(const std::vector<double>& consta
 }
 
 void OpenClEnsemble::upload_spring_coupling(const std::vector<double>& constants) {
-  const std::size_t m = spring_rows_.size();
+  const std::size_t m = static_cast<std::size_t>(springs_.size());
   std::vector<double> couplings(m * m * static_cast<std::size_t>(S_));
   for (int s = 0; s < S_; ++s) {
     const std::vector<double> own = spring_diagonal(constants, s, ligament_k_);

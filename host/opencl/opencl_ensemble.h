@@ -81,8 +81,8 @@ class OpenClEnsemble : public DeviceEnsemble {
   // system that is not positive definite, uploads the representative's diagonal instead
   // (upload_diagonal_factor).
   void refresh_factor(const std::vector<double>& constants);
-  // The spring correction of a fresh shared factor (SpringCorrection): W and the rows' places
-  // go down, and the representative's springs are kept for the couplings.
+  // The spring correction of a fresh shared factor (SpringCorrection): V at the rows it
+  // reaches goes down, and the representative's springs are kept for the couplings.
   void prepare_spring_correction(const std::vector<double>& constants);
   // Each sigma point's coupling H for its springs against the representative's.
   void upload_spring_coupling(const std::vector<double>& constants);
@@ -125,14 +125,14 @@ class OpenClEnsemble : public DeviceEnsemble {
   // (s / block) nonzeros block + k block + s % block (factor_value_index).
   int factor_block_ = 1;
   std::size_t factor_value_index(int s, std::size_t k, std::size_t nonzeros) const;
-  // What the factor's buffers hold: nothing yet, the diagonal stand-in, or a factor (whose
-  // pattern and ordering later refreshes keep).
-  // The spring rows the shared factor is corrected at (empty: none), the correction, the
-  // representative's diagonal there when factorised, and whether the couplings are out of date.
-  std::vector<int> spring_rows_;
+  // The shared factor's correction for the sigma points' springs (no rows: none), the
+  // representative's diagonal at its rows when factorised, and whether the couplings are out
+  // of date.
   SpringCorrection springs_;
   std::vector<double> factorised_springs_;
   bool coupling_stale_ = false;
+  // What the factor's buffers hold: nothing yet, the diagonal stand-in, or a factor (whose
+  // pattern and ordering later refreshes keep).
   enum class FactorOnDevice { none, diagonal, factor };
   FactorOnDevice on_device_ = FactorOnDevice::none;
 

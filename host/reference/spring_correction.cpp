@@ -17,8 +17,7 @@ std::vector<int> estimated_spring_rows(const Model& model, const EstimatedParame
   return rows;
 }
 
-void SpringCorrection::prepare(const FactorisedPreconditioner& factor, const std::vector<int>& rows) {
-  rows_ = rows;
+void SpringCorrection::prepare(const FactorisedPreconditioner& factor) {
   const Eigen::SparseMatrix<double>& L = factor.lower();
   const Eigen::Index n = L.rows();
   const Eigen::Index m = static_cast<Eigen::Index>(rows_.size());
@@ -38,6 +37,7 @@ void SpringCorrection::prepare(const FactorisedPreconditioner& factor, const std
   values_.resize(static_cast<Eigen::Index>(reached_.size()), m);
   for (std::size_t u = 0; u < reached_.size(); ++u) values_.row(static_cast<Eigen::Index>(u)) = V.row(reached_[u]);
   gathered_ = values_.transpose() * values_;
+  prepared_ = true;
 }
 
 Eigen::MatrixXd SpringCorrection::coupling(const Eigen::VectorXd& delta) const {

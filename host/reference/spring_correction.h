@@ -31,8 +31,12 @@ std::vector<int> estimated_spring_rows(const Model& model, const EstimatedParame
 
 class SpringCorrection {
  public:
-  // V = L^-1 P E and G = V^T V for the factor (ready) and the m rows `rows` of A.
-  void prepare(const FactorisedPreconditioner& factor, const std::vector<int>& rows);
+  // At the m rows `rows` of A (none: no correction).
+  explicit SpringCorrection(std::vector<int> rows = {}) : rows_(std::move(rows)) {}
+  // V = L^-1 P E and G = V^T V for the factor (ready).
+  void prepare(const FactorisedPreconditioner& factor);
+  bool prepared() const { return prepared_; }
+  const std::vector<int>& rows() const { return rows_; }
   int size() const { return static_cast<int>(rows_.size()); }
   // The rows of L (in L's order, increasing) where some column of V is not zero, and V there:
   // reached()[u]'s row of V is reached_values().row(u) (reached rows x m).
@@ -51,6 +55,7 @@ class SpringCorrection {
   std::vector<int> reached_;
   Eigen::MatrixXd values_;    // V at the reached rows
   Eigen::MatrixXd gathered_;  // G = V^T V, m x m
+  bool prepared_ = false;
 };
 
 }  // namespace sigmafem

@@ -30,7 +30,8 @@ class SpringCorrectionTest : public ::testing::Test {
     ASSERT_TRUE(factor_.factorise(simulation_->system_matrix()));
     for (int node : held_.model.ligaments[0].nodes)
       for (int k = 0; k < 3; ++k) rows_.push_back(3 * node + k);
-    correction_.prepare(factor_, rows_);
+    correction_ = SpringCorrection(rows_);
+    correction_.prepare(factor_);
   }
   Eigen::Vector3d so(int step) const { return test::held_box_so(held_.model, step * held_.model.dt); }
   // The simulation's next system with the ligament `scale` times as stiff, and a right-hand
