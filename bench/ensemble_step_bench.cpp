@@ -61,9 +61,10 @@ const Backend kOpenClWholeSolve{"opencl", Precision::single,
                                 "opencl single, device 0, CG solve in one launch",
                                 SolveLaunch::whole_solve};
 // OpenCL as it runs by default on a CPU device: its CPU form with sparse Cholesky factors as
-// CG's preconditioner (issue 18): each sigma point's own where their copies stay small
-// (DeviceOptions::own_factors_bytes), else one of the mean sigma point's system; and with the
-// shared one forced, as before stop 49.
+// CG's preconditioner (issue 18): one of the mean sigma point's system, corrected for each
+// sigma point's springs (stop 51), or each sigma point's own where they differ by more (region
+// moduli) and their copies stay small (DeviceOptions::own_factors_bytes); and with the shared
+// one forced, as before stop 49.
 const Backend kOpenClFactorised{"opencl", Precision::single,
                                 "opencl single, device 0, factors",
                                 SolveLaunch::automatic, Preconditioner::factorised};
