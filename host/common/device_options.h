@@ -50,6 +50,9 @@ inline bool spring_correction_fits(std::size_t spring_rows, int sigma_count) {
   return spring_rows > 0 && spring_rows * static_cast<std::size_t>(sigma_count) <= kSpringRowsTimesSigmaPoints;
 }
 
+// DeviceOptions::node_iteration_work's default, measured on lavapipe (bench/RESULTS.md, stop 52).
+constexpr long long kNodeIterationWork = 32768;
+
 struct DeviceOptions {
   int device = 0;                   // index in `sigmafem devices`' list for the back end
   Precision precision = Precision::single;
@@ -69,6 +72,10 @@ struct DeviceOptions {
   // ligaments' rows (host/reference/spring_correction.h) where that is small enough; false:
   // the factor alone (tests and benchmarks compare).
   bool spring_correction = true;
+  // Vulkan with one CG partition forms q = A d inside its CG iteration shader (two dispatches
+  // an iteration instead of three: cg_node_iteration, kernels/vulkan/conjugate_gradient.comp)
+  // up to this many element-sigma pairs (elements x S); 0: never (tests compare).
+  long long node_iteration_work = kNodeIterationWork;
   // The CPU back end's worker threads: 0, the machine's cores (over MPI ranks, shared among
   // the ranks on one machine: estimation_job.cpp).
   int cpu_threads = 0;

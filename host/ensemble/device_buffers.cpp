@@ -208,7 +208,7 @@ const std::vector<DeviceBuffer>& kernel_buffers(DeviceKernel kernel) {
                {SF_CG_START_CONVERGED, B::converged}, {SF_CG_START_ITERATIONS, B::iterations},
                {SF_CG_START_PARTIAL, B::partial}, {SF_CG_START_OWN_ACTIVE, B::own_active},
                {SF_CG_START_OWN_ITERATIONS, B::own_iterations}, {SF_CG_START_OWN_RZ, B::own_rz}}),
-      // Vulkan's cg_iteration, cg_dot, cg_update, cg_direction
+      // Vulkan's cg_iteration, cg_node_iteration, cg_dot, cg_update, cg_direction
       by_slot({{SF_CG_ITERATION_CONSTANTS, B::constants},
                {SF_CG_ITERATION_INVERSE_DIAGONAL, B::inverse_diagonal},
                {SF_CG_ITERATION_DV, B::dv}, {SF_CG_ITERATION_R, B::r}, {SF_CG_ITERATION_Z, B::z},
@@ -218,7 +218,13 @@ const std::vector<DeviceBuffer>& kernel_buffers(DeviceKernel kernel) {
                {SF_CG_ITERATION_ITERATIONS, B::iterations}, {SF_CG_ITERATION_PARTIAL, B::partial},
                {SF_CG_ITERATION_OWN_ACTIVE, B::own_active},
                {SF_CG_ITERATION_OWN_ITERATIONS, B::own_iterations},
-               {SF_CG_ITERATION_OWN_RZ, B::own_rz}}),
+               {SF_CG_ITERATION_OWN_RZ, B::own_rz},
+               {SF_CG_ITERATION_INCIDENCE_OFFSETS, B::incidence_offsets},
+               {SF_CG_ITERATION_INCIDENCE, B::incidence},
+               {SF_CG_ITERATION_LIGAMENT_OFFSETS, B::ligament_offsets},
+               {SF_CG_ITERATION_LIGAMENT_OF_NODE, B::ligament_of_node},
+               {SF_CG_ITERATION_LIGAMENT_K, B::ligament_k}, {SF_CG_ITERATION_CONTROL_K, B::control_k},
+               {SF_CG_ITERATION_MASS, B::mass}, {SF_CG_ITERATION_ELEMENT_OUT, B::element_out}}),
   };
 #undef SF_NODE_ROW_SLOTS
   return table[static_cast<std::size_t>(kernel)];

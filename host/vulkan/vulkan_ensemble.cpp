@@ -84,7 +84,16 @@ VulkanEnsemble::VulkanEnsemble(const Model& model, EstimatedParameters estimated
     return device_.kernel(name, static_cast<int>(buffers.size()), cg_group_, partitions);
   };
   k_cg_start_ = cg_kernel("cg_start", start);
-  k_cg_iteration_ = cg_kernel("cg_iteration", iteration);
+  // One partition on a small mesh: two dispatches an iteration (cg_node_iteration forms q = A d
+  // itself), where lavapipe's cost per dispatch outweighs their work; on a larger one the
+  // three, where node_product's lanes (a node's sigma points) gather faster than
+  // cg_node_iteration's (a sigma point's nodes) (bench/RESULTS.md, stop 52).
+  node_iteration_ = cg_partitions_ == 1 &&
+                    static_cast<long long>(elements_) * S_ <= options.node_iteration_work;
+  if (node_iteration_)
+    k_cg_node_iteration_ = cg_kernel("cg_node_iteration", iteration);
+  else if (cg_partitions_ == 1)
+    k_cg_iteration_ = cg_kernel("cg_iteration", iteration);
   if (cg_partitions_ > 1) {
     k_cg_start_partials_ = cg_kernel("cg_start_partials", start);
     k_cg_start_scalars_ = cg_kernel("cg_start_scalars", start);
@@ -102,7 +111,10 @@ VulkanEnsemble::VulkanEnsemble(const Model& model, EstimatedParameters estimated
   s_product_all_ = bind(k_element_product_, with_buffer(product, B::active, B::all_active));
   s_node_product_ = bind(k_node_product_, kernel_buffers(DeviceKernel::node_product));
   s_cg_start_ = bind(k_cg_start_, start);
-  s_cg_iteration_ = bind(k_cg_iteration_, iteration);
+  if (node_iteration_)
+    s_cg_node_iteration_ = bind(k_cg_node_iteration_, iteration);
+  else if (cg_partitions_ == 1)
+    s_cg_iteration_ = bind(k_cg_iteration_, iteration);
   if (cg_partitions_ > 1) {
     s_cg_start_partials_ = bind(k_cg_start_partials_, start);
     s_cg_start_scalars_ = bind(k_cg_start_scalars_, start);
@@ -192,14 +204,19 @@ void VulkanEnsemble::record_cg_iterations(VkCommandBuffer cmd, int count) const 
   push.max_iterations = model_.solver.cg_max_iterations;
   const std::uint32_t groups = static_cast<std::uint32_t>(S_ * cg_partitions_);
   for (int i = 0; i < count; ++i) {
-    record_system_product(cmd, s_product_cg_);
-    if (cg_partitions_ > 1) {
+    if (node_iteration_) {
+      dispatch_items(cmd, k_element_product_, s_product_cg_, elements_ * static_cast<std::size_t>(S_),
+                     elements_);
+      device_.dispatch(cmd, k_cg_node_iteration_, s_cg_node_iteration_, &push, groups);
+    } else if (cg_partitions_ > 1) {
+      record_system_product(cmd, s_product_cg_);
       device_.dispatch(cmd, k_cg_dot_, s_cg_dot_, &push, groups);
       device_.barrier(cmd);
       device_.dispatch(cmd, k_cg_update_, s_cg_update_, &push, groups);
       device_.barrier(cmd);
       device_.dispatch(cmd, k_cg_direction_, s_cg_direction_, &push, groups);
     } else {
+      record_system_product(cmd, s_product_cg_);
       device_.dispatch(cmd, k_cg_iteration_, s_cg_iteration_, &push, groups);
     }
     device_.barrier(cmd);

@@ -50,6 +50,8 @@ class VulkanEnsemble : public DeviceEnsemble {
   const VulkanDeviceInfo& device_info() const { return device_.info(); }
   // Whether the shaders read their read-only arrays through texel buffers (the CPU form).
   bool texel_reads() const { return device_.texel_reads(); }
+  // Whether a CG iteration is two dispatches (cg_node_iteration forms q = A d), not three.
+  bool node_iteration() const { return node_iteration_; }
   // Host waits (command-buffer submissions) of the last advance().
   int last_step_waits() const { return last_step_waits_; }
 
@@ -85,6 +87,7 @@ class VulkanEnsemble : public DeviceEnsemble {
   mutable VulkanDevice device_;
   std::uint32_t cg_group_ = 64;              // work-items per sigma point in the CG shaders
   int cg_partitions_ = 1;                    // work-groups per sigma point in them (constant 1)
+  bool node_iteration_ = false;              // CG iterations by element_product and cg_node_iteration
   int last_step_waits_ = 0;
   // The observations gathered at the end of the last advance(), until recenter() moves x.
   mutable std::vector<double> observations_cache_;
@@ -100,6 +103,7 @@ class VulkanEnsemble : public DeviceEnsemble {
   VulkanKernel k_element_rhs_, k_node_rhs_, k_element_product_, k_node_product_;
   VulkanKernel k_cg_start_, k_cg_iteration_, k_state_update_, k_observation_gather_, k_recenter_;
   VulkanKernel k_cg_start_partials_, k_cg_start_scalars_, k_cg_dot_, k_cg_update_, k_cg_direction_;
+  VulkanKernel k_cg_node_iteration_;
   // Descriptor sets; element_product has three: the warm start's product (dv, all active),
   // the CG product (d, the active flags) and system_product()'s (d, all active).
   VkDescriptorSet s_element_rhs_ = VK_NULL_HANDLE, s_node_rhs_ = VK_NULL_HANDLE;
@@ -110,7 +114,7 @@ class VulkanEnsemble : public DeviceEnsemble {
   VkDescriptorSet s_recenter_ = VK_NULL_HANDLE;
   VkDescriptorSet s_cg_start_partials_ = VK_NULL_HANDLE, s_cg_start_scalars_ = VK_NULL_HANDLE;
   VkDescriptorSet s_cg_dot_ = VK_NULL_HANDLE, s_cg_update_ = VK_NULL_HANDLE;
-  VkDescriptorSet s_cg_direction_ = VK_NULL_HANDLE;
+  VkDescriptorSet s_cg_direction_ = VK_NULL_HANDLE, s_cg_node_iteration_ = VK_NULL_HANDLE;
 };
 
 }  // namespace sigmafem

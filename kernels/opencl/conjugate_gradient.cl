@@ -138,7 +138,7 @@ void cg_iteration(uint S, uint node_count, int max_iterations, __global const re
     SF_UNROLL
     for (int k = 0; k < 3; ++k) {
       size_t row = ((size_t)3 * n + k) * S + s;
-      SF_CG_UPDATE_ROW(row, alpha, x, r, z, d, q, inverse_diagonal, sum_rr, sum_rz)
+      SF_CG_UPDATE_ROW(row, alpha, q[row], x, r, z, d, inverse_diagonal, sum_rr, sum_rz)
     }
   }
   sum_rr = sf_group_sum(scratch, sum_rr);
@@ -277,7 +277,7 @@ void cg_update(uint S, uint node_count, __global const real* inverse_diagonal, _
   real sum_rz = (real)0;
   for (uint row = begin + get_local_id(0); row < end; row += SF_GROUP_SIZE) {
     size_t at = (size_t)row * S + s;
-    SF_CG_UPDATE_ROW(at, alpha, x, r, z, d, q, inverse_diagonal, sum_rr, sum_rz)
+    SF_CG_UPDATE_ROW(at, alpha, q[at], x, r, z, d, inverse_diagonal, sum_rr, sum_rz)
   }
   sum_rr = sf_group_sum(scratch, sum_rr);
   sum_rz = sf_group_sum(scratch, sum_rz);
@@ -569,7 +569,7 @@ static inline __attribute__((always_inline)) int sf_block_cg_iteration(
   for (uint row = 0; row < rows; ++row) {
     for (uint i = 0; i < count; ++i) {
       size_t at = (size_t)row * S + first + i;
-      SF_CG_UPDATE_ROW(at, alpha[i], x, r, z, d, q, inverse_diagonal, rr_new[i], rz_new[i])
+      SF_CG_UPDATE_ROW(at, alpha[i], q[at], x, r, z, d, inverse_diagonal, rr_new[i], rz_new[i])
     }
   }
 #endif

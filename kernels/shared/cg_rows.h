@@ -24,11 +24,12 @@
     sum_rz += ri_ * zi_;                                                                       \
   }
 
-/* An iteration's row, with q = A d there: x += alpha d, r -= alpha q, z = M^-1 r; r.r, r.z. */
-#define SF_CG_UPDATE_ROW(at, alpha, x_, r_, z_, d_, q_, inverse_diagonal_, sum_rr, sum_rz) \
+/* An iteration's row, with q = A d there (q_value: its value at the row): x += alpha d,
+ * r -= alpha q, z = M^-1 r; r.r, r.z. */
+#define SF_CG_UPDATE_ROW(at, alpha, q_value, x_, r_, z_, d_, inverse_diagonal_, sum_rr, sum_rz) \
   {                                                                                       \
     x_[at] += (alpha) * d_[at];                                                           \
-    SF_REAL ri_ = r_[at] - (alpha) * SF_LOAD(q_, at);                                     \
+    SF_REAL ri_ = r_[at] - (alpha) * (q_value);                                           \
     SF_REAL zi_ = SF_LOAD(inverse_diagonal_, at) * ri_;                                   \
     r_[at] = ri_;                                                                         \
     z_[at] = zi_;                                                                         \

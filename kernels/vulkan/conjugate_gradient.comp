@@ -4,6 +4,11 @@
  * Compiled once per entry point (cmake/compile_glsl.cmake):
  *   -DSF_ENTRY_CG_START      cg_start:     the warm start's residual and first direction
  *   -DSF_ENTRY_CG_ITERATION  cg_iteration: one iteration after the product q = A d
+ *   -DSF_ENTRY_CG_NODE_ITERATION  cg_node_iteration: the same after element_product alone,
+ *                            forming q = A d itself from the element outputs (node_product's
+ *                            rows): two dispatches an iteration instead of three, with one
+ *                            partition, where lavapipe's cost per dispatch outweighs the
+ *                            work (VulkanEnsemble)
  * and, for partitions (below), cg_start_partials and cg_start_scalars for cg_start, and
  * cg_dot, cg_update and cg_direction for cg_iteration.
  *
@@ -183,7 +188,24 @@ layout(std430, binding = SF_CG_ITERATION_DV) restrict buffer X { real x[]; };
 layout(std430, binding = SF_CG_ITERATION_R) restrict buffer R { real r[]; };
 layout(std430, binding = SF_CG_ITERATION_Z) restrict buffer Z { real z[]; };
 layout(std430, binding = SF_CG_ITERATION_D) restrict buffer D { real d[]; };
+#  if defined(SF_ENTRY_CG_NODE_ITERATION)
+/* q is this shader's own (each work-item writes and reads its rows); the node rows' buffers
+ * (node_rows.h) and the element outputs are read. */
+#    include "node_rows.h"
+layout(std430, binding = SF_CG_ITERATION_Q) restrict buffer Q { real q[]; };
+#    define SF_Q(row) q[row]
+SF_READ_INTS(SF_CG_ITERATION_INCIDENCE_OFFSETS, incidence_offsets)
+SF_READ_INTS(SF_CG_ITERATION_INCIDENCE, incidence)
+SF_READ_INTS(SF_CG_ITERATION_LIGAMENT_OFFSETS, ligament_offsets)
+SF_READ_INTS(SF_CG_ITERATION_LIGAMENT_OF_NODE, ligament_of_node)
+SF_READ_REALS(SF_CG_ITERATION_LIGAMENT_K, ligament_k)
+SF_READ_REALS(SF_CG_ITERATION_CONTROL_K, control_k)
+SF_READ_REALS(SF_CG_ITERATION_MASS, mass)
+SF_READ_REALS(SF_CG_ITERATION_ELEMENT_OUT, element_out)
+#  else
 SF_READ_REALS(SF_CG_ITERATION_Q, q)
+#    define SF_Q(row) SF_LOAD(q, row)
+#  endif
 SF_READ_REALS(SF_CG_ITERATION_BB, bb)
 layout(std430, binding = SF_CG_ITERATION_RR) restrict buffer RR { real rr[]; };
 layout(std430, binding = SF_CG_ITERATION_RZ) restrict buffer RZ { real rz[]; };
@@ -198,11 +220,24 @@ layout(std430, binding = SF_CG_ITERATION_OWN_RZ) restrict buffer OwnRz { real ow
 /* The group's d.q over nodes [begin, end) of sigma point s. */
 real sf_dq_rows(uint s, uint S, uint begin, uint end) {
   real sum_dq = real(0);
-  for (uint n = begin + gl_LocalInvocationID.x; n < end; n += gl_WorkGroupSize.x)
+  for (uint n = begin + gl_LocalInvocationID.x; n < end; n += gl_WorkGroupSize.x) {
+#  if defined(SF_ENTRY_CG_NODE_ITERATION)
+    /* q = A d at the node's rows first, as node_product forms it. */
+    real spring;
+    SF_NODE_SPRING(ligament_offsets, ligament_of_node, ligament_k, control_k, n, s, S, spring)
+    real m = sf_solver_mass(SF_LOAD(mass, n), spring);
+    real Kd[3];
+    SF_CORNER_SUMS(element_out, incidence_offsets, incidence, n, s, S, Kd)
     for (uint k = 0u; k < 3u; ++k) {
       uint row = (3u * n + k) * S + s;
-      sum_dq += d[row] * SF_LOAD(q, row);
+      q[row] = SF_SYSTEM_ROW(c, s, S, Kd[k], spring, m, d[row]);
     }
+#  endif
+    for (uint k = 0u; k < 3u; ++k) {
+      uint row = (3u * n + k) * S + s;
+      sum_dq += d[row] * SF_Q(row);
+    }
+  }
   return sf_group_sum(sum_dq);
 }
 
@@ -214,7 +249,7 @@ void sf_update_rows(uint s, uint S, uint begin, uint end, real alpha, out real s
   for (uint n = begin + gl_LocalInvocationID.x; n < end; n += gl_WorkGroupSize.x)
     for (uint k = 0u; k < 3u; ++k) {
       uint row = (3u * n + k) * S + s;
-      SF_CG_UPDATE_ROW(row, alpha, x, r, z, d, q, inverse_diagonal, sum_rr, sum_rz)
+      SF_CG_UPDATE_ROW(row, alpha, SF_Q(row), x, r, z, d, inverse_diagonal, sum_rr, sum_rz)
     }
   sum_rr = sf_group_sum(sum_rr);
   sum_rz = sf_group_sum(sum_rz);
@@ -246,7 +281,7 @@ void sf_store_scalars(uint s, int count, real sum_rr, real sum_rz, bool done, bo
   if (stop) active_flags[s] = 0u;
 }
 
-#  if defined(SF_ENTRY_CG_ITERATION)
+#  if defined(SF_ENTRY_CG_ITERATION) || defined(SF_ENTRY_CG_NODE_ITERATION)
 /* alpha = rz / d.q, x += alpha d, r -= alpha q, z = M^-1 r, then the stop test and
  * d = z + beta d. */
 void main() {

@@ -5,6 +5,7 @@
 
 #include <gtest/gtest.h>
 
+#include <cmath>
 #include <cstdint>
 #include <cstdlib>
 #include <string>
@@ -176,6 +177,38 @@ TEST_F(VulkanDeviceTest, TheProfileListsEveryShadersDispatches) {
     EXPECT_NE(printed.find(shader), std::string::npos) << shader << "\n" << printed;
   EXPECT_NE(printed.find("between dispatches"), std::string::npos) << printed;
   EXPECT_EQ(printed.find("nan"), std::string::npos) << printed;
+}
+
+// CG in two dispatches an iteration (cg_node_iteration forms q = A d from the element
+// products) does what node_product and cg_iteration do, in the same order: the same bits.
+TEST_F(VulkanDeviceTest, CgInTwoDispatchesGivesTheBitsOfThree) {
+  const Scenario scenario = load_scenario(std::string(SIGMAFEM_SOURCE_DIR) + "/scenarios/box.json");
+  const Model model = make_model(scenario);
+  const std::vector<int>& estimated = scenario.filter->estimate;
+  const int p = static_cast<int>(estimated.size()), S = p + 1;
+  Eigen::MatrixXd theta(p, S);
+  for (int j = 0; j < p; ++j)
+    for (int s = 0; s < S; ++s)
+      theta(j, s) = std::log(model.ligaments[estimated[j]].stiffness) + 0.3 * std::cos(s + 2 * j);
+  DeviceOptions three;
+  three.node_iteration_work = 0;
+  VulkanEnsemble two_dispatches(model, estimated, scenario.observations.nodes, S, DeviceOptions{});
+  VulkanEnsemble three_dispatches(model, estimated, scenario.observations.nodes, S, three);
+  ASSERT_TRUE(two_dispatches.node_iteration()) << "the box at S = 4 takes two dispatches by default";
+  ASSERT_FALSE(three_dispatches.node_iteration());
+  two_dispatches.set_parameters(theta);
+  three_dispatches.set_parameters(theta);
+  for (int k = 1; k <= 8; ++k) {
+    const Eigen::Vector3d so = scenario.control.trajectory.position(k * scenario.time.dt, scenario.control.start);
+    const StepReport a = two_dispatches.advance(so);
+    const StepReport b = three_dispatches.advance(so);
+    EXPECT_EQ(a.unconverged_count(), 0);
+    EXPECT_EQ(a.cg_iterations, b.cg_iterations) << "step " << k;
+  }
+  for (int s = 0; s < S; ++s) {
+    EXPECT_TRUE(two_dispatches.positions(s) == three_dispatches.positions(s)) << "sigma point " << s;
+    EXPECT_TRUE(two_dispatches.velocities(s) == three_dispatches.velocities(s)) << "sigma point " << s;
+  }
 }
 
 // The form of the shaders: the CPU form (texel reads) on a CPU device by default or when asked,
