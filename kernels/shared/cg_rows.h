@@ -27,14 +27,14 @@
 /* An iteration's row, with q = A d there (q_value: its value at the row): x += alpha d,
  * r -= alpha q, z = M^-1 r; r.r, r.z. */
 #define SF_CG_UPDATE_ROW(at, alpha, q_value, x_, r_, z_, d_, inverse_diagonal_, sum_rr, sum_rz) \
-  {                                                                                       \
-    x_[at] += (alpha) * d_[at];                                                           \
-    SF_REAL ri_ = r_[at] - (alpha) * (q_value);                                           \
-    SF_REAL zi_ = SF_LOAD(inverse_diagonal_, at) * ri_;                                   \
-    r_[at] = ri_;                                                                         \
-    z_[at] = zi_;                                                                         \
-    sum_rr += ri_ * ri_;                                                                  \
-    sum_rz += ri_ * zi_;                                                                  \
+  {                                                                                             \
+    x_[at] += (alpha) * d_[at];                                                                 \
+    SF_REAL ri_ = r_[at] - (alpha) * (q_value);                                                 \
+    SF_REAL zi_ = SF_LOAD(inverse_diagonal_, at) * ri_;                                         \
+    r_[at] = ri_;                                                                               \
+    z_[at] = zi_;                                                                               \
+    sum_rr += ri_ * ri_;                                                                        \
+    sum_rz += ri_ * zi_;                                                                        \
   }
 
 /* After the warm start: an overflowed load (|b|^2 not finite) would pass the stop test as
