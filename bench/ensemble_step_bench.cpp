@@ -38,6 +38,7 @@ struct Backend {
   int cg_partitions = 0;        // OpenCL's GPU form: CG work-groups per sigma point (0: by mesh)
   KernelForm kernel_form = KernelForm::automatic;
   bool spring_correction = true;   // OpenCL's shared factor corrected for the sigma points' springs
+  long long node_iteration_work = kNodeIterationWork;   // Vulkan: CG in two dispatches up to it
 };
 
 // The CPU back end with its default preconditioner (factors: one per sigma point within
@@ -80,6 +81,12 @@ const Backend kOpenClUncorrectedFactor{"opencl", Precision::single,
 const Backend kOpenClOneGroup{"opencl", Precision::single,
                               "opencl single, device 0, CG a work-group per sigma point",
                               SolveLaunch::automatic, Preconditioner::jacobi, false, 1};
+// Vulkan's CG in three dispatches an iteration (node_product apart) where it would take two
+// (cg_node_iteration, stop 52), to compare them.
+const Backend kVulkanThreeDispatches{"vulkan", Precision::single,
+                                     "vulkan single, device 0, CG in three dispatches an iteration",
+                                     SolveLaunch::automatic, Preconditioner::jacobi, false, 0,
+                                     KernelForm::automatic, true, 0};
 const Backend kVulkanOneGroup{"vulkan", Precision::single,
                               "vulkan single, device 0, CG a work-group per sigma point",
                               SolveLaunch::automatic, Preconditioner::jacobi, false, 1};
@@ -100,6 +107,7 @@ DeviceOptions device_options(const Backend& backend) {
   options.kernel_form = backend.kernel_form;
   if (backend.shared_factor) options.own_factors_bytes = 0;
   options.spring_correction = backend.spring_correction;
+  options.node_iteration_work = backend.node_iteration_work;
   return options;
 }
 
@@ -320,6 +328,9 @@ BENCHMARK_CAPTURE(BM_ensemble_step, opencl_one_group_liver_4768, kOpenClOneGroup
 BENCHMARK_CAPTURE(BM_ensemble_step, vulkan_one_group_liver_4768, kVulkanOneGroup,
                   std::string("liver"), 1)
     ->Arg(16)->Arg(64)->Unit(benchmark::kMillisecond)->UseRealTime();
+BENCHMARK_CAPTURE(BM_ensemble_step, vulkan_three_dispatches_liver_4768, kVulkanThreeDispatches,
+                  std::string("liver"), 1)
+    ->Arg(4)->Unit(benchmark::kMillisecond)->UseRealTime();
 BENCHMARK_CAPTURE(BM_ensemble_step, vulkan_liver_4768, kVulkan, std::string("liver"), 1)
     ->RangeMultiplier(2)->Range(1, 256)->Unit(benchmark::kMillisecond)->UseRealTime();
 BENCHMARK_CAPTURE(BM_ensemble_step, vulkan_texel_reads_liver_4768, kVulkanTexelReads, std::string("liver"), 1)
@@ -403,6 +414,8 @@ BENCHMARK_CAPTURE(BM_filter_step, opencl_uncorrected_factor, kOpenClUncorrectedF
 BENCHMARK_CAPTURE(BM_filter_step, opencl_per_iteration, kOpenClPerIteration, std::string("liver"))
     ->Unit(benchmark::kMillisecond)->UseRealTime();
 BENCHMARK_CAPTURE(BM_filter_step, opencl_whole_solve, kOpenClWholeSolve, std::string("liver"))
+    ->Unit(benchmark::kMillisecond)->UseRealTime();
+BENCHMARK_CAPTURE(BM_filter_step, vulkan_three_dispatches, kVulkanThreeDispatches, std::string("liver"))
     ->Unit(benchmark::kMillisecond)->UseRealTime();
 BENCHMARK_CAPTURE(BM_filter_step, vulkan, kVulkan, std::string("liver"))
     ->Unit(benchmark::kMillisecond)->UseRealTime();
