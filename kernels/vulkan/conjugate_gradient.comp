@@ -222,20 +222,23 @@ real sf_dq_rows(uint s, uint S, uint begin, uint end) {
   real sum_dq = real(0);
   for (uint n = begin + gl_LocalInvocationID.x; n < end; n += gl_WorkGroupSize.x) {
 #  if defined(SF_ENTRY_CG_NODE_ITERATION)
-    /* q = A d at the node's rows first, as node_product forms it. */
+    /* q = A d at the node's rows, as node_product forms it, kept for the update. */
     real spring;
     SF_NODE_SPRING(ligament_offsets, ligament_of_node, ligament_k, control_k, n, s, S, spring)
     real m = sf_solver_mass(SF_LOAD(mass, n), spring);
     real Kd[3];
     SF_CORNER_SUMS(element_out, incidence_offsets, incidence, n, s, S, Kd)
-    for (uint k = 0u; k < 3u; ++k) {
-      uint row = (3u * n + k) * S + s;
-      q[row] = SF_SYSTEM_ROW(c, s, S, Kd[k], spring, m, d[row]);
-    }
 #  endif
     for (uint k = 0u; k < 3u; ++k) {
       uint row = (3u * n + k) * S + s;
-      sum_dq += d[row] * SF_Q(row);
+      real d_row = d[row];
+#  if defined(SF_ENTRY_CG_NODE_ITERATION)
+      real q_row = SF_SYSTEM_ROW(c, s, S, Kd[k], spring, m, d_row);
+      q[row] = q_row;
+#  else
+      real q_row = SF_LOAD(q, row);
+#  endif
+      sum_dq += d_row * q_row;
     }
   }
   return sf_group_sum(sum_dq);
