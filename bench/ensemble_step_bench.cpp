@@ -87,6 +87,10 @@ const Backend kVulkanThreeDispatches{"vulkan", Precision::single,
                                      "vulkan single, device 0, CG in three dispatches an iteration",
                                      SolveLaunch::automatic, Preconditioner::jacobi, false, 0,
                                      KernelForm::automatic, true, 0};
+// Vulkan with one shared factor as CG's preconditioner (factor_solve.comp, stop 53), its
+// default on a CPU device since then; kVulkan is Jacobi, as the device rows' history.
+const Backend kVulkanFactorised{"vulkan", Precision::single, "vulkan single, device 0, one shared factor",
+                                SolveLaunch::automatic, Preconditioner::factorised};
 const Backend kVulkanOneGroup{"vulkan", Precision::single,
                               "vulkan single, device 0, CG a work-group per sigma point",
                               SolveLaunch::automatic, Preconditioner::jacobi, false, 1};
@@ -333,6 +337,8 @@ BENCHMARK_CAPTURE(BM_ensemble_step, vulkan_three_dispatches_liver_4768, kVulkanT
     ->Arg(4)->Unit(benchmark::kMillisecond)->UseRealTime();
 BENCHMARK_CAPTURE(BM_ensemble_step, vulkan_liver_4768, kVulkan, std::string("liver"), 1)
     ->RangeMultiplier(2)->Range(1, 256)->Unit(benchmark::kMillisecond)->UseRealTime();
+BENCHMARK_CAPTURE(BM_ensemble_step, vulkan_factorised_liver_4768, kVulkanFactorised, std::string("liver"), 1)
+    ->Arg(4)->Arg(16)->Unit(benchmark::kMillisecond)->UseRealTime();
 BENCHMARK_CAPTURE(BM_ensemble_step, vulkan_texel_reads_liver_4768, kVulkanTexelReads, std::string("liver"), 1)
     ->Arg(16)->Arg(64)->Unit(benchmark::kMillisecond)->UseRealTime();
 BENCHMARK_CAPTURE(BM_ensemble_step, vulkan_storage_reads_liver_4768, kVulkanStorageReads, std::string("liver"), 1)
@@ -356,6 +362,8 @@ BENCHMARK_CAPTURE(BM_ensemble_step, cpu_polar_liver_4768, kCpu, std::string("liv
 BENCHMARK_CAPTURE(BM_ensemble_step, opencl_liver_596, kOpenCl, std::string("liver"), 0)
     ->Arg(16)->Unit(benchmark::kMillisecond)->UseRealTime();
 BENCHMARK_CAPTURE(BM_ensemble_step, vulkan_liver_596, kVulkan, std::string("liver"), 0)
+    ->Arg(16)->Unit(benchmark::kMillisecond)->UseRealTime();
+BENCHMARK_CAPTURE(BM_ensemble_step, vulkan_factorised_liver_596, kVulkanFactorised, std::string("liver"), 0)
     ->Arg(16)->Unit(benchmark::kMillisecond)->UseRealTime();
 BENCHMARK_CAPTURE(BM_ensemble_step, cpu_liver_596, kCpu, std::string("liver"), 0)
     ->Arg(16)->Unit(benchmark::kMillisecond)->UseRealTime();
@@ -419,6 +427,8 @@ BENCHMARK_CAPTURE(BM_filter_step, vulkan_three_dispatches, kVulkanThreeDispatche
     ->Unit(benchmark::kMillisecond)->UseRealTime();
 BENCHMARK_CAPTURE(BM_filter_step, vulkan, kVulkan, std::string("liver"))
     ->Unit(benchmark::kMillisecond)->UseRealTime();
+BENCHMARK_CAPTURE(BM_filter_step, vulkan_factorised, kVulkanFactorised, std::string("liver"))
+    ->Unit(benchmark::kMillisecond)->UseRealTime();
 BENCHMARK_CAPTURE(BM_filter_step, vulkan_texel_reads, kVulkanTexelReads, std::string("liver"))
     ->Unit(benchmark::kMillisecond)->UseRealTime();
 BENCHMARK_CAPTURE(BM_filter_step, vulkan_storage_reads, kVulkanStorageReads, std::string("liver"))
@@ -454,6 +464,8 @@ BENCHMARK_CAPTURE(BM_cloud_observation, cpu, kCpu)->Arg(1000)->Unit(benchmark::k
 BENCHMARK_CAPTURE(BM_filter_step, opencl_liver_fine_38144, kOpenCl, std::string("liver_fine"))
     ->Iterations(20)->Unit(benchmark::kMillisecond)->UseRealTime();
 BENCHMARK_CAPTURE(BM_filter_step, vulkan_liver_fine_38144, kVulkan, std::string("liver_fine"))
+    ->Iterations(20)->Unit(benchmark::kMillisecond)->UseRealTime();
+BENCHMARK_CAPTURE(BM_filter_step, vulkan_factorised_liver_fine_38144, kVulkanFactorised, std::string("liver_fine"))
     ->Iterations(20)->Unit(benchmark::kMillisecond)->UseRealTime();
 BENCHMARK_CAPTURE(BM_filter_step, opencl_factorised_liver_fine_38144, kOpenClFactorised,
                   std::string("liver_fine"))

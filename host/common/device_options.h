@@ -52,6 +52,9 @@ inline bool spring_correction_fits(std::size_t spring_rows, int sigma_count) {
 
 // DeviceOptions::node_iteration_work's default, measured on lavapipe (bench/RESULTS.md, stop 52).
 constexpr long long kNodeIterationWork = 32768;
+// DeviceOptions::factor_loop_turns' default: under llvmpipe's 65535 loop turns an invocation
+// (kernels/vulkan/factor_solve.comp).
+constexpr long long kFactorLoopTurns = 61440;
 
 struct DeviceOptions {
   int device = 0;                   // index in `sigmafem devices`' list for the back end
@@ -76,6 +79,9 @@ struct DeviceOptions {
   // an iteration instead of three: cg_node_iteration, kernels/vulkan/conjugate_gradient.comp)
   // up to this many element-sigma pairs (elements x S); 0: never (tests compare).
   long long node_iteration_work = kNodeIterationWork;
+  // Vulkan with a factor: the loop turns of one factor_solve dispatch (each of L's entries
+  // and rows is one), below llvmpipe's limit; tests make it small to cut a solve into many.
+  long long factor_loop_turns = kFactorLoopTurns;
   // The CPU back end's worker threads: 0, the machine's cores (over MPI ranks, shared among
   // the ranks on one machine: estimation_job.cpp).
   int cpu_threads = 0;

@@ -21,9 +21,6 @@ std::unique_ptr<SimulationEnsemble> make_ensemble(const std::string& backend, co
   if (backend == "cpu")
     return std::make_unique<CpuEnsemble>(model, estimated, observed, sigma_count, options.cpu_threads,
                                          options.preconditioner);
-  if (options.preconditioner == Preconditioner::factorised && backend == "vulkan")
-    throw InputError("--preconditioner factorised: the cpu back end and OpenCL on a CPU device "
-                     "have it (the vulkan kernels precondition CG with Jacobi)");
   if (backend == "opencl")
     return std::make_unique<OpenClEnsemble>(model, estimated, observed, sigma_count, options);
   if (backend == "vulkan")
@@ -42,6 +39,13 @@ std::string preconditioner_used(const std::string& backend, const DeviceOptions&
                                  ? devices[static_cast<std::size_t>(options.device)].type
                                  : "";
     factors = opencl_uses_factor(options.preconditioner, opencl_cpu_form(options.kernel_form, type));
+  }
+  if (backend == "vulkan") {
+    const std::vector<VulkanDeviceInfo> devices = list_vulkan_devices();
+    const std::string type = options.device >= 0 && options.device < static_cast<int>(devices.size())
+                                 ? devices[static_cast<std::size_t>(options.device)].type
+                                 : "";
+    factors = vulkan_uses_factor(options.preconditioner, type);
   }
   return factors ? "factorised" : "jacobi";
 }

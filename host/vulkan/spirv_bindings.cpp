@@ -15,6 +15,7 @@ constexpr std::uint32_t kOpTypeSampledImage = 27, kOpTypePointer = 32, kOpVariab
 constexpr std::uint32_t kOpDecorate = 71;
 constexpr std::uint32_t kDecorationBinding = 33, kDecorationDescriptorSet = 34;
 constexpr std::uint32_t kDimBuffer = 5;
+constexpr std::uint32_t kImageFormatR32f = 3;
 
 }  // namespace
 
@@ -26,6 +27,7 @@ std::map<std::uint32_t, SpirvBinding> spirv_bindings(const std::uint32_t* words,
   std::unordered_map<std::uint32_t, std::uint32_t> variable_type; // variable -> pointer type
   std::unordered_map<std::uint32_t, std::uint32_t> sampled_image; // sampled image -> image
   std::unordered_map<std::uint32_t, std::uint32_t> buffer_image;  // buffer image -> sampled type
+  std::unordered_map<std::uint32_t, std::uint32_t> image_format;  // buffer image -> its format
   std::unordered_map<std::uint32_t, SpirvBinding> scalar_kind;    // 32-bit scalar types
   for (std::size_t at = 5; at < count;) {
     const std::uint32_t length = words[at] >> 16, opcode = words[at] & 0xffffu;
@@ -42,8 +44,10 @@ std::map<std::uint32_t, SpirvBinding> spirv_bindings(const std::uint32_t* words,
       scalar_kind[operand[0]] = SpirvBinding::float_texels;
     else if (opcode == kOpTypeInt && operands >= 3 && operand[1] == 32)
       scalar_kind[operand[0]] = operand[2] ? SpirvBinding::int_texels : SpirvBinding::uint_texels;
-    else if (opcode == kOpTypeImage && operands >= 3 && operand[2] == kDimBuffer)
+    else if (opcode == kOpTypeImage && operands >= 3 && operand[2] == kDimBuffer) {
       buffer_image[operand[0]] = operand[1];
+      if (operands >= 8) image_format[operand[0]] = operand[7];
+    }
     else if (opcode == kOpTypeSampledImage && operands >= 2)
       sampled_image[operand[0]] = operand[1];
     else if (opcode == kOpTypePointer && operands >= 3)
@@ -52,7 +56,8 @@ std::map<std::uint32_t, SpirvBinding> spirv_bindings(const std::uint32_t* words,
       variable_type[operand[1]] = operand[0];
     at += length;
   }
-  // What a variable's pointee is: a sampled buffer image of 32-bit texels, or else storage.
+  // What a variable's pointee is: a sampled buffer image of 32-bit texels, a buffer image
+  // itself (a storage texel buffer, of r32f only), or else storage.
   auto find = [](const auto& map, std::uint32_t key, std::uint32_t& value) {
     const auto it = map.find(key);
     if (it == map.end()) return false;
@@ -69,6 +74,13 @@ std::map<std::uint32_t, SpirvBinding> spirv_bindings(const std::uint32_t* words,
         find(sampled_image, type, image) && find(buffer_image, image, texel)) {
       const auto it = scalar_kind.find(texel);
       if (it != scalar_kind.end()) kind = it->second;
+    } else if (find(variable_type, variable, pointer) && find(pointee, pointer, type) &&
+               find(buffer_image, type, texel)) {
+      std::uint32_t format = 0;
+      if (!find(image_format, type, format) || format != kImageFormatR32f)
+        throw std::invalid_argument("binding " + std::to_string(binding) +
+                                    " is a storage texel buffer of a format other than r32f");
+      kind = SpirvBinding::float_image;
     }
     result[binding] = kind;
   }

@@ -16,11 +16,13 @@ enum class SpirvBinding {
   int_texels,       // uniform isamplerBuffer: R32_SINT
   uint_texels,      // uniform usamplerBuffer: R32_UINT (in a float64 shader, R32G32_UINT:
                     // a double's two halves; kernels/vulkan/ensemble_layout.h)
+  float_image,      // imageBuffer, r32f: a storage texel buffer (read and written)
 };
 
 // Binding number -> kind, for the variables of descriptor set 0 that carry a Binding
 // decoration. Throws std::invalid_argument when the words are not a well-formed SPIR-V
-// module (no magic number, an instruction that runs past the end, a zero word count).
+// module (no magic number, an instruction that runs past the end, a zero word count) or
+// declare a storage texel buffer of a format other than r32f.
 std::map<std::uint32_t, SpirvBinding> spirv_bindings(const std::uint32_t* words, std::size_t count);
 
 }  // namespace sigmafem

@@ -82,13 +82,14 @@ VulkanDevice::VulkanDevice(int index, Precision precision) : precision_(precisio
     check(api_->vkCreateFence(device_, &fence, nullptr, &fence_), "creating a fence");
 
     // Enough for the ensemble's descriptor sets (about twenty, at most 25 buffers each; about
-    // 240 buffers in all, of either kind).
-    const VkDescriptorPoolSize sizes[2] = {{VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, 1024},
-                                           {VK_DESCRIPTOR_TYPE_UNIFORM_TEXEL_BUFFER, 1024}};
+    // 240 buffers in all, of any kind; one storage texel buffer, the factor's work vector).
+    const VkDescriptorPoolSize sizes[3] = {{VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, 1024},
+                                           {VK_DESCRIPTOR_TYPE_UNIFORM_TEXEL_BUFFER, 1024},
+                                           {VK_DESCRIPTOR_TYPE_STORAGE_TEXEL_BUFFER, 256}};
     VkDescriptorPoolCreateInfo descriptors{};
     descriptors.sType = VK_STRUCTURE_TYPE_DESCRIPTOR_POOL_CREATE_INFO;
     descriptors.maxSets = 64;
-    descriptors.poolSizeCount = 2;
+    descriptors.poolSizeCount = 3;
     descriptors.pPoolSizes = sizes;
     check(api_->vkCreateDescriptorPool(device_, &descriptors, nullptr, &descriptor_pool_),
           "creating a descriptor pool");
@@ -191,7 +192,8 @@ VulkanBuffer VulkanDevice::buffer(std::size_t bytes, const char* what) {
   info.sType = VK_STRUCTURE_TYPE_BUFFER_CREATE_INFO;
   info.size = bytes;
   info.usage = VK_BUFFER_USAGE_STORAGE_BUFFER_BIT | VK_BUFFER_USAGE_UNIFORM_TEXEL_BUFFER_BIT |
-               VK_BUFFER_USAGE_TRANSFER_SRC_BIT | VK_BUFFER_USAGE_TRANSFER_DST_BIT;
+               VK_BUFFER_USAGE_STORAGE_TEXEL_BUFFER_BIT | VK_BUFFER_USAGE_TRANSFER_SRC_BIT |
+               VK_BUFFER_USAGE_TRANSFER_DST_BIT;
   VulkanBuffer result;
   result.bytes = bytes;
   check(api_->vkCreateBuffer(device_, &info, nullptr, &result.buffer), std::string("creating ") + what);
@@ -301,6 +303,8 @@ VulkanKernel VulkanDevice::kernel_from_spirv(const std::string& name, const std:
       slots[b].binding = static_cast<std::uint32_t>(b);
       slots[b].descriptorType = k.kinds[b] == SpirvBinding::storage_buffer
                                     ? VK_DESCRIPTOR_TYPE_STORAGE_BUFFER
+                                : k.kinds[b] == SpirvBinding::float_image
+                                    ? VK_DESCRIPTOR_TYPE_STORAGE_TEXEL_BUFFER
                                     : VK_DESCRIPTOR_TYPE_UNIFORM_TEXEL_BUFFER;
       slots[b].descriptorCount = 1;
       slots[b].stageFlags = VK_SHADER_STAGE_COMPUTE_BIT;
@@ -382,7 +386,9 @@ VkDescriptorSet VulkanDevice::bind(const VulkanKernel& kernel, const std::vector
       writes[b].pBufferInfo = &infos[b];
     } else {
       views[b] = texel_view(buffers[b], kernel.kinds[b], kernel.name);
-      writes[b].descriptorType = VK_DESCRIPTOR_TYPE_UNIFORM_TEXEL_BUFFER;
+      writes[b].descriptorType = kernel.kinds[b] == SpirvBinding::float_image
+                                     ? VK_DESCRIPTOR_TYPE_STORAGE_TEXEL_BUFFER
+                                     : VK_DESCRIPTOR_TYPE_UNIFORM_TEXEL_BUFFER;
       writes[b].pTexelBufferView = &views[b];
     }
   }
@@ -394,7 +400,8 @@ VkBufferView VulkanDevice::texel_view(const VulkanBuffer& buffer, SpirvBinding k
                                       const std::string& kernel) {
   // A float64 shader's unsigned texels are its doubles (kernels/vulkan/ensemble_layout.h).
   const bool doubles = kind == SpirvBinding::uint_texels && precision_ == Precision::double_precision;
-  const VkFormat format = kind == SpirvBinding::float_texels ? VK_FORMAT_R32_SFLOAT
+  const VkFormat format = kind == SpirvBinding::float_texels || kind == SpirvBinding::float_image
+                              ? VK_FORMAT_R32_SFLOAT
                           : kind == SpirvBinding::int_texels ? VK_FORMAT_R32_SINT
                           : doubles                          ? VK_FORMAT_R32G32_UINT
                                                              : VK_FORMAT_R32_UINT;

@@ -50,16 +50,16 @@ bool vulkan_validation_available();
 
 struct VulkanApi;  // the loader's function table (vulkan_instance.h)
 
-// A buffer in device memory, bound to shaders as a storage buffer or as a uniform texel buffer
-// (by what each shader declares). Owned by the VulkanDevice that made it.
+// A buffer in device memory, bound to shaders as a storage buffer, a uniform texel buffer or
+// a storage texel buffer (by what each shader declares). Owned by the VulkanDevice that made it.
 struct VulkanBuffer {
   VkBuffer buffer = VK_NULL_HANDLE;
   VkDeviceSize bytes = 0;
 };
 
 // A compute pipeline: one entry shader, `bindings` buffers at bindings 0..n-1 of set 0 (each
-// a storage buffer or a uniform texel buffer, as the SPIR-V declares it), and 16 bytes of
-// push constants. Owned by the VulkanDevice that made it.
+// a storage buffer, a uniform texel buffer or a storage texel buffer, as the SPIR-V declares
+// it), and 16 bytes of push constants. Owned by the VulkanDevice that made it.
 struct VulkanKernel {
   std::string name;
   VkPipeline pipeline = VK_NULL_HANDLE;
@@ -95,8 +95,9 @@ class VulkanDevice {
 
   // The pipeline of embedded shader `name` in this device's precision (and with texel reads
   // when set and the shader has that variant). `group_size` > 0 sets
-  // specialization constant 0 (the work-group size of the CG shaders), `partitions` > 0 (with
-  // it) constant 1 (the CG shaders' partitions per sigma point). Throws DeviceError when the
+  // specialization constant 0 (the work-group size of the CG and factor shaders), `partitions`
+  // > 0 (with it) constant 1 (the CG shaders' partitions per sigma point, factor_solve's rows
+  // of L). Throws DeviceError when the
   // shader is not embedded, is not SPIR-V or the driver rejects it.
   VulkanKernel kernel(const char* name, int bindings, std::uint32_t group_size = 0,
                       std::uint32_t partitions = 0);

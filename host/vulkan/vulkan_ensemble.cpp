@@ -23,6 +23,11 @@ bool vulkan_texel_reads(KernelForm form, const std::string& device_type,
   return cpu_form && largest_bytes / 4 <= max_texel_elements;
 }
 
+bool vulkan_uses_factor(Preconditioner preconditioner, const std::string& device_type) {
+  return preconditioner == Preconditioner::factorised ||
+         (preconditioner == Preconditioner::automatic && device_type == "cpu");
+}
+
 VulkanEnsemble::VulkanEnsemble(const Model& model, EstimatedParameters estimated,
                                ObservedPoints observed, int sigma_count,
                                const DeviceOptions& options)
@@ -45,6 +50,25 @@ VulkanEnsemble::VulkanEnsemble(const Model& model, EstimatedParameters estimated
   // Work-items per sigma point in CG: on a CPU (lavapipe) one SIMD register's worth, so that
   // a group's barriers cost nothing; on a GPU 64 (two warps, one wavefront).
   cg_group_ = info.type == "cpu" ? 8 : 64;
+  // CG's preconditioner (vulkan_uses_factor): one factor of the representative's system,
+  // analysed here for its size, made at the first step and again when due. With one CG
+  // work-group per sigma point only (its finishing shaders); on a CPU device more are made
+  // only when a test forces them, and then Jacobi unless the factor is asked for.
+  if (vulkan_uses_factor(options.preconditioner, info.type)) {
+    const bool asked = options.preconditioner == Preconditioner::factorised;
+    if (asked && info.type != "cpu")
+      throw DeviceError("--preconditioner factorised: Vulkan has it on a CPU device only (its "
+                        "GPU shaders precondition CG with Jacobi); device " + info.name);
+    if (asked && cg_partitions_ > 1)
+      throw DeviceError("--preconditioner factorised: Vulkan has it with one CG work-group per "
+                        "sigma point only (" + std::to_string(cg_partitions_) + " asked)");
+    if (cg_partitions_ == 1) {
+      factor_ = std::make_unique<FactorisedPreconditioner>();
+      const ReferenceSimulation rest(model_);
+      factor_->analyse(representative_system(rest.positions(), rest.velocities()));
+      check_device_memory(device_.real_size(), info.name, info.memory, info.max_buffer, factor_->nonzeros());
+    }
+  }
 
   // The partitions' buffers are bound but unused with one partition.
   std::size_t largest = 0;
@@ -90,10 +114,20 @@ VulkanEnsemble::VulkanEnsemble(const Model& model, EstimatedParameters estimated
   // cg_node_iteration's (a sigma point's nodes) (bench/RESULTS.md, stop 52).
   node_iteration_ = cg_partitions_ == 1 &&
                     static_cast<long long>(elements_) * S_ <= options.node_iteration_work;
+  // With a factor, the iteration shaders stop at the stop test, and factor_solve and
+  // cg_factor_direction follow them.
   if (node_iteration_)
-    k_cg_node_iteration_ = cg_kernel("cg_node_iteration", iteration);
+    k_cg_node_iteration_ = cg_kernel(factor_ ? "cg_node_iteration_factor" : "cg_node_iteration", iteration);
   else if (cg_partitions_ == 1)
-    k_cg_iteration_ = cg_kernel("cg_iteration", iteration);
+    k_cg_iteration_ = cg_kernel(factor_ ? "cg_iteration_factor" : "cg_iteration", iteration);
+  if (factor_) {
+    k_cg_factor_start_ = cg_kernel("cg_factor_start", iteration);
+    k_cg_factor_direction_ = cg_kernel("cg_factor_direction", iteration);
+    factor_solve_ = std::make_unique<VulkanFactorSolve>(
+        device_, 3 * nodes_, factor_->nonzeros(), S_, buffer(B::r), buffer(B::z), buffer(B::active),
+        options.factor_loop_turns);
+    device_bytes_ += factor_solve_->bytes();
+  }
   if (cg_partitions_ > 1) {
     k_cg_start_partials_ = cg_kernel("cg_start_partials", start);
     k_cg_start_scalars_ = cg_kernel("cg_start_scalars", start);
@@ -121,6 +155,10 @@ VulkanEnsemble::VulkanEnsemble(const Model& model, EstimatedParameters estimated
     s_cg_dot_ = bind(k_cg_dot_, iteration);
     s_cg_update_ = bind(k_cg_update_, iteration);
     s_cg_direction_ = bind(k_cg_direction_, iteration);
+  }
+  if (factor_) {
+    s_cg_factor_start_ = bind(k_cg_factor_start_, iteration);
+    s_cg_factor_direction_ = bind(k_cg_factor_direction_, iteration);
   }
   s_state_update_ = bind(k_state_update_, kernel_buffers(DeviceKernel::state_update));
   s_observation_gather_ = bind(k_observation_gather_, kernel_buffers(DeviceKernel::observation_gather));
@@ -220,7 +258,29 @@ void VulkanEnsemble::record_cg_iterations(VkCommandBuffer cmd, int count) const 
       device_.dispatch(cmd, k_cg_iteration_, s_cg_iteration_, &push, groups);
     }
     device_.barrier(cmd);
+    if (factor_) record_factor_solve(cmd, k_cg_factor_direction_, s_cg_factor_direction_);
   }
+}
+
+void VulkanEnsemble::record_factor_solve(VkCommandBuffer cmd, const VulkanKernel& finish,
+                                         VkDescriptorSet set) const {
+  factor_solve_->record(cmd);
+  PushConstants push;
+  push.S = static_cast<std::uint32_t>(S_);
+  push.count = static_cast<std::uint32_t>(nodes_);
+  push.max_iterations = model_.solver.cg_max_iterations;
+  device_.dispatch(cmd, finish, set, &push, static_cast<std::uint32_t>(S_));
+  device_.barrier(cmd);
+}
+
+void VulkanEnsemble::refresh_factor() {
+  // A matrix that is not positive definite (a diverged state?) leaves the last factor in
+  // place, and the next step tries again.
+  const Eigen::SparseMatrix<double> A = representative_system();
+  if (factor_->factorise(A))
+    factor_solve_->upload(*factor_);
+  else if (!factor_solve_->ready())
+    factor_solve_->upload_diagonal(A);
 }
 
 StepReport VulkanEnsemble::advance(const Eigen::Vector3d& so_position) {
@@ -231,6 +291,8 @@ StepReport VulkanEnsemble::advance(const Eigen::Vector3d& so_position) {
   const std::size_t at_rr = 12 * S, at_bb = at_rr + real * S, at_observations = at_bb + real * S;
   last_step_waits_ = 0;
   observations_current_ = false;
+  const int factorisations_before = factorisations();
+  if (factor_ && factor_->due()) refresh_factor();
 
   // The right-hand side, the warm start and the first batch of iterations: as many as the
   // last step needed (warm-started steps need about the same).
@@ -257,6 +319,7 @@ StepReport VulkanEnsemble::advance(const Eigen::Vector3d& so_position) {
     device_.dispatch(cmd, k_cg_start_, s_cg_start_, &push, static_cast<std::uint32_t>(S_));
   }
   device_.barrier(cmd);
+  if (factor_) record_factor_solve(cmd, k_cg_factor_start_, s_cg_factor_start_);
 
   // Then batches until every sigma point is done or the cap is reached, each submitted and
   // waited for, with the S active flags read back.
@@ -298,8 +361,11 @@ StepReport VulkanEnsemble::advance(const Eigen::Vector3d& so_position) {
     observations_cache_ = from_device_reals(area + at_observations, rows * S, precision);
     observations_current_ = true;
   }
-  return step_report(iterations, converged, from_device_reals(area + at_rr, S, precision),
-                     from_device_reals(area + at_bb, S, precision));
+  StepReport report = step_report(iterations, converged, from_device_reals(area + at_rr, S, precision),
+                                  from_device_reals(area + at_bb, S, precision));
+  if (factor_) factor_->record(*std::max_element(iterations.begin(), iterations.end()));
+  report.factorisations = factorisations() - factorisations_before;
+  return report;
 }
 
 void VulkanEnsemble::predicted_observations(Eigen::MatrixXd& y) const {

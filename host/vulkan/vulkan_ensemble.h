@@ -18,13 +18,16 @@
 #pragma once
 
 #include <Eigen/Core>
+#include <memory>
 #include <string>
 #include <vector>
 
 #include "device_layout.h"
 #include "host/ensemble/device_ensemble.h"
 #include "host/model/model.h"
+#include "host/reference/factorised_preconditioner.h"
 #include "host/vulkan/vulkan_device.h"
+#include "host/vulkan/vulkan_factor_solve.h"
 
 namespace sigmafem {
 
@@ -35,6 +38,12 @@ namespace sigmafem {
 // (largest_bytes / 4 <= max_texel_elements); without that, the GPU form.
 bool vulkan_texel_reads(KernelForm form, const std::string& device_type,
                         std::size_t largest_bytes, unsigned long long max_texel_elements);
+
+// Whether Vulkan preconditions CG with one shared factor (VulkanFactorSolve): asked, or by
+// default on a CPU device (lavapipe), where fewer iterations save more dispatches than the
+// substitutions cost; Jacobi on a GPU, where a lane per sigma point in a sequential solve
+// would leave it idle.
+bool vulkan_uses_factor(Preconditioner preconditioner, const std::string& device_type);
 
 class VulkanEnsemble : public DeviceEnsemble {
  public:
@@ -54,6 +63,11 @@ class VulkanEnsemble : public DeviceEnsemble {
   bool node_iteration() const { return node_iteration_; }
   // Host waits (command-buffer submissions) of the last advance().
   int last_step_waits() const { return last_step_waits_; }
+  // Whether CG is preconditioned by a factor (vulkan_uses_factor), its factorisations so far
+  // (0 with Jacobi), and the dispatches of one solve with it.
+  bool factorised() const { return factor_ != nullptr; }
+  int factorisations() const { return factor_ ? factor_->factorisations() : 0; }
+  int factor_solve_dispatches() const { return factor_solve_ ? factor_solve_->dispatches() : 0; }
 
  private:
   // The scalar arguments of every shader (SF_PUSH_CONSTANTS, kernels/shared/device_layout.h).
@@ -77,6 +91,11 @@ class VulkanEnsemble : public DeviceEnsemble {
   void dispatch_items(VkCommandBuffer cmd, const VulkanKernel& kernel, VkDescriptorSet set,
                       std::size_t items, std::uint32_t count) const;
   void record_cg_iterations(VkCommandBuffer cmd, int count) const;
+  // With a factor: z = M^-1 r, then `finish` (cg_factor_start or cg_factor_direction).
+  void record_factor_solve(VkCommandBuffer cmd, const VulkanKernel& finish, VkDescriptorSet set) const;
+  // Makes the factor again from the representative (the mean sigma point) when it is due and
+  // uploads it; with no factor yet and a failed factorisation, A's diagonal (Jacobi) instead.
+  void refresh_factor();
   void record_system_product(VkCommandBuffer cmd, VkDescriptorSet element_product_set) const;
   // Records what set_parameters() and recenter() left for the next submission; flush_pending()
   // submits it alone, before a read-out.
@@ -103,7 +122,10 @@ class VulkanEnsemble : public DeviceEnsemble {
   VulkanKernel k_element_rhs_, k_node_rhs_, k_element_product_, k_node_product_;
   VulkanKernel k_cg_start_, k_cg_iteration_, k_state_update_, k_observation_gather_, k_recenter_;
   VulkanKernel k_cg_start_partials_, k_cg_start_scalars_, k_cg_dot_, k_cg_update_, k_cg_direction_;
-  VulkanKernel k_cg_node_iteration_;
+  VulkanKernel k_cg_node_iteration_, k_cg_factor_start_, k_cg_factor_direction_;
+  // CG's shared factor (vulkan_uses_factor), with its refresh rule, and its solve on the device.
+  std::unique_ptr<FactorisedPreconditioner> factor_;
+  std::unique_ptr<VulkanFactorSolve> factor_solve_;
   // Descriptor sets; element_product has three: the warm start's product (dv, all active),
   // the CG product (d, the active flags) and system_product()'s (d, all active).
   VkDescriptorSet s_element_rhs_ = VK_NULL_HANDLE, s_node_rhs_ = VK_NULL_HANDLE;
@@ -115,6 +137,7 @@ class VulkanEnsemble : public DeviceEnsemble {
   VkDescriptorSet s_cg_start_partials_ = VK_NULL_HANDLE, s_cg_start_scalars_ = VK_NULL_HANDLE;
   VkDescriptorSet s_cg_dot_ = VK_NULL_HANDLE, s_cg_update_ = VK_NULL_HANDLE;
   VkDescriptorSet s_cg_direction_ = VK_NULL_HANDLE, s_cg_node_iteration_ = VK_NULL_HANDLE;
+  VkDescriptorSet s_cg_factor_start_ = VK_NULL_HANDLE, s_cg_factor_direction_ = VK_NULL_HANDLE;
 };
 
 }  // namespace sigmafem

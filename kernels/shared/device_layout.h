@@ -162,5 +162,19 @@
 #define SF_CG_ITERATION_CONTROL_K 22
 #define SF_CG_ITERATION_MASS 23
 #define SF_CG_ITERATION_ELEMENT_OUT 24
+/* Vulkan's factor_solve (z = M^-1 r with a sparse Cholesky factor; host/vulkan/vulkan_factor_solve.h):
+ * L by rows (for L y = P r) and by columns (for L^T w = y), each row's L position's original
+ * row, CG's r, z and active flags, and the work vector y. */
+#define SF_FACTOR_SOLVE_ROW_STARTS 0
+#define SF_FACTOR_SOLVE_ROW_COLUMNS 1
+#define SF_FACTOR_SOLVE_ROW_VALUES 2
+#define SF_FACTOR_SOLVE_COLUMN_STARTS 3
+#define SF_FACTOR_SOLVE_COLUMN_ROWS 4
+#define SF_FACTOR_SOLVE_COLUMN_VALUES 5
+#define SF_FACTOR_SOLVE_ORIGINAL_ROW 6
+#define SF_FACTOR_SOLVE_R 7
+#define SF_FACTOR_SOLVE_Z 8
+#define SF_FACTOR_SOLVE_ACTIVE 9
+#define SF_FACTOR_SOLVE_WORK 10
 
 #endif /* SIGMAFEM_DEVICE_LAYOUT_H */

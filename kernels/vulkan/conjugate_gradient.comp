@@ -12,6 +12,14 @@
  * and, for partitions (below), cg_start_partials and cg_start_scalars for cg_start, and
  * cg_dot, cg_update and cg_direction for cg_iteration.
  *
+ * With a factor as the preconditioner (one partition; host/vulkan/vulkan_factor_solve.h),
+ * factor_solve.comp forms z = M^-1 r after the start and after each iteration's update, and
+ * these finish what Jacobi's z lets the shaders above do at once:
+ *   -DSF_ENTRY_CG_ITERATION_FACTOR, -DSF_ENTRY_CG_NODE_ITERATION_FACTOR  cg_iteration and
+ *                            cg_node_iteration up to the stop test: no r.z, no new direction
+ *   -DSF_ENTRY_CG_FACTOR_START      cg_factor_start: r.z and d = z after the warm start's solve
+ *   -DSF_ENTRY_CG_FACTOR_DIRECTION  cg_factor_direction: r.z, beta and d = z + beta d
+ *
  * One work-group per sigma point owns every row of that sigma point, so the dot products are
  * reduced inside the group by a fixed tree (the same bits every run) and the rest of a CG
  * iteration after the product is one dispatch. The group size is specialization constant 0
@@ -30,6 +38,14 @@
  * converged (1 converged, 0 hit the cap or broke down), iterations (products done). */
 #version 450
 #extension GL_GOOGLE_include_directive : require
+
+#if defined(SF_ENTRY_CG_ITERATION_FACTOR)
+#  define SF_ENTRY_CG_ITERATION
+#  define SF_FACTOR
+#elif defined(SF_ENTRY_CG_NODE_ITERATION_FACTOR)
+#  define SF_ENTRY_CG_NODE_ITERATION
+#  define SF_FACTOR
+#endif
 
 #if defined(SF_ENTRY_CG_START) || defined(SF_ENTRY_CG_START_PARTIALS) || \
     defined(SF_ENTRY_CG_START_SCALARS)
@@ -275,11 +291,14 @@ bool sf_stop(bool done, real sum_rr, int count) {
   return sf_cg_stops(done, sum_rr, count, sf_push.max_iterations);
 }
 
-/* Sigma point s's scalars after an iteration (read by the host and the other shaders). */
+/* Sigma point s's scalars after an iteration (read by the host and the other shaders); r.z
+ * with the factor is cg_factor_direction's. */
 void sf_store_scalars(uint s, int count, real sum_rr, real sum_rz, bool done, bool stop) {
   iterations[s] = count;
   rr[s] = sum_rr;
+#  if !defined(SF_FACTOR)
   rz[s] = sum_rz;
+#  endif
   if (done) converged[s] = 1u;
   if (stop) active_flags[s] = 0u;
 }
@@ -301,8 +320,37 @@ void main() {
   memoryBarrierBuffer();
   barrier(); /* everyone has read the old scalars before they change */
   if (gl_LocalInvocationID.x == 0u) sf_store_scalars(s, count, sum_rr, sum_rz, done, stop);
+#    if !defined(SF_FACTOR) /* else factor_solve's z, then cg_factor_direction */
   if (stop) return;
   sf_direction_rows(s, S, 0u, sf_push.count, sum_rz / rz_old);
+#    endif
+}
+
+#  elif defined(SF_ENTRY_CG_FACTOR_START) || defined(SF_ENTRY_CG_FACTOR_DIRECTION)
+/* After factor_solve's z = M^-1 r: r.z, and d = z (the start) or d = z + beta d with
+ * beta = r.z / the last r.z. */
+void main() {
+  uint S = sf_push.S;
+  uint s = gl_WorkGroupID.x;
+  if (active_flags[s] == 0u) return; /* the same for the whole group */
+  real sum_rz = real(0);
+  for (uint row = gl_LocalInvocationID.x; row < 3u * sf_push.count; row += gl_WorkGroupSize.x)
+    sum_rz += r[row * S + s] * z[row * S + s];
+  sum_rz = sf_group_sum(sum_rz);
+#    if defined(SF_ENTRY_CG_FACTOR_DIRECTION)
+  real beta = sum_rz / rz[s];
+  memoryBarrierBuffer();
+  barrier(); /* everyone has read the old r.z before it changes */
+#    endif
+  if (gl_LocalInvocationID.x == 0u) rz[s] = sum_rz;
+  for (uint row = gl_LocalInvocationID.x; row < 3u * sf_push.count; row += gl_WorkGroupSize.x) {
+    uint at = row * S + s;
+#    if defined(SF_ENTRY_CG_FACTOR_START)
+    d[at] = z[at];
+#    else
+    d[at] = z[at] + beta * d[at];
+#    endif
+  }
 }
 
 #  elif defined(SF_ENTRY_CG_DOT)

@@ -117,8 +117,12 @@ std::vector<BackendCase> backend_cases() {
   cases.push_back({"opencl", Precision::single, "OpenClSingleGpuFormPartitions",
                    SolveLaunch::automatic, KernelForm::gpu, 3});
   // Vulkan as it runs on a CPU device (lavapipe): float32 shaders with texel reads; on these
-  // meshes CG in two dispatches an iteration (cg_node_iteration forms q = A d).
+  // meshes CG in two dispatches an iteration (cg_node_iteration forms q = A d); Jacobi.
   cases.push_back({"vulkan", Precision::single, "VulkanSingle"});
+  // And as it runs by default on a CPU device since stop 53: CG preconditioned by one factor
+  // that the sigma points share (factor_solve.comp), S = 4 on both meshes.
+  cases.push_back({"vulkan", Precision::single, "VulkanSingleDefault", SolveLaunch::automatic,
+                   KernelForm::automatic, 0, Preconditioner::automatic});
   // And in three (node_product apart), as larger meshes run it: the liver at S = 4.
   cases.push_back({"vulkan", Precision::single, "VulkanSingleThreeDispatches", SolveLaunch::automatic,
                    KernelForm::automatic, 0, Preconditioner::jacobi, DeviceOptions{}.own_factors_bytes, 4,

@@ -4,6 +4,7 @@
 // Vulkan always Jacobi.
 #include "host/engine/make_ensemble.h"
 #include "host/opencl/opencl_ensemble.h"
+#include "host/vulkan/vulkan_ensemble.h"
 
 #include <gtest/gtest.h>
 
@@ -22,7 +23,20 @@ TEST(MakeEnsemble, SaysWhichPreconditionerEachBackEndRuns) {
   EXPECT_EQ(preconditioner_used("cpu", with(Preconditioner::jacobi)), "jacobi");
   EXPECT_EQ(preconditioner_used("opencl", with(Preconditioner::factorised)), "factorised");
   EXPECT_EQ(preconditioner_used("opencl", with(Preconditioner::jacobi)), "jacobi");
-  EXPECT_EQ(preconditioner_used("vulkan", with(Preconditioner::automatic)), "jacobi");
+  EXPECT_EQ(preconditioner_used("vulkan", with(Preconditioner::jacobi)), "jacobi");
+  EXPECT_EQ(preconditioner_used("vulkan", with(Preconditioner::factorised)), "factorised");
+}
+
+// Vulkan's default since stop 53: the factor on a CPU device (lavapipe), Jacobi on a GPU.
+TEST(MakeEnsemble, VulkansDefaultIsTheFactorOnACpuDeviceOnly) {
+  EXPECT_TRUE(vulkan_uses_factor(Preconditioner::automatic, "cpu"));
+  EXPECT_FALSE(vulkan_uses_factor(Preconditioner::automatic, "discrete gpu"));
+  EXPECT_FALSE(vulkan_uses_factor(Preconditioner::jacobi, "cpu"));
+  EXPECT_TRUE(vulkan_uses_factor(Preconditioner::factorised, "discrete gpu"));   // refused by the ensemble
+  const std::vector<VulkanDeviceInfo> devices = list_vulkan_devices();
+  if (devices.empty()) GTEST_SKIP() << "no Vulkan device";
+  EXPECT_EQ(preconditioner_used("vulkan", with(Preconditioner::automatic)),
+            devices[0].type == "cpu" ? "factorised" : "jacobi");
 }
 
 TEST(MakeEnsemble, OpenClsDefaultIsTheFactorOnItsCpuFormOnly) {

@@ -65,6 +65,32 @@ TEST(SpirvBindings, EveryShaderHasATexelVariantWithTheSameBindings) {
   }
 }
 
+// factor_solve's work vector in float32 is an r32f imageBuffer (a storage texel buffer, read
+// and written); in float64 a storage buffer. A storage texel buffer of another format is
+// refused (the host makes r32f views only).
+TEST(SpirvBindings, TheFactorSolvesWorkVectorIsAStorageTexelBufferInFloat32) {
+  for (const bool texel_reads : {false, true}) {
+    const EmbeddedShader& shader = embedded("factor_solve", false, texel_reads);
+    EXPECT_EQ(spirv_bindings(shader.words, shader.word_count).at(SF_FACTOR_SOLVE_WORK), SpirvBinding::float_image);
+    EXPECT_EQ(spirv_bindings(shader.words, shader.word_count).at(SF_FACTOR_SOLVE_Z), SpirvBinding::storage_buffer);
+    const EmbeddedShader& doubles = embedded("factor_solve", true, texel_reads);
+    EXPECT_EQ(spirv_bindings(doubles.words, doubles.word_count).at(SF_FACTOR_SOLVE_WORK), SpirvBinding::storage_buffer);
+  }
+  const EmbeddedShader& shader = embedded("factor_solve", false, true);
+  std::vector<std::uint32_t> words(shader.words, shader.words + shader.word_count);
+  bool changed = false;
+  for (std::size_t at = 5; at < words.size(); at += words[at] >> 16) {
+    const bool storage_image = (words[at] & 0xffffu) == 25u && (words[at] >> 16) >= 9 &&
+                               words[at + 3] == 5u && words[at + 7] == 2u;   // OpTypeImage, Buffer, Sampled 2
+    if (storage_image) {
+      words[at + 8] = 1u;   // Rgba32f
+      changed = true;
+    }
+  }
+  ASSERT_TRUE(changed);
+  EXPECT_THROW(spirv_bindings(words.data(), words.size()), std::invalid_argument);
+}
+
 TEST(SpirvBindings, WordsThatAreNotSpirvAreRefused) {
   const std::vector<std::uint32_t> garbage = {0xdeadbeef, 1, 2, 3, 4, 5};
   EXPECT_THROW(spirv_bindings(garbage.data(), garbage.size()), std::invalid_argument);

@@ -1,0 +1,159 @@
+#include "host/vulkan/vulkan_factor_solve.h"
+
+#include <algorithm>
+#include <cmath>
+#include <string>
+
+#include "device_layout.h"
+#include "host/ensemble/device_readout.h"
+
+namespace sigmafem {
+namespace {
+
+// factor_solve's push constants (SF_PUSH_CONSTANTS): S, the first step, -, one past the last.
+#define SF_HOST_UINT(name) std::uint32_t name = 0;
+#define SF_HOST_INT(name) std::int32_t name = 0;
+struct Push {
+  SF_PUSH_CONSTANTS(SF_HOST_UINT, SF_HOST_INT)
+};
+#undef SF_HOST_UINT
+#undef SF_HOST_INT
+static_assert(sizeof(Push) == VulkanDevice::kPushConstantBytes, "SF_PUSH_CONSTANTS' 16 bytes");
+
+}  // namespace
+
+VulkanFactorSolve::VulkanFactorSolve(VulkanDevice& device, int rows, std::size_t nonzeros,
+                                     int sigma_count, const VulkanBuffer& r, const VulkanBuffer& z,
+                                     const VulkanBuffer& active, long long loop_turns)
+    : device_(device), rows_(rows), S_(sigma_count),
+      nonzeros_(std::max<std::size_t>(nonzeros, static_cast<std::size_t>(rows))),
+      loop_turns_(loop_turns) {
+  const std::size_t n = static_cast<std::size_t>(rows), real = device_.real_size();
+  row_starts_ = make(4 * (n + 1));
+  row_columns_ = make(4 * nonzeros_);
+  row_values_ = make(real * nonzeros_);
+  column_starts_ = make(4 * (n + 1));
+  column_rows_ = make(4 * nonzeros_);
+  column_values_ = make(real * nonzeros_);
+  original_row_ = make(4 * n);
+  work_ = make(real * n * static_cast<std::size_t>(S_));
+  const std::uint32_t group = static_cast<std::uint32_t>(std::min(S_, kLanes));
+  groups_ = (static_cast<std::uint32_t>(S_) + group - 1) / group;
+  kernel_ = device_.kernel("factor_solve", SF_FACTOR_SOLVE_WORK + 1, group, static_cast<std::uint32_t>(rows));
+  set_ = device_.bind(kernel_, {row_starts_, row_columns_, row_values_, column_starts_, column_rows_,
+                                column_values_, original_row_, r, z, active, work_});
+}
+
+VulkanBuffer VulkanFactorSolve::make(std::size_t bytes) {
+  bytes_ += bytes;
+  return device_.buffer(bytes, "the factor");
+}
+
+void VulkanFactorSolve::upload_ints(const VulkanBuffer& buffer, const std::vector<int>& values) {
+  device_.upload(buffer, values.data(), values.size() * sizeof(int));
+}
+
+void VulkanFactorSolve::upload(const FactorisedPreconditioner& factor) {
+  const Eigen::SparseMatrix<double>& L = factor.lower();
+  const std::size_t n = static_cast<std::size_t>(rows_), entries = static_cast<std::size_t>(L.nonZeros());
+  if (L.rows() != rows_ || entries > nonzeros_)
+    throw DeviceError("the factor has " + std::to_string(entries) + " entries in " +
+                      std::to_string(L.rows()) + " rows; the Vulkan buffers hold " +
+                      std::to_string(nonzeros_) + " in " + std::to_string(rows_));
+  const int* starts = L.outerIndexPtr();
+  const int* rows = L.innerIndexPtr();
+  if (pattern_ != Pattern::factor) {
+    // L by rows: each column's entries appended to their rows in column order, so that a
+    // row's diagonal (its largest column) comes last.
+    std::vector<int> row_starts(n + 1, 0), row_columns(entries), original_row(n);
+    for (std::size_t k = 0; k < entries; ++k) ++row_starts[static_cast<std::size_t>(rows[k]) + 1];
+    for (std::size_t i = 0; i < n; ++i) row_starts[i + 1] += row_starts[i];
+    std::vector<int> next(row_starts.begin(), row_starts.end() - 1);
+    row_position_.resize(entries);
+    for (std::size_t j = 0; j < n; ++j)
+      for (int k = starts[j]; k < starts[j + 1]; ++k) {
+        const std::size_t at = static_cast<std::size_t>(next[static_cast<std::size_t>(rows[k])]++);
+        row_columns[at] = static_cast<int>(j);
+        row_position_[static_cast<std::size_t>(k)] = at;
+      }
+    for (std::size_t i = 0; i < n; ++i) original_row[static_cast<std::size_t>(factor.order()[i])] = static_cast<int>(i);
+    upload_pattern(row_starts, row_columns, std::vector<int>(starts, starts + n + 1),
+                   std::vector<int>(rows, rows + entries), original_row);
+    pattern_ = Pattern::factor;
+  }
+  std::vector<double> row_values(entries), column_values(L.valuePtr(), L.valuePtr() + entries);
+  for (std::size_t k = 0; k < entries; ++k) row_values[row_position_[k]] = column_values[k];
+  upload_values(row_values, column_values);
+}
+
+void VulkanFactorSolve::upload_diagonal(const Eigen::SparseMatrix<double>& A) {
+  const std::size_t n = static_cast<std::size_t>(rows_);
+  std::vector<int> starts(n + 1), identity(n);
+  std::vector<double> values(n);
+  for (std::size_t i = 0; i < n; ++i) {
+    starts[i] = static_cast<int>(i);
+    identity[i] = static_cast<int>(i);
+    // |diag A|: a preconditioner must be positive definite; a row whose diagonal is 0 or not
+    // finite is left unscaled (as OpenClEnsemble's stand-in).
+    const double d = std::abs(A.coeff(static_cast<Eigen::Index>(i), static_cast<Eigen::Index>(i)));
+    values[i] = std::isfinite(d) && d > 0.0 ? std::sqrt(d) : 1.0;
+  }
+  starts[n] = static_cast<int>(n);
+  upload_pattern(starts, identity, starts, identity, identity);
+  upload_values(values, values);
+  pattern_ = Pattern::diagonal;
+}
+
+void VulkanFactorSolve::upload_pattern(const std::vector<int>& row_starts, const std::vector<int>& row_columns,
+                                       const std::vector<int>& column_starts, const std::vector<int>& column_rows,
+                                       const std::vector<int>& original_row) {
+  upload_ints(row_starts_, row_starts);
+  upload_ints(row_columns_, row_columns);
+  upload_ints(column_starts_, column_starts);
+  upload_ints(column_rows_, column_rows);
+  upload_ints(original_row_, original_row);
+  // The 2n steps (forward rows 0 .. n-1, then backward columns n-1 .. 0) cut into ranges of at
+  // most loop_turns_ turns: a step turns once and once per entry of its row or column, and
+  // a loop once more on leaving (counted with the step, to be safe).
+  ranges_.clear();
+  const std::size_t n = static_cast<std::size_t>(rows_);
+  long long turns = 0;
+  std::uint32_t first = 0;
+  for (std::size_t step = 0; step < 2 * n; ++step) {
+    const std::size_t j = step < n ? step : 2 * n - 1 - step;
+    const std::vector<int>& starts = step < n ? row_starts : column_starts;
+    const long long cost = starts[j + 1] - starts[j] + 2;
+    if (cost > loop_turns_)
+      throw DeviceError("the factor's row " + std::to_string(j) + " has " +
+                        std::to_string(cost - 2) + " entries, more than a Vulkan dispatch may turn (" +
+                        std::to_string(loop_turns_) + " loop turns)");
+    if (turns + cost > loop_turns_) {
+      ranges_.emplace_back(first, static_cast<std::uint32_t>(step));
+      first = static_cast<std::uint32_t>(step);
+      turns = 0;
+    }
+    turns += cost;
+  }
+  ranges_.emplace_back(first, static_cast<std::uint32_t>(2 * n));
+}
+
+void VulkanFactorSolve::upload_values(const std::vector<double>& row_values,
+                                      const std::vector<double>& column_values) {
+  const std::vector<unsigned char> rows = to_device_reals(row_values, device_.precision());
+  const std::vector<unsigned char> columns = to_device_reals(column_values, device_.precision());
+  device_.upload(row_values_, rows.data(), rows.size());
+  device_.upload(column_values_, columns.data(), columns.size());
+}
+
+void VulkanFactorSolve::record(VkCommandBuffer cmd) const {
+  Push push;
+  push.S = static_cast<std::uint32_t>(S_);
+  for (const auto& [first, last] : ranges_) {
+    push.count = first;
+    push.p = last;
+    device_.dispatch(cmd, kernel_, set_, &push, groups_);
+    device_.barrier(cmd);
+  }
+}
+
+}  // namespace sigmafem

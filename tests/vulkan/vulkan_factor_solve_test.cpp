@@ -1,0 +1,172 @@
+// VulkanFactorSolve (kernels/vulkan/factor_solve.comp): z = M^-1 r on the device against the
+// same factor's substitutions on the host in double precision, cut into many dispatches or
+// few, in both forms of the shader; the diagonal stand-in; a factor that no dispatch could
+// hold; and the ensemble that uses it by default on a CPU device.
+#include "host/vulkan/vulkan_factor_solve.h"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <cstring>
+#include <string>
+#include <vector>
+
+#include "host/model/model.h"
+#include "host/reference/reference_simulation.h"
+#include "host/scenario/scenario.h"
+#include "host/vulkan/vulkan_ensemble.h"
+#include "requirement.h"
+
+namespace sigmafem {
+namespace {
+
+class VulkanFactorSolveTest : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    std::string why;
+    if (list_vulkan_devices(&why).empty()) SIGMAFEM_MISSING(why);
+    const Scenario box = load_scenario(std::string(SIGMAFEM_SOURCE_DIR) + "/scenarios/box.json");
+    A_ = ReferenceSimulation(make_model(box)).system_matrix();
+    ASSERT_TRUE(factor_.factorise(A_));
+    n_ = static_cast<int>(A_.rows());
+  }
+
+  // z of S sigma points ([row S + s]) for r, on device 0 in float32, with sigma point
+  // `inactive` left alone (its z stays at `untouched`).
+  std::vector<float> device_solve(const std::vector<float>& r, int S, int inactive, bool texel_reads,
+                                  long long loop_turns, bool diagonal, int* dispatches = nullptr) {
+    VulkanDevice device(0, Precision::single);
+    device.set_texel_reads(texel_reads);
+    const std::size_t bytes = r.size() * sizeof(float);
+    const VulkanBuffer r_buffer = device.buffer(bytes, "r"), z_buffer = device.buffer(bytes, "z");
+    const VulkanBuffer active = device.buffer(4 * static_cast<std::size_t>(S), "active");
+    std::vector<std::uint32_t> flags(static_cast<std::size_t>(S), 1u);
+    if (inactive >= 0) flags[static_cast<std::size_t>(inactive)] = 0u;
+    device.upload(r_buffer, r.data(), bytes);
+    device.upload(active, flags.data(), 4 * flags.size());
+    const std::vector<float> sentinel(r.size(), untouched);
+    device.upload(z_buffer, sentinel.data(), bytes);
+    VulkanFactorSolve solve(device, n_, factor_.nonzeros(), S, r_buffer, z_buffer, active, loop_turns);
+    if (diagonal)
+      solve.upload_diagonal(A_);
+    else
+      solve.upload(factor_);
+    if (dispatches) *dispatches = solve.dispatches();
+    VkCommandBuffer cmd = device.begin();
+    solve.record(cmd);
+    device.submit_and_wait(cmd);
+    std::vector<float> z(r.size());
+    device.download(z_buffer, z.data(), bytes);
+    return z;
+  }
+
+  // Sigma point s's r, a smooth field with a different phase each.
+  std::vector<float> residuals(int S) const {
+    std::vector<float> r(static_cast<std::size_t>(n_) * S);
+    for (int i = 0; i < n_; ++i)
+      for (int s = 0; s < S; ++s) r[static_cast<std::size_t>(i) * S + s] = static_cast<float>(std::sin(0.37 * i + s));
+    return r;
+  }
+
+  static constexpr float untouched = 7.0f;
+  Eigen::SparseMatrix<double> A_;
+  FactorisedPreconditioner factor_;
+  int n_ = 0;
+};
+
+// Against P^T L^-T L^-1 P r in double from the same L, for S = 11 (a group of 8 and one of
+// 3), in 1000-turn dispatches and in the default's few, texel and storage reads: within
+// float32's rounding, the same bits however the solve is cut, an inactive sigma point untouched.
+TEST_F(VulkanFactorSolveTest, SolvesAsTheHostFactorInManyDispatchesOrFew) {
+  const int S = 11, inactive = 6;
+  const std::vector<float> r = residuals(S);
+  const Eigen::SparseMatrix<double>& L = factor_.lower();
+  for (const bool texel_reads : {true, false}) {
+    int many = 0, few = 0;
+    const std::vector<float> cut = device_solve(r, S, inactive, texel_reads, 1000, false, &many);
+    const std::vector<float> whole = device_solve(r, S, inactive, texel_reads, kFactorLoopTurns, false, &few);
+    EXPECT_GT(many, 20) << "1000 loop turns cut the box's factor into many dispatches";
+    EXPECT_LT(few, many);
+    EXPECT_EQ(0, std::memcmp(cut.data(), whole.data(), cut.size() * sizeof(float)))
+        << "the same sums in the same order, however the solve is cut";
+    for (int s = 0; s < S; ++s) {
+      Eigen::VectorXd y(n_);
+      for (int i = 0; i < n_; ++i) y[factor_.order()[i]] = r[static_cast<std::size_t>(i) * S + s];
+      L.triangularView<Eigen::Lower>().solveInPlace(y);
+      L.transpose().triangularView<Eigen::Upper>().solveInPlace(y);
+      const double scale = y.cwiseAbs().maxCoeff();
+      for (int i = 0; i < n_; ++i) {
+        const float got = cut[static_cast<std::size_t>(i) * S + s];
+        if (s == inactive)
+          ASSERT_EQ(got, untouched) << "row " << i;
+        else
+          ASSERT_NEAR(got, y[factor_.order()[i]], 1e-4 * scale) << "sigma point " << s << ", row " << i;
+      }
+    }
+  }
+}
+
+// Until a factorisation succeeds: z = r / |diag A|, Jacobi's preconditioner, in one dispatch.
+TEST_F(VulkanFactorSolveTest, TheDiagonalStandInIsJacobi) {
+  const int S = 4;
+  const std::vector<float> r = residuals(S);
+  int dispatches = 0;
+  const std::vector<float> z = device_solve(r, S, -1, true, kFactorLoopTurns, true, &dispatches);
+  EXPECT_EQ(dispatches, 1);
+  for (int i = 0; i < n_; ++i)
+    for (int s = 0; s < S; ++s) {
+      const std::size_t at = static_cast<std::size_t>(i) * S + s;
+      ASSERT_NEAR(z[at], r[at] / std::abs(A_.coeff(i, i)), 1e-6 * std::abs(z[at]) + 1e-30) << "row " << i;
+    }
+}
+
+// A bound on loop turns that a single row of L exceeds is a DeviceError that says so, not a
+// solve that llvmpipe would end silently.
+TEST_F(VulkanFactorSolveTest, ARowBeyondTheLoopBoundIsADeviceError) {
+  try {
+    device_solve(residuals(4), 4, -1, true, 8, false);
+    FAIL() << "no error";
+  } catch (const DeviceError& e) {
+    EXPECT_NE(std::string(e.what()).find("loop turns"), std::string::npos) << e.what();
+  }
+}
+
+// The ensemble on a CPU device: the factor by default (made at the first step), Jacobi when
+// asked; the factor's steps take a fraction of Jacobi's iterations and end where Jacobi's do.
+TEST_F(VulkanFactorSolveTest, TheEnsembleTakesItByDefaultOnACpuDevice) {
+  if (list_vulkan_devices().front().type != "cpu") GTEST_SKIP() << "device 0 is not a CPU";
+  const Scenario scenario = load_scenario(std::string(SIGMAFEM_SOURCE_DIR) + "/scenarios/liver.json");
+  const Model model = make_model(scenario);
+  const std::vector<int>& estimated = scenario.filter->estimate;
+  const int S = static_cast<int>(estimated.size()) + 1;
+  DeviceOptions jacobi_options;
+  jacobi_options.preconditioner = Preconditioner::jacobi;
+  VulkanEnsemble factorised(model, estimated, scenario.observations.nodes, S, DeviceOptions{});
+  VulkanEnsemble jacobi(model, estimated, scenario.observations.nodes, S, jacobi_options);
+  ASSERT_TRUE(factorised.factorised());
+  ASSERT_FALSE(jacobi.factorised());
+  int factor_iterations = 0, jacobi_iterations = 0;
+  for (int k = 1; k <= 6; ++k) {
+    const Eigen::Vector3d so = scenario.control.trajectory.position(k * scenario.time.dt, scenario.control.start);
+    const StepReport a = factorised.advance(so);
+    const StepReport b = jacobi.advance(so);
+    EXPECT_EQ(a.unconverged_count(), 0) << "step " << k;
+    for (int s = 0; s < S; ++s) {
+      factor_iterations += a.cg_iterations[static_cast<std::size_t>(s)];
+      jacobi_iterations += b.cg_iterations[static_cast<std::size_t>(s)];
+    }
+  }
+  EXPECT_GE(factorised.factorisations(), 1);
+  EXPECT_LT(5 * factor_iterations, jacobi_iterations);
+  for (int s = 0; s < S; ++s) {
+    // Both stop at CG's float32 tolerance (|r| <= 1e-6 |b|, kSingleCgTolerance), from
+    // different preconditioners: the velocities within 1e-3 of their size (1.4e-5 seen).
+    const Eigen::VectorXd v = factorised.velocities(s);
+    EXPECT_GT(v.cwiseAbs().maxCoeff(), 0.0);
+    EXPECT_LT((v - jacobi.velocities(s)).cwiseAbs().maxCoeff(), 1e-3 * v.cwiseAbs().maxCoeff())
+        << "sigma point " << s;
+  }
+}
+
+}  // namespace
+}  // namespace sigmafem
