@@ -87,10 +87,15 @@ const Backend kVulkanThreeDispatches{"vulkan", Precision::single,
                                      "vulkan single, device 0, CG in three dispatches an iteration",
                                      SolveLaunch::automatic, Preconditioner::jacobi, false, 0,
                                      KernelForm::automatic, true, 0};
-// Vulkan with one shared factor as CG's preconditioner (factor_solve.comp, stop 53), its
-// default on a CPU device since then; kVulkan is Jacobi, as the device rows' history.
+// Vulkan with one shared factor, corrected for the sigma points' springs, as CG's
+// preconditioner (factor_solve.comp, stop 53), its default on a CPU device since then;
+// kVulkan is Jacobi, as the device rows' history.
 const Backend kVulkanFactorised{"vulkan", Precision::single, "vulkan single, device 0, one shared factor",
                                 SolveLaunch::automatic, Preconditioner::factorised};
+const Backend kVulkanUncorrectedFactor{"vulkan", Precision::single,
+                                       "vulkan single, device 0, one shared factor, not corrected for the springs",
+                                       SolveLaunch::automatic, Preconditioner::factorised, false, 0,
+                                       KernelForm::automatic, false};
 const Backend kVulkanOneGroup{"vulkan", Precision::single,
                               "vulkan single, device 0, CG a work-group per sigma point",
                               SolveLaunch::automatic, Preconditioner::jacobi, false, 1};
@@ -339,6 +344,9 @@ BENCHMARK_CAPTURE(BM_ensemble_step, vulkan_liver_4768, kVulkan, std::string("liv
     ->RangeMultiplier(2)->Range(1, 256)->Unit(benchmark::kMillisecond)->UseRealTime();
 BENCHMARK_CAPTURE(BM_ensemble_step, vulkan_factorised_liver_4768, kVulkanFactorised, std::string("liver"), 1)
     ->Arg(4)->Arg(16)->Unit(benchmark::kMillisecond)->UseRealTime();
+BENCHMARK_CAPTURE(BM_ensemble_step, vulkan_uncorrected_factor_liver_4768, kVulkanUncorrectedFactor,
+                  std::string("liver"), 1)
+    ->Arg(16)->Unit(benchmark::kMillisecond)->UseRealTime();
 BENCHMARK_CAPTURE(BM_ensemble_step, vulkan_texel_reads_liver_4768, kVulkanTexelReads, std::string("liver"), 1)
     ->Arg(16)->Arg(64)->Unit(benchmark::kMillisecond)->UseRealTime();
 BENCHMARK_CAPTURE(BM_ensemble_step, vulkan_storage_reads_liver_4768, kVulkanStorageReads, std::string("liver"), 1)
@@ -428,6 +436,8 @@ BENCHMARK_CAPTURE(BM_filter_step, vulkan_three_dispatches, kVulkanThreeDispatche
 BENCHMARK_CAPTURE(BM_filter_step, vulkan, kVulkan, std::string("liver"))
     ->Unit(benchmark::kMillisecond)->UseRealTime();
 BENCHMARK_CAPTURE(BM_filter_step, vulkan_factorised, kVulkanFactorised, std::string("liver"))
+    ->Unit(benchmark::kMillisecond)->UseRealTime();
+BENCHMARK_CAPTURE(BM_filter_step, vulkan_uncorrected_factor, kVulkanUncorrectedFactor, std::string("liver"))
     ->Unit(benchmark::kMillisecond)->UseRealTime();
 BENCHMARK_CAPTURE(BM_filter_step, vulkan_texel_reads, kVulkanTexelReads, std::string("liver"))
     ->Unit(benchmark::kMillisecond)->UseRealTime();

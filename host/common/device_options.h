@@ -30,10 +30,10 @@ enum class KernelForm { automatic, cpu, gpu };
 
 // CG's preconditioner: Jacobi (the oracle's and the device kernels'), or sparse Cholesky
 // factors, one per sigma point of the CPU ensemble or one they share (CpuEnsemble,
-// host/reference/factorised_preconditioner.h), or on OpenCL's CPU form one factor of the
-// mean sigma point's system that all share (OpenClEnsemble); automatic is the factors on the
-// CPU back end and on OpenCL's CPU form, Jacobi on the GPU forms and Vulkan (they have no
-// other yet).
+// host/reference/factorised_preconditioner.h), or on OpenCL's CPU form and Vulkan on a CPU
+// device one factor of the mean sigma point's system that all share (OpenClEnsemble,
+// VulkanFactorSolve); automatic is the factors on the CPU back end, OpenCL's CPU form and
+// Vulkan on a CPU device, Jacobi on the GPU forms (they have no other yet).
 enum class Preconditioner { automatic, jacobi, factorised };
 
 // Own factors pay from this many sigma points (bench/RESULTS.md, stop 49, the liver's filter
@@ -71,9 +71,9 @@ struct DeviceOptions {
   // the springs a shared factor is corrected for (spring_correction); else one factor of the
   // mean sigma point, shared (0: always shared).
   std::size_t own_factors_bytes = std::size_t{8} << 20;
-  // OpenCL's shared factor corrected for each sigma point's own springs at the estimated
-  // ligaments' rows (host/reference/spring_correction.h) where that is small enough; false:
-  // the factor alone (tests and benchmarks compare).
+  // OpenCL's and Vulkan's shared factor corrected for each sigma point's own springs at the
+  // estimated ligaments' rows (host/reference/spring_correction.h) where that is small
+  // enough; false: the factor alone (tests and benchmarks compare).
   bool spring_correction = true;
   // Vulkan with one CG partition forms q = A d inside its CG iteration shader (two dispatches
   // an iteration instead of three: cg_node_iteration, kernels/vulkan/conjugate_gradient.comp)

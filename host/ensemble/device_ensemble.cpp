@@ -93,6 +93,39 @@ Eigen::SparseMatrix<double> DeviceEnsemble::sigma_system(int s, const Eigen::Vec
   return system_at(theta, effects_.empty() ? PhysicsEffects{} : effects_.at(static_cast<std::size_t>(s)), x, v);
 }
 
+std::vector<double> DeviceEnsemble::spring_diagonal(const SpringCorrection& springs,
+                                                    const std::vector<double>& constants, int s,
+                                                    const std::vector<double>& ligament_k) const {
+  // The other springs are the same for all sigma points, and cancel.
+  const double factor = constants[SF_STEP_CONSTANTS + SF_STIFFNESS_FACTOR * S_ + s];
+  std::vector<double> node_k(static_cast<std::size_t>(nodes_), 0.0);
+  for (int l : estimated_.ligaments)
+    for (int node : model_.ligaments[static_cast<std::size_t>(l)].nodes)
+      node_k[static_cast<std::size_t>(node)] += ligament_k[static_cast<std::size_t>(l) * S_ + s];
+  const std::vector<int>& rows = springs.rows();
+  std::vector<double> diagonal(rows.size());
+  for (std::size_t j = 0; j < rows.size(); ++j) diagonal[j] = factor * node_k[static_cast<std::size_t>(rows[j] / 3)];
+  return diagonal;
+}
+
+std::vector<double> DeviceEnsemble::spring_couplings(const SpringCorrection& springs,
+                                                     const std::vector<double>& constants,
+                                                     const std::vector<double>& factorised) const {
+  const std::size_t m = static_cast<std::size_t>(springs.size());
+  std::vector<double> couplings(m * m * static_cast<std::size_t>(S_));
+  for (int s = 0; s < S_; ++s) {
+    const std::vector<double> own = spring_diagonal(springs, constants, s, ligament_k_);
+    Eigen::VectorXd delta(static_cast<Eigen::Index>(m));
+    for (std::size_t j = 0; j < m; ++j) delta[static_cast<Eigen::Index>(j)] = own[j] - factorised[j];
+    const Eigen::MatrixXd H = springs.coupling(delta);
+    for (std::size_t j = 0; j < m; ++j)
+      for (std::size_t k = 0; k < m; ++k)
+        couplings[(static_cast<std::size_t>(s) * m + j) * m + k] =
+            H(static_cast<Eigen::Index>(j), static_cast<Eigen::Index>(k));
+  }
+  return couplings;
+}
+
 std::vector<double> DeviceEnsemble::representative_ligament_k() const {
   std::vector<double> k = ligament_k_;
   if (theta_.size() > 0)

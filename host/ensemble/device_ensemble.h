@@ -24,6 +24,7 @@
 #include "host/model/estimated_parameters.h"
 #include "host/model/model.h"
 #include "host/reference/reference_simulation.h"
+#include "host/reference/spring_correction.h"
 
 namespace sigmafem {
 
@@ -99,6 +100,15 @@ class DeviceEnsemble : public SimulationEnsemble {
   // ligament_k_ with every sigma point's estimated ligaments at the representative's
   // stiffnesses (the sigma points' mean log-stiffnesses, as representative_system has them).
   std::vector<double> representative_ligament_k() const;
+  // A shared factor's correction for the sigma points' springs (SpringCorrection, OpenCL's and
+  // Vulkan's): h (h + a) times the estimated ligaments' springs at each of `springs`' rows,
+  // for sigma point s of the step's constants and stiffnesses ligament_k ([l S + s]) ...
+  std::vector<double> spring_diagonal(const SpringCorrection& springs, const std::vector<double>& constants,
+                                      int s, const std::vector<double>& ligament_k) const;
+  // ... and each sigma point's coupling H for its springs (ligament_k_) against `factorised`,
+  // the springs of the factor's system: [(s m + j) m + k], S m^2 reals.
+  std::vector<double> spring_couplings(const SpringCorrection& springs, const std::vector<double>& constants,
+                                       const std::vector<double>& factorised) const;
   // The step's solver report from CG's per-sigma results; notes the iterations for the next
   // step's first batch.
   StepReport step_report(const std::vector<std::int32_t>& iterations,

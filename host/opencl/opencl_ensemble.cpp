@@ -421,26 +421,11 @@ void OpenClEnsemble::refresh_factor(const std::vector<double>& constants) {
   on_device_ = FactorOnDevice::factor;
 }
 
-std::vector<double> OpenClEnsemble::spring_diagonal(const std::vector<double>& constants, int s,
-                                                    const std::vector<double>& ligament_k) const {
-  // Sigma point s's stiffness factor h (h + a) times its springs of the estimated ligaments at
-  // each spring row (the other springs are the same for all, and cancel).
-  const double factor = constants[SF_STEP_CONSTANTS + SF_STIFFNESS_FACTOR * S_ + s];
-  std::vector<double> node_k(static_cast<std::size_t>(nodes_), 0.0);
-  for (int l : estimated_.ligaments)
-    for (int node : model_.ligaments[static_cast<std::size_t>(l)].nodes)
-      node_k[static_cast<std::size_t>(node)] += ligament_k[static_cast<std::size_t>(l) * S_ + s];
-  const std::vector<int>& rows = springs_.rows();
-  std::vector<double> diagonal(rows.size());
-  for (std::size_t j = 0; j < rows.size(); ++j) diagonal[j] = factor * node_k[static_cast<std::size_t>(rows[j] / 3)];
-  return diagonal;
-}
-
 void OpenClEnsemble::prepare_spring_correction(const std::vector<double>& constants) {
   springs_.prepare(*factor_);
   // The representative's springs, with sigma point 0's stiffness factor (its effects, as
   // representative_system has them).
-  factorised_springs_ = spring_diagonal(constants, 0, representative_ligament_k());
+  factorised_springs_ = spring_diagonal(springs_, constants, 0, representative_ligament_k());
   const std::vector<int>& reached = springs_.reached();
   std::vector<int> at = {static_cast<int>(reached.size())};
   at.insert(at.end(), reached.begin(), reached.end());
@@ -454,19 +439,7 @@ void OpenClEnsemble::prepare_spring_correction(const std::vector<double>& consta
 }
 
 void OpenClEnsemble::upload_spring_coupling(const std::vector<double>& constants) {
-  const std::size_t m = static_cast<std::size_t>(springs_.size());
-  std::vector<double> couplings(m * m * static_cast<std::size_t>(S_));
-  for (int s = 0; s < S_; ++s) {
-    const std::vector<double> own = spring_diagonal(constants, s, ligament_k_);
-    Eigen::VectorXd delta(static_cast<Eigen::Index>(m));
-    for (std::size_t j = 0; j < m; ++j) delta[static_cast<Eigen::Index>(j)] = own[j] - factorised_springs_[j];
-    const Eigen::MatrixXd H = springs_.coupling(delta);
-    for (std::size_t j = 0; j < m; ++j)
-      for (std::size_t k = 0; k < m; ++k)
-        couplings[(static_cast<std::size_t>(s) * m + j) * m + k] =
-            H(static_cast<Eigen::Index>(j), static_cast<Eigen::Index>(k));
-  }
-  write_reals(DeviceBuffer::spring_coupling, couplings);
+  write_reals(DeviceBuffer::spring_coupling, spring_couplings(springs_, constants, factorised_springs_));
   coupling_stale_ = false;
 }
 

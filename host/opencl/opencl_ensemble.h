@@ -86,10 +86,6 @@ class OpenClEnsemble : public DeviceEnsemble {
   void prepare_spring_correction(const std::vector<double>& constants);
   // Each sigma point's coupling H for its springs against the representative's.
   void upload_spring_coupling(const std::vector<double>& constants);
-  // h (h + a) times the estimated ligaments' springs at each spring row, for sigma point s of
-  // the step's constants and stiffnesses ligament_k ([l S + s]).
-  std::vector<double> spring_diagonal(const std::vector<double>& constants, int s,
-                                      const std::vector<double>& ligament_k) const;
   // A stand-in for the factor: L = sqrt(|diag A|), no reordering, so that z = r / |diag A|,
   // Jacobi's preconditioner, until a factorisation succeeds.
   void upload_diagonal_factor(const Eigen::SparseMatrix<double>& A);

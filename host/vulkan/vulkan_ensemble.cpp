@@ -67,6 +67,11 @@ VulkanEnsemble::VulkanEnsemble(const Model& model, EstimatedParameters estimated
       const ReferenceSimulation rest(model_);
       factor_->analyse(representative_system(rest.positions(), rest.velocities()));
       check_device_memory(device_.real_size(), info.name, info.memory, info.max_buffer, factor_->nonzeros());
+      // Corrected for each sigma point's own springs at the estimated ligaments' rows, as
+      // OpenCL's (SpringCorrection), where m x S stays small.
+      std::vector<int> spring_rows = estimated_spring_rows(model_, estimated_);
+      if (options.spring_correction && spring_correction_fits(spring_rows.size(), S_))
+        springs_ = SpringCorrection(std::move(spring_rows));
     }
   }
 
@@ -124,8 +129,8 @@ VulkanEnsemble::VulkanEnsemble(const Model& model, EstimatedParameters estimated
     k_cg_factor_start_ = cg_kernel("cg_factor_start", iteration);
     k_cg_factor_direction_ = cg_kernel("cg_factor_direction", iteration);
     factor_solve_ = std::make_unique<VulkanFactorSolve>(
-        device_, 3 * nodes_, factor_->nonzeros(), S_, buffer(B::r), buffer(B::z), buffer(B::active),
-        options.factor_loop_turns);
+        device_, 3 * nodes_, factor_->nonzeros(), springs_.size(), S_, buffer(B::r), buffer(B::z),
+        buffer(B::active), options.factor_loop_turns);
     device_bytes_ += factor_solve_->bytes();
   }
   if (cg_partitions_ > 1) {
@@ -185,6 +190,7 @@ std::vector<double> VulkanEnsemble::read_reals(DeviceBuffer id, std::size_t coun
 
 void VulkanEnsemble::upload_ligament_k() {
   pending_ligament_k_ = to_device_reals(ligament_k_, device_.precision());
+  coupling_stale_ = springs_.prepared();   // the springs' corrections follow the stiffnesses
 }
 
 bool VulkanEnsemble::has_pending() const {
@@ -273,14 +279,25 @@ void VulkanEnsemble::record_factor_solve(VkCommandBuffer cmd, const VulkanKernel
   device_.barrier(cmd);
 }
 
-void VulkanEnsemble::refresh_factor() {
+void VulkanEnsemble::refresh_factor(const std::vector<double>& constants) {
   // A matrix that is not positive definite (a diverged state?) leaves the last factor in
   // place, and the next step tries again.
   const Eigen::SparseMatrix<double> A = representative_system();
-  if (factor_->factorise(A))
-    factor_solve_->upload(*factor_);
-  else if (!factor_solve_->ready())
-    factor_solve_->upload_diagonal(A);
+  if (!factor_->factorise(A)) {
+    if (!factor_solve_->ready()) factor_solve_->upload_diagonal(A);
+    return;
+  }
+  factor_solve_->upload(*factor_);
+  if (springs_.size() == 0) return;
+  springs_.prepare(*factor_);
+  if (!factor_solve_->upload_springs(springs_)) {
+    springs_ = SpringCorrection();   // too large a correction for a dispatch: the factor alone
+    return;
+  }
+  // The representative's springs, with sigma point 0's stiffness factor (its effects, as
+  // representative_system has them).
+  factorised_springs_ = spring_diagonal(springs_, constants, 0, representative_ligament_k());
+  coupling_stale_ = true;
 }
 
 StepReport VulkanEnsemble::advance(const Eigen::Vector3d& so_position) {
@@ -292,14 +309,18 @@ StepReport VulkanEnsemble::advance(const Eigen::Vector3d& so_position) {
   last_step_waits_ = 0;
   observations_current_ = false;
   const int factorisations_before = factorisations();
-  if (factor_ && factor_->due()) refresh_factor();
+  const std::vector<double> step_constants = step_constants_.next_step(model_, so_position);
+  if (factor_ && factor_->due()) refresh_factor(step_constants);
+  if (coupling_stale_) {
+    factor_solve_->upload_couplings(spring_couplings(springs_, step_constants, factorised_springs_));
+    coupling_stale_ = false;
+  }
 
   // The right-hand side, the warm start and the first batch of iterations: as many as the
   // last step needed (warm-started steps need about the same).
   VkCommandBuffer cmd = device_.begin();
   record_pending(cmd);
-  const std::vector<unsigned char> constants =
-      to_device_reals(step_constants_.next_step(model_, so_position), device_.precision());
+  const std::vector<unsigned char> constants = to_device_reals(step_constants, device_.precision());
   device_.update(cmd, buffer(DeviceBuffer::constants), constants.data(), constants.size());
   device_.barrier(cmd);
   dispatch_items(cmd, k_element_rhs_, s_element_rhs_, elements_ * S, elements_);

@@ -14,7 +14,9 @@
 // (until stop 41 each wrote with its own submission: seven host waits per filter step).
 //
 // Arithmetic and tolerances as OpenClEnsemble: float32 by default, the CG tolerance raised
-// to kSingleCgTolerance; --precision double needs shaderFloat64.
+// to kSingleCgTolerance; --precision double needs shaderFloat64. CG's preconditioner: on a
+// CPU device OpenCL's shared factor corrected for each sigma point's springs
+// (VulkanFactorSolve), on a GPU Jacobi (vulkan_uses_factor).
 #pragma once
 
 #include <Eigen/Core>
@@ -94,8 +96,9 @@ class VulkanEnsemble : public DeviceEnsemble {
   // With a factor: z = M^-1 r, then `finish` (cg_factor_start or cg_factor_direction).
   void record_factor_solve(VkCommandBuffer cmd, const VulkanKernel& finish, VkDescriptorSet set) const;
   // Makes the factor again from the representative (the mean sigma point) when it is due and
-  // uploads it; with no factor yet and a failed factorisation, A's diagonal (Jacobi) instead.
-  void refresh_factor();
+  // uploads it with its spring correction; with no factor yet and a failed factorisation,
+  // A's diagonal (Jacobi) instead.
+  void refresh_factor(const std::vector<double>& constants);
   void record_system_product(VkCommandBuffer cmd, VkDescriptorSet element_product_set) const;
   // Records what set_parameters() and recenter() left for the next submission; flush_pending()
   // submits it alone, before a read-out.
@@ -126,6 +129,11 @@ class VulkanEnsemble : public DeviceEnsemble {
   // CG's shared factor (vulkan_uses_factor), with its refresh rule, and its solve on the device.
   std::unique_ptr<FactorisedPreconditioner> factor_;
   std::unique_ptr<VulkanFactorSolve> factor_solve_;
+  // The factor's correction for each sigma point's springs (no rows: none), the factor's
+  // system's springs at its rows, and whether the couplings are out of date.
+  SpringCorrection springs_;
+  std::vector<double> factorised_springs_;
+  bool coupling_stale_ = false;
   // Descriptor sets; element_product has three: the warm start's product (dv, all active),
   // the CG product (d, the active flags) and system_product()'s (d, all active).
   VkDescriptorSet s_element_rhs_ = VK_NULL_HANDLE, s_node_rhs_ = VK_NULL_HANDLE;

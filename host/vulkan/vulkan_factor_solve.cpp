@@ -20,12 +20,20 @@ struct Push {
 #undef SF_HOST_INT
 static_assert(sizeof(Push) == VulkanDevice::kPushConstantBytes, "SF_PUSH_CONSTANTS' 16 bytes");
 
+// The correction's loop turns: V^T y (m sums of `reached` terms), H V^T y (m of m), y -= V
+// (`reached` of m), each loop turning once more on leaving.
+long long correction_turns(long long m, std::size_t reached) {
+  const long long u = static_cast<long long>(reached);
+  return m * (u + 1) + m * (m + 1) + u * (m + 1) + 3;
+}
+
 }  // namespace
 
 VulkanFactorSolve::VulkanFactorSolve(VulkanDevice& device, int rows, std::size_t nonzeros,
-                                     int sigma_count, const VulkanBuffer& r, const VulkanBuffer& z,
-                                     const VulkanBuffer& active, long long loop_turns)
-    : device_(device), rows_(rows), S_(sigma_count),
+                                     int spring_rows, int sigma_count, const VulkanBuffer& r,
+                                     const VulkanBuffer& z, const VulkanBuffer& active,
+                                     long long loop_turns)
+    : device_(device), rows_(rows), S_(sigma_count), spring_rows_(spring_rows),
       nonzeros_(std::max<std::size_t>(nonzeros, static_cast<std::size_t>(rows))),
       loop_turns_(loop_turns) {
   const std::size_t n = static_cast<std::size_t>(rows), real = device_.real_size();
@@ -36,12 +44,20 @@ VulkanFactorSolve::VulkanFactorSolve(VulkanDevice& device, int rows, std::size_t
   column_rows_ = make(4 * nonzeros_);
   column_values_ = make(real * nonzeros_);
   original_row_ = make(4 * n);
-  work_ = make(real * n * static_cast<std::size_t>(S_));
+  // y's n rows, then V^T y and H V^T y (factor_solve.comp).
+  const std::size_t m = static_cast<std::size_t>(spring_rows_);
+  work_ = make(real * (n + 2 * m) * static_cast<std::size_t>(S_));
+  spring_at_ = make(4 * (2 + n));
+  spring_solves_ = make(real * n * m);
+  spring_coupling_ = make(real * m * m * static_cast<std::size_t>(S_));
+  upload_spring_rows(0, {});
   const std::uint32_t group = static_cast<std::uint32_t>(std::min(S_, kLanes));
   groups_ = (static_cast<std::uint32_t>(S_) + group - 1) / group;
-  kernel_ = device_.kernel("factor_solve", SF_FACTOR_SOLVE_WORK + 1, group, static_cast<std::uint32_t>(rows));
+  kernel_ = device_.kernel("factor_solve", SF_FACTOR_SOLVE_SPRING_COUPLING + 1, group,
+                           static_cast<std::uint32_t>(rows));
   set_ = device_.bind(kernel_, {row_starts_, row_columns_, row_values_, column_starts_, column_rows_,
-                                column_values_, original_row_, r, z, active, work_});
+                                column_values_, original_row_, r, z, active, work_, spring_at_,
+                                spring_solves_, spring_coupling_});
 }
 
 VulkanBuffer VulkanFactorSolve::make(std::size_t bytes) {
@@ -84,6 +100,42 @@ void VulkanFactorSolve::upload(const FactorisedPreconditioner& factor) {
   std::vector<double> row_values(entries), column_values(L.valuePtr(), L.valuePtr() + entries);
   for (std::size_t k = 0; k < entries; ++k) row_values[row_position_[k]] = column_values[k];
   upload_values(row_values, column_values);
+  upload_spring_rows(0, {});   // the last correction was the last factor's
+}
+
+bool VulkanFactorSolve::upload_springs(const SpringCorrection& springs) {
+  if (springs.size() != spring_rows_ || !springs.prepared())
+    throw DeviceError("the factor's spring correction has " + std::to_string(springs.size()) +
+                      " rows (prepared: " + (springs.prepared() ? "yes" : "no") +
+                      "); the Vulkan buffers hold " + std::to_string(spring_rows_));
+  if (correction_turns(springs.size(), springs.reached().size()) + step_turns_.at(static_cast<std::size_t>(rows_)) >
+      loop_turns_)
+    return false;
+  const Eigen::MatrixXd& V = springs.reached_values();
+  std::vector<double> values(static_cast<std::size_t>(V.size()));   // by rows
+  for (Eigen::Index u = 0; u < V.rows(); ++u)
+    for (Eigen::Index j = 0; j < V.cols(); ++j) values[static_cast<std::size_t>(u * V.cols() + j)] = V(u, j);
+  const std::vector<unsigned char> bytes = to_device_reals(values, device_.precision());
+  if (!bytes.empty()) device_.upload(spring_solves_, bytes.data(), bytes.size());
+  upload_spring_rows(springs.size(), springs.reached());
+  return true;
+}
+
+void VulkanFactorSolve::upload_couplings(const std::vector<double>& couplings) {
+  const std::size_t m = static_cast<std::size_t>(spring_rows_);
+  if (couplings.size() != m * m * static_cast<std::size_t>(S_))
+    throw DeviceError("the springs' couplings: " + std::to_string(couplings.size()) + " reals for " +
+                      std::to_string(m * m * static_cast<std::size_t>(S_)));
+  const std::vector<unsigned char> bytes = to_device_reals(couplings, device_.precision());
+  if (!bytes.empty()) device_.upload(spring_coupling_, bytes.data(), bytes.size());
+}
+
+void VulkanFactorSolve::upload_spring_rows(int m, const std::vector<int>& reached) {
+  std::vector<int> at = {m, static_cast<int>(reached.size())};
+  at.insert(at.end(), reached.begin(), reached.end());
+  upload_ints(spring_at_, at);
+  correction_turns_ = correction_turns(m, reached.size());
+  plan_dispatches();
 }
 
 void VulkanFactorSolve::upload_diagonal(const Eigen::SparseMatrix<double>& A) {
@@ -101,6 +153,7 @@ void VulkanFactorSolve::upload_diagonal(const Eigen::SparseMatrix<double>& A) {
   starts[n] = static_cast<int>(n);
   upload_pattern(starts, identity, starts, identity, identity);
   upload_values(values, values);
+  upload_spring_rows(0, {});
   pattern_ = Pattern::diagonal;
 }
 
@@ -112,21 +165,32 @@ void VulkanFactorSolve::upload_pattern(const std::vector<int>& row_starts, const
   upload_ints(column_starts_, column_starts);
   upload_ints(column_rows_, column_rows);
   upload_ints(original_row_, original_row);
-  // The 2n steps (forward rows 0 .. n-1, then backward columns n-1 .. 0) cut into ranges of at
-  // most loop_turns_ turns: a step turns once and once per entry of its row or column, and
-  // a loop once more on leaving (counted with the step, to be safe).
+  // Each step turns once and once per entry of its row or column, and its loop once more on
+  // leaving (counted with the step, to be safe).
+  const std::size_t n = static_cast<std::size_t>(rows_);
+  step_turns_.assign(2 * n, 0);
+  for (std::size_t step = 0; step < 2 * n; ++step) {
+    const std::size_t j = step < n ? step : 2 * n - 1 - step;
+    const std::vector<int>& starts = step < n ? row_starts : column_starts;
+    step_turns_[step] = starts[j + 1] - starts[j] + 2;
+  }
+  plan_dispatches();
+}
+
+void VulkanFactorSolve::plan_dispatches() {
+  // The 2n steps (forward rows 0 .. n-1, then backward columns n-1 .. 0, the correction with
+  // step n) cut into ranges of at most loop_turns_ turns.
   ranges_.clear();
+  if (step_turns_.empty()) return;
   const std::size_t n = static_cast<std::size_t>(rows_);
   long long turns = 0;
   std::uint32_t first = 0;
   for (std::size_t step = 0; step < 2 * n; ++step) {
-    const std::size_t j = step < n ? step : 2 * n - 1 - step;
-    const std::vector<int>& starts = step < n ? row_starts : column_starts;
-    const long long cost = starts[j + 1] - starts[j] + 2;
+    const long long cost = step_turns_[step] + (step == n ? correction_turns_ : 0);
     if (cost > loop_turns_)
-      throw DeviceError("the factor's row " + std::to_string(j) + " has " +
-                        std::to_string(cost - 2) + " entries, more than a Vulkan dispatch may turn (" +
-                        std::to_string(loop_turns_) + " loop turns)");
+      throw DeviceError("the factor's step " + std::to_string(step) + " turns " + std::to_string(cost) +
+                        " times, more than a Vulkan dispatch may turn (" + std::to_string(loop_turns_) +
+                        " loop turns)");
     if (turns + cost > loop_turns_) {
       ranges_.emplace_back(first, static_cast<std::uint32_t>(step));
       first = static_cast<std::uint32_t>(step);

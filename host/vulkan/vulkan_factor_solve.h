@@ -13,6 +13,7 @@
 #include <vector>
 
 #include "host/reference/factorised_preconditioner.h"
+#include "host/reference/spring_correction.h"
 #include "host/vulkan/vulkan_device.h"
 
 namespace sigmafem {
@@ -23,15 +24,22 @@ class VulkanFactorSolve {
   static constexpr int kLanes = 8;
 
   // Room for a factor of n rows and `nonzeros` entries (FactorisedPreconditioner::nonzeros()
-  // after analyse()) for `sigma_count` sigma points; r, z and the active flags are CG's
-  // buffers, [row S + s]. `loop_turns`: the most a dispatch may turn (DeviceOptions).
-  VulkanFactorSolve(VulkanDevice& device, int rows, std::size_t nonzeros, int sigma_count,
-                    const VulkanBuffer& r, const VulkanBuffer& z, const VulkanBuffer& active,
-                    long long loop_turns);
+  // after analyse()) for `sigma_count` sigma points, with a correction for each one's springs
+  // at `spring_rows` rows (m; 0: none); r, z and the active flags are CG's buffers,
+  // [row S + s]. `loop_turns`: the most a dispatch may turn (DeviceOptions).
+  VulkanFactorSolve(VulkanDevice& device, int rows, std::size_t nonzeros, int spring_rows,
+                    int sigma_count, const VulkanBuffer& r, const VulkanBuffer& z,
+                    const VulkanBuffer& active, long long loop_turns);
 
   // Sends a fresh factorisation (factor.ready(); its pattern is the analysis's, so after the
-  // first only the values go).
+  // first only the values go), uncorrected until upload_springs().
   void upload(const FactorisedPreconditioner& factor);
+  // The correction of the factor just uploaded (springs.prepare()d with it; its m the
+  // constructor's), and each sigma point's coupling H ([(s m + j) m + k], S m^2 reals) for it.
+  // False, and the factor left uncorrected, where the correction would turn more loops than
+  // one dispatch may (m times the rows it reaches, twice).
+  bool upload_springs(const SpringCorrection& springs);
+  void upload_couplings(const std::vector<double>& couplings);
   // A stand-in until a factorisation succeeds: L = sqrt|diag A|, no reordering, so that
   // z = r / |diag A|, Jacobi's preconditioner.
   void upload_diagonal(const Eigen::SparseMatrix<double>& A);
@@ -53,11 +61,15 @@ class VulkanFactorSolve {
                       const std::vector<int>& column_starts, const std::vector<int>& column_rows,
                       const std::vector<int>& original_row);
   void upload_values(const std::vector<double>& row_values, const std::vector<double>& column_values);
+  // The correction's rows on the device: m and `reached`, then those rows (none: m = 0).
+  void upload_spring_rows(int m, const std::vector<int>& reached);
+  // ranges_ from the steps' loop turns and the correction's.
+  void plan_dispatches();
   VulkanBuffer make(std::size_t bytes);
   void upload_ints(const VulkanBuffer& buffer, const std::vector<int>& values);
 
   VulkanDevice& device_;
-  int rows_ = 0, S_ = 0;
+  int rows_ = 0, S_ = 0, spring_rows_ = 0;
   std::size_t nonzeros_ = 0;
   long long loop_turns_ = 0;
   std::size_t bytes_ = 0;
@@ -65,10 +77,14 @@ class VulkanFactorSolve {
   Pattern pattern_ = Pattern::none;
   // The factor's pattern in L's column storage -> its place in the row storage.
   std::vector<std::size_t> row_position_;
-  // The dispatches: ranges [first, last) of the 2n steps (factor_solve.comp).
+  // Each of the 2n steps' loop turns (a forward row's, a backward column's), the
+  // correction's (with step n), and the dispatches: ranges [first, last) of the steps
+  // (factor_solve.comp).
+  std::vector<long long> step_turns_;
+  long long correction_turns_ = 0;
   std::vector<std::pair<std::uint32_t, std::uint32_t>> ranges_;
   VulkanBuffer row_starts_, row_columns_, row_values_, column_starts_, column_rows_,
-      column_values_, original_row_, work_;
+      column_values_, original_row_, work_, spring_at_, spring_solves_, spring_coupling_;
   VulkanKernel kernel_;
   VkDescriptorSet set_ = VK_NULL_HANDLE;
   std::uint32_t groups_ = 1;

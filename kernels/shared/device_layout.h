@@ -164,7 +164,9 @@
 #define SF_CG_ITERATION_ELEMENT_OUT 24
 /* Vulkan's factor_solve (z = M^-1 r with a sparse Cholesky factor; host/vulkan/vulkan_factor_solve.h):
  * L by rows (for L y = P r) and by columns (for L^T w = y), each row's L position's original
- * row, CG's r, z and active flags, and the work vector y. */
+ * row, CG's r, z and active flags, the work vector y, and the factor's correction for each
+ * sigma point's springs (host/reference/spring_correction.h): [m, reached rows u, the rows],
+ * V there by rows and each sigma point's m x m H. */
 #define SF_FACTOR_SOLVE_ROW_STARTS 0
 #define SF_FACTOR_SOLVE_ROW_COLUMNS 1
 #define SF_FACTOR_SOLVE_ROW_VALUES 2
@@ -176,5 +178,8 @@
 #define SF_FACTOR_SOLVE_Z 8
 #define SF_FACTOR_SOLVE_ACTIVE 9
 #define SF_FACTOR_SOLVE_WORK 10
+#define SF_FACTOR_SOLVE_SPRING_AT 11
+#define SF_FACTOR_SOLVE_SPRING_SOLVES 12
+#define SF_FACTOR_SOLVE_SPRING_COUPLING 13
 
 #endif /* SIGMAFEM_DEVICE_LAYOUT_H */

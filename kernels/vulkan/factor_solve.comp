@@ -8,14 +8,18 @@
  * the sigma points are independent, and L's entries are read once for the group at the same
  * address in every lane. Both substitutions read, never scatter: L y = P r by L's rows
  * (y_j = ((P r)_j - sum_k<j L_jk y_k) / L_jj) and L^T w = y by its columns (w_j = (y_j -
- * sum_k>j L_kj w_k) / L_jj), each w_j also stored as z at its original row.
+ * sum_k>j L_kj w_k) / L_jj), each w_j also stored as z at its original row. Between them,
+ * the correction for the sigma point's own springs (SpringCorrection, host/reference/
+ * spring_correction.h; OpenCL's SF_SPRING_ROWS): y -= V H_s V^T y at the rows V reaches, with
+ * V^T y and H_s V^T y kept in y's rows n .. n + 2m - 1 (none where m = 0).
  *
  * llvmpipe ends every loop of an invocation, silently, once its loops together have turned
  * 65535 times (gallivm's LP_MAX_TGSI_LOOP_ITERATIONS; bench/RESULTS.md, stop 52), and a
  * factor has far more entries than that beyond the smallest meshes. So one dispatch does a
  * range of the two passes' 2n steps (steps 0 .. n-1 the forward rows, n .. 2n-1 the backward
  * columns from the last), the ranges cut by the host to a bound of loop turns
- * (push constants: count = the first step, p = one past the last; S the sigma points).
+ * (push constants: count = the first step, p = one past the last; S the sigma points); the
+ * correction goes with step n, the first backward one.
  * An inactive sigma point (CG done) is left alone.
  *
  * The work vector y ([row S + s], in L's order) is a storage texel buffer in float32: llvmpipe
@@ -39,6 +43,9 @@ SF_READ_INTS(SF_FACTOR_SOLVE_ORIGINAL_ROW, original_row)
 SF_READ_REALS(SF_FACTOR_SOLVE_R, r)
 layout(std430, binding = SF_FACTOR_SOLVE_Z) restrict writeonly buffer Z { real z[]; };
 SF_READ_UINTS(SF_FACTOR_SOLVE_ACTIVE, active_flags)
+SF_READ_INTS(SF_FACTOR_SOLVE_SPRING_AT, spring_at)
+SF_READ_REALS(SF_FACTOR_SOLVE_SPRING_SOLVES, spring_solves)
+SF_READ_REALS(SF_FACTOR_SOLVE_SPRING_COUPLING, spring_coupling)
 #if defined(SF_USE_DOUBLE)
 layout(std430, binding = SF_FACTOR_SOLVE_WORK) restrict buffer Work { real y[]; };
 #  define SF_Y(i) y[i]
@@ -48,6 +55,28 @@ layout(binding = SF_FACTOR_SOLVE_WORK, r32f) uniform restrict imageBuffer y;
 #  define SF_Y(i) imageLoad(y, int(i)).x
 #  define SF_SET_Y(i, value) imageStore(y, int(i), vec4(value))
 #endif
+
+/* y -= V H_s V^T y for sigma point s, each sum in a register (no arrays of m per lane). */
+void sf_spring_correction(uint s, uint S, uint n) {
+  uint m = uint(SF_LOAD(spring_at, 0)), reached = uint(SF_LOAD(spring_at, 1));
+  for (uint j = 0u; j < m; ++j) { /* V^T y */
+    real sum = real(0);
+    for (uint u = 0u; u < reached; ++u)
+      sum += SF_LOAD(spring_solves, u * m + j) * SF_Y(uint(SF_LOAD(spring_at, 2u + u)) * S + s);
+    SF_SET_Y((n + j) * S + s, sum);
+  }
+  for (uint j = 0u; j < m; ++j) { /* H_s V^T y */
+    real sum = real(0);
+    for (uint k = 0u; k < m; ++k) sum += SF_LOAD(spring_coupling, (s * m + j) * m + k) * SF_Y((n + k) * S + s);
+    SF_SET_Y((n + m + j) * S + s, sum);
+  }
+  for (uint u = 0u; u < reached; ++u) { /* y -= V H_s V^T y */
+    uint at = uint(SF_LOAD(spring_at, 2u + u)) * S + s;
+    real sum = real(0);
+    for (uint j = 0u; j < m; ++j) sum += SF_LOAD(spring_solves, u * m + j) * SF_Y((n + m + j) * S + s);
+    SF_SET_Y(at, SF_Y(at) - sum);
+  }
+}
 
 void main() {
   uint S = sf_push.S;
@@ -63,6 +92,7 @@ void main() {
     real b = SF_LOAD(r, uint(SF_LOAD(original_row, j)) * S + s);
     SF_SET_Y(j * S + s, (b - sum) / SF_LOAD(row_values, end));
   }
+  if (first <= n && n < last) sf_spring_correction(s, S, n);
   for (uint step = max(first, n); step < last; ++step) { /* L^T w = y: column j, diagonal first */
     uint j = 2u * n - 1u - step;
     int begin = SF_LOAD(column_starts, j), end = SF_LOAD(column_starts, j + 1u);
