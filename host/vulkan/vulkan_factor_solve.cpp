@@ -20,13 +20,6 @@ struct Push {
 #undef SF_HOST_INT
 static_assert(sizeof(Push) == VulkanDevice::kPushConstantBytes, "SF_PUSH_CONSTANTS' 16 bytes");
 
-// The correction's loop turns: V^T y (m sums of `reached` terms), H V^T y (m of m), y -= V
-// (`reached` of m), each loop turning once more on leaving.
-long long correction_turns(long long m, std::size_t reached) {
-  const long long u = static_cast<long long>(reached);
-  return m * (u + 1) + m * (m + 1) + u * (m + 1) + 3;
-}
-
 }  // namespace
 
 VulkanFactorSolve::VulkanFactorSolve(VulkanDevice& device, int rows, std::size_t nonzeros,
@@ -108,9 +101,9 @@ bool VulkanFactorSolve::upload_springs(const SpringCorrection& springs) {
     throw DeviceError("the factor's spring correction has " + std::to_string(springs.size()) +
                       " rows (prepared: " + (springs.prepared() ? "yes" : "no") +
                       "); the Vulkan buffers hold " + std::to_string(spring_rows_));
-  if (correction_turns(springs.size(), springs.reached().size()) + step_turns_.at(static_cast<std::size_t>(rows_)) >
-      loop_turns_)
-    return false;
+  // A step of the correction sums over the reached rows or over m (factor_solve.comp).
+  const long long longest = std::max<long long>(springs.size(), static_cast<long long>(springs.reached().size()));
+  if (longest + 2 > loop_turns_) return false;
   const Eigen::MatrixXd& V = springs.reached_values();
   std::vector<double> values(static_cast<std::size_t>(V.size()));   // by rows
   for (Eigen::Index u = 0; u < V.rows(); ++u)
@@ -134,7 +127,7 @@ void VulkanFactorSolve::upload_spring_rows(int m, const std::vector<int>& reache
   std::vector<int> at = {m, static_cast<int>(reached.size())};
   at.insert(at.end(), reached.begin(), reached.end());
   upload_ints(spring_at_, at);
-  correction_turns_ = correction_turns(m, reached.size());
+  spring_steps_ = {m, static_cast<int>(reached.size())};
   plan_dispatches();
 }
 
@@ -165,40 +158,44 @@ void VulkanFactorSolve::upload_pattern(const std::vector<int>& row_starts, const
   upload_ints(column_starts_, column_starts);
   upload_ints(column_rows_, column_rows);
   upload_ints(original_row_, original_row);
-  // Each step turns once and once per entry of its row or column, and its loop once more on
-  // leaving (counted with the step, to be safe).
+  // A substitution's step turns once and once per entry of its row or column besides the
+  // diagonal, and its loop once more on leaving (counted with the step, to be safe).
   const std::size_t n = static_cast<std::size_t>(rows_);
-  step_turns_.assign(2 * n, 0);
-  for (std::size_t step = 0; step < 2 * n; ++step) {
-    const std::size_t j = step < n ? step : 2 * n - 1 - step;
-    const std::vector<int>& starts = step < n ? row_starts : column_starts;
-    step_turns_[step] = starts[j + 1] - starts[j] + 2;
+  forward_turns_.resize(n);
+  backward_turns_.resize(n);
+  for (std::size_t j = 0; j < n; ++j) {
+    forward_turns_[j] = row_starts[j + 1] - row_starts[j] + 1;
+    backward_turns_[j] = column_starts[j + 1] - column_starts[j] + 1;
   }
   plan_dispatches();
 }
 
 void VulkanFactorSolve::plan_dispatches() {
-  // The 2n steps (forward rows 0 .. n-1, then backward columns n-1 .. 0, the correction with
-  // step n) cut into ranges of at most loop_turns_ turns.
+  // The steps of factor_solve.comp (the forward rows, the correction's 2m + u, the backward
+  // columns from the last) cut into ranges of at most loop_turns_ turns.
   ranges_.clear();
-  if (step_turns_.empty()) return;
-  const std::size_t n = static_cast<std::size_t>(rows_);
-  long long turns = 0;
+  if (forward_turns_.empty()) return;
+  const auto [m, reached] = spring_steps_;
+  std::vector<long long> turns(forward_turns_);
+  turns.insert(turns.end(), static_cast<std::size_t>(m), reached + 2);   // (V^T y)_j
+  turns.insert(turns.end(), static_cast<std::size_t>(m), m + 2);         // (H V^T y)_j
+  turns.insert(turns.end(), static_cast<std::size_t>(reached), m + 2);   // y -= V H V^T y, a row
+  turns.insert(turns.end(), backward_turns_.rbegin(), backward_turns_.rend());
+  long long sum = 0;
   std::uint32_t first = 0;
-  for (std::size_t step = 0; step < 2 * n; ++step) {
-    const long long cost = step_turns_[step] + (step == n ? correction_turns_ : 0);
-    if (cost > loop_turns_)
-      throw DeviceError("the factor's step " + std::to_string(step) + " turns " + std::to_string(cost) +
+  for (std::size_t step = 0; step < turns.size(); ++step) {
+    if (turns[step] > loop_turns_)
+      throw DeviceError("the factor's step " + std::to_string(step) + " turns " + std::to_string(turns[step]) +
                         " times, more than a Vulkan dispatch may turn (" + std::to_string(loop_turns_) +
                         " loop turns)");
-    if (turns + cost > loop_turns_) {
+    if (sum + turns[step] > loop_turns_) {
       ranges_.emplace_back(first, static_cast<std::uint32_t>(step));
       first = static_cast<std::uint32_t>(step);
-      turns = 0;
+      sum = 0;
     }
-    turns += cost;
+    sum += turns[step];
   }
-  ranges_.emplace_back(first, static_cast<std::uint32_t>(2 * n));
+  ranges_.emplace_back(first, static_cast<std::uint32_t>(turns.size()));
 }
 
 void VulkanFactorSolve::upload_values(const std::vector<double>& row_values,

@@ -36,8 +36,8 @@ class VulkanFactorSolve {
   void upload(const FactorisedPreconditioner& factor);
   // The correction of the factor just uploaded (springs.prepare()d with it; its m the
   // constructor's), and each sigma point's coupling H ([(s m + j) m + k], S m^2 reals) for it.
-  // False, and the factor left uncorrected, where the correction would turn more loops than
-  // one dispatch may (m times the rows it reaches, twice).
+  // False, and the factor left uncorrected, where one of the correction's sums would turn
+  // more loops than one dispatch may.
   bool upload_springs(const SpringCorrection& springs);
   void upload_couplings(const std::vector<double>& couplings);
   // A stand-in until a factorisation succeeds: L = sqrt|diag A|, no reordering, so that
@@ -63,7 +63,7 @@ class VulkanFactorSolve {
   void upload_values(const std::vector<double>& row_values, const std::vector<double>& column_values);
   // The correction's rows on the device: m and `reached`, then those rows (none: m = 0).
   void upload_spring_rows(int m, const std::vector<int>& reached);
-  // ranges_ from the steps' loop turns and the correction's.
+  // ranges_ from the steps' loop turns.
   void plan_dispatches();
   VulkanBuffer make(std::size_t bytes);
   void upload_ints(const VulkanBuffer& buffer, const std::vector<int>& values);
@@ -77,11 +77,11 @@ class VulkanFactorSolve {
   Pattern pattern_ = Pattern::none;
   // The factor's pattern in L's column storage -> its place in the row storage.
   std::vector<std::size_t> row_position_;
-  // Each of the 2n steps' loop turns (a forward row's, a backward column's), the
-  // correction's (with step n), and the dispatches: ranges [first, last) of the steps
+  // The loop turns of each forward row's step and each backward column's (by column), the
+  // correction's m and reached rows, and the dispatches: ranges [first, last) of the steps
   // (factor_solve.comp).
-  std::vector<long long> step_turns_;
-  long long correction_turns_ = 0;
+  std::vector<long long> forward_turns_, backward_turns_;
+  std::pair<int, int> spring_steps_{0, 0};
   std::vector<std::pair<std::uint32_t, std::uint32_t>> ranges_;
   VulkanBuffer row_starts_, row_columns_, row_values_, column_starts_, column_rows_,
       column_values_, original_row_, work_, spring_at_, spring_solves_, spring_coupling_;

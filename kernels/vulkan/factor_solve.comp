@@ -11,15 +11,19 @@
  * sum_k>j L_kj w_k) / L_jj), each w_j also stored as z at its original row. Between them,
  * the correction for the sigma point's own springs (SpringCorrection, host/reference/
  * spring_correction.h; OpenCL's SF_SPRING_ROWS): y -= V H_s V^T y at the rows V reaches, with
- * V^T y and H_s V^T y kept in y's rows n .. n + 2m - 1 (none where m = 0).
+ * V^T y and H_s V^T y kept in y's rows n .. n + 2m - 1 (none where m = 0: no steps).
  *
  * llvmpipe ends every loop of an invocation, silently, once its loops together have turned
  * 65535 times (gallivm's LP_MAX_TGSI_LOOP_ITERATIONS; bench/RESULTS.md, stop 52), and a
- * factor has far more entries than that beyond the smallest meshes. So one dispatch does a
- * range of the two passes' 2n steps (steps 0 .. n-1 the forward rows, n .. 2n-1 the backward
- * columns from the last), the ranges cut by the host to a bound of loop turns
- * (push constants: count = the first step, p = one past the last; S the sigma points); the
- * correction goes with step n, the first backward one.
+ * factor has far more entries than that beyond the smallest meshes. So the solve is a
+ * sequence of steps, each a short loop, and one dispatch does a range of them, cut by the
+ * host to a bound of loop turns (push constants: count = the first step, p = one past the
+ * last; S the sigma points). The steps, with m spring rows reaching u rows of L:
+ *   [0, n)                   the forward rows
+ *   [n, n + m)               V^T y, a sum over the u rows each
+ *   [n + m, n + 2m)          H_s V^T y, a sum over m each
+ *   [n + 2m, n + 2m + u)     y -= V H_s V^T y at one reached row each
+ *   [n + 2m + u, 2n + 2m + u)  the backward columns, from the last.
  * An inactive sigma point (CG done) is left alone.
  *
  * The work vector y ([row S + s], in L's order) is a storage texel buffer in float32: llvmpipe
@@ -56,35 +60,15 @@ layout(binding = SF_FACTOR_SOLVE_WORK, r32f) uniform restrict imageBuffer y;
 #  define SF_SET_Y(i, value) imageStore(y, int(i), vec4(value))
 #endif
 
-/* y -= V H_s V^T y for sigma point s, each sum in a register (no arrays of m per lane). */
-void sf_spring_correction(uint s, uint S, uint n) {
-  uint m = uint(SF_LOAD(spring_at, 0)), reached = uint(SF_LOAD(spring_at, 1));
-  for (uint j = 0u; j < m; ++j) { /* V^T y */
-    real sum = real(0);
-    for (uint u = 0u; u < reached; ++u)
-      sum += SF_LOAD(spring_solves, u * m + j) * SF_Y(uint(SF_LOAD(spring_at, 2u + u)) * S + s);
-    SF_SET_Y((n + j) * S + s, sum);
-  }
-  for (uint j = 0u; j < m; ++j) { /* H_s V^T y */
-    real sum = real(0);
-    for (uint k = 0u; k < m; ++k) sum += SF_LOAD(spring_coupling, (s * m + j) * m + k) * SF_Y((n + k) * S + s);
-    SF_SET_Y((n + m + j) * S + s, sum);
-  }
-  for (uint u = 0u; u < reached; ++u) { /* y -= V H_s V^T y */
-    uint at = uint(SF_LOAD(spring_at, 2u + u)) * S + s;
-    real sum = real(0);
-    for (uint j = 0u; j < m; ++j) sum += SF_LOAD(spring_solves, u * m + j) * SF_Y((n + m + j) * S + s);
-    SF_SET_Y(at, SF_Y(at) - sum);
-  }
-}
-
 void main() {
   uint S = sf_push.S;
   uint s = gl_WorkGroupID.x * gl_WorkGroupSize.x + gl_LocalInvocationID.x;
   if (s >= S || SF_LOAD(active_flags, s) == 0u) return;
   uint n = SF_FACTOR_ROWS;
+  uint m = uint(SF_LOAD(spring_at, 0)), reached = uint(SF_LOAD(spring_at, 1));
+  uint projected = n, coupled = n + m, updated = n + 2u * m, backward = n + 2u * m + reached;
   uint first = sf_push.count, last = sf_push.p;
-  for (uint j = first; j < min(last, n); ++j) { /* L y = P r: row j, its diagonal last */
+  for (uint j = first; j < min(last, projected); ++j) { /* L y = P r: row j, its diagonal last */
     int begin = SF_LOAD(row_starts, j), end = SF_LOAD(row_starts, j + 1u) - 1;
     real sum = real(0);
     for (int k = begin; k < end; ++k)
@@ -92,9 +76,30 @@ void main() {
     real b = SF_LOAD(r, uint(SF_LOAD(original_row, j)) * S + s);
     SF_SET_Y(j * S + s, (b - sum) / SF_LOAD(row_values, end));
   }
-  if (first <= n && n < last) sf_spring_correction(s, S, n);
-  for (uint step = max(first, n); step < last; ++step) { /* L^T w = y: column j, diagonal first */
-    uint j = 2u * n - 1u - step;
+  /* The springs' correction, each sum in a register (no arrays of m per lane). */
+  for (uint step = max(first, projected); step < min(last, coupled); ++step) { /* (V^T y)_j */
+    uint j = step - projected;
+    real sum = real(0);
+    for (uint u = 0u; u < reached; ++u)
+      sum += SF_LOAD(spring_solves, u * m + j) * SF_Y(uint(SF_LOAD(spring_at, 2u + u)) * S + s);
+    SF_SET_Y(step * S + s, sum);
+  }
+  for (uint step = max(first, coupled); step < min(last, updated); ++step) { /* (H_s V^T y)_j */
+    uint j = step - coupled;
+    real sum = real(0);
+    for (uint k = 0u; k < m; ++k)
+      sum += SF_LOAD(spring_coupling, (s * m + j) * m + k) * SF_Y((projected + k) * S + s);
+    SF_SET_Y(step * S + s, sum);
+  }
+  for (uint step = max(first, updated); step < min(last, backward); ++step) { /* y -= V H_s V^T y */
+    uint u = step - updated;
+    uint at = uint(SF_LOAD(spring_at, 2u + u)) * S + s;
+    real sum = real(0);
+    for (uint j = 0u; j < m; ++j) sum += SF_LOAD(spring_solves, u * m + j) * SF_Y((coupled + j) * S + s);
+    SF_SET_Y(at, SF_Y(at) - sum);
+  }
+  for (uint step = max(first, backward); step < last; ++step) { /* L^T w = y: column j, diagonal first */
+    uint j = backward + n - 1u - step;
     int begin = SF_LOAD(column_starts, j), end = SF_LOAD(column_starts, j + 1u);
     real sum = real(0);
     for (int k = begin + 1; k < end; ++k)
