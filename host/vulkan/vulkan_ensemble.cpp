@@ -311,10 +311,6 @@ StepReport VulkanEnsemble::advance(const Eigen::Vector3d& so_position) {
   const int factorisations_before = factorisations();
   const std::vector<double> step_constants = step_constants_.next_step(model_, so_position);
   if (factor_ && factor_->due()) refresh_factor(step_constants);
-  if (coupling_stale_) {
-    factor_solve_->upload_couplings(spring_couplings(springs_, step_constants, factorised_springs_));
-    coupling_stale_ = false;
-  }
 
   // The right-hand side, the warm start and the first batch of iterations: as many as the
   // last step needed (warm-started steps need about the same).
@@ -322,6 +318,10 @@ StepReport VulkanEnsemble::advance(const Eigen::Vector3d& so_position) {
   record_pending(cmd);
   const std::vector<unsigned char> constants = to_device_reals(step_constants, device_.precision());
   device_.update(cmd, buffer(DeviceBuffer::constants), constants.data(), constants.size());
+  if (coupling_stale_) {   // the springs' couplings for this step's stiffnesses (or factor)
+    factor_solve_->record_couplings(cmd, spring_couplings(springs_, step_constants, factorised_springs_));
+    coupling_stale_ = false;
+  }
   device_.barrier(cmd);
   dispatch_items(cmd, k_element_rhs_, s_element_rhs_, elements_ * S, elements_);
   dispatch_items(cmd, k_node_rhs_, s_node_rhs_, nodes_ * S, nodes_);

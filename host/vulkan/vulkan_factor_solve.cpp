@@ -114,13 +114,13 @@ bool VulkanFactorSolve::upload_springs(const SpringCorrection& springs) {
   return true;
 }
 
-void VulkanFactorSolve::upload_couplings(const std::vector<double>& couplings) {
+void VulkanFactorSolve::record_couplings(VkCommandBuffer cmd, const std::vector<double>& couplings) const {
   const std::size_t m = static_cast<std::size_t>(spring_rows_);
   if (couplings.size() != m * m * static_cast<std::size_t>(S_))
     throw DeviceError("the springs' couplings: " + std::to_string(couplings.size()) + " reals for " +
                       std::to_string(m * m * static_cast<std::size_t>(S_)));
   const std::vector<unsigned char> bytes = to_device_reals(couplings, device_.precision());
-  if (!bytes.empty()) device_.upload(spring_coupling_, bytes.data(), bytes.size());
+  device_.update(cmd, spring_coupling_, bytes.data(), bytes.size());
 }
 
 void VulkanFactorSolve::upload_spring_rows(int m, const std::vector<int>& reached) {

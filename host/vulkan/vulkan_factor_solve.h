@@ -35,11 +35,12 @@ class VulkanFactorSolve {
   // first only the values go), uncorrected until upload_springs().
   void upload(const FactorisedPreconditioner& factor);
   // The correction of the factor just uploaded (springs.prepare()d with it; its m the
-  // constructor's), and each sigma point's coupling H ([(s m + j) m + k], S m^2 reals) for it.
-  // False, and the factor left uncorrected, where one of the correction's sums would turn
-  // more loops than one dispatch may.
+  // constructor's). False, and the factor left uncorrected, where one of the correction's sums
+  // would turn more loops than one dispatch may.
   bool upload_springs(const SpringCorrection& springs);
-  void upload_couplings(const std::vector<double>& couplings);
+  // Records each sigma point's coupling H ([(s m + j) m + k], S m^2 reals) for the correction,
+  // into `cmd` (no host wait; the caller's barrier follows).
+  void record_couplings(VkCommandBuffer cmd, const std::vector<double>& couplings) const;
   // A stand-in until a factorisation succeeds: L = sqrt|diag A|, no reordering, so that
   // z = r / |diag A|, Jacobi's preconditioner.
   void upload_diagonal(const Eigen::SparseMatrix<double>& A);

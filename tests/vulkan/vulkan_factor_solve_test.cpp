@@ -84,10 +84,14 @@ class VulkanFactorSolveTest : public ::testing::Test {
           for (std::size_t k = 0; k < m; ++k)
             couplings.push_back(H(static_cast<Eigen::Index>(j), static_cast<Eigen::Index>(k)));
       }
-      solve.upload_couplings(couplings);
+      couplings_ = couplings;
     }
     if (dispatches) *dispatches = solve.dispatches();
     VkCommandBuffer cmd = device.begin();
+    if (springs) {
+      solve.record_couplings(cmd, couplings_);
+      device.barrier(cmd);
+    }
     solve.record(cmd);
     device.submit_and_wait(cmd);
     std::vector<float> z(r.size());
@@ -108,6 +112,7 @@ class VulkanFactorSolveTest : public ::testing::Test {
   FactorisedPreconditioner factor_;
   int n_ = 0;
   std::vector<int> spring_rows_;   // the box's estimated ligaments' rows
+  std::vector<double> couplings_;  // each sigma point's H for spring_delta(s)
 };
 
 // Against P^T L^-T L^-1 P r in double from the same L, for S = 11 (a group of 8 and one of
