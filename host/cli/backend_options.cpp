@@ -33,9 +33,9 @@ void add_backend_options(CLI::App* command, BackendChoice& choice) {
       ->capture_default_str();
   command->add_option("--preconditioner", choice.preconditioner,
                       "CG's preconditioner: jacobi, factorised (sparse Cholesky factors: on cpu one "
-                      "per sigma point or one they share, on OpenCL's CPU device one they share; "
-                      "not vulkan) or auto (factorised on cpu and on OpenCL's CPU device, else "
-                      "jacobi)")
+                      "per sigma point or one they share, on OpenCL's and Vulkan's CPU devices one "
+                      "they share; not on a GPU) or auto (factorised on cpu and on a CPU device, "
+                      "else jacobi)")
       ->check(CLI::IsMember({"auto", "jacobi", "factorised"}))
       ->capture_default_str();
 }
