@@ -30,23 +30,25 @@ std::unique_ptr<SimulationEnsemble> make_ensemble(const std::string& backend, co
   throw InputError("--backend " + backend + ": unknown back end (available: " + names + ")");
 }
 
+namespace {
+
+// The type of device `index` among `devices` ("" where there is none).
+template <class DeviceInfo>
+std::string device_type(const std::vector<DeviceInfo>& devices, int index) {
+  return index >= 0 && index < static_cast<int>(devices.size()) ? devices[static_cast<std::size_t>(index)].type
+                                                                 : "";
+}
+
+}  // namespace
+
 std::string preconditioner_used(const std::string& backend, const DeviceOptions& options) {
   bool factors = false;
   if (backend == "cpu") factors = options.preconditioner != Preconditioner::jacobi;
-  if (backend == "opencl") {
-    const std::vector<OpenClDeviceInfo> devices = list_opencl_devices();
-    const std::string type = options.device >= 0 && options.device < static_cast<int>(devices.size())
-                                 ? devices[static_cast<std::size_t>(options.device)].type
-                                 : "";
-    factors = opencl_uses_factor(options.preconditioner, opencl_cpu_form(options.kernel_form, type));
-  }
-  if (backend == "vulkan") {
-    const std::vector<VulkanDeviceInfo> devices = list_vulkan_devices();
-    const std::string type = options.device >= 0 && options.device < static_cast<int>(devices.size())
-                                 ? devices[static_cast<std::size_t>(options.device)].type
-                                 : "";
-    factors = vulkan_uses_factor(options.preconditioner, type);
-  }
+  if (backend == "opencl")
+    factors = opencl_uses_factor(options.preconditioner,
+                                 opencl_cpu_form(options.kernel_form, device_type(list_opencl_devices(), options.device)));
+  if (backend == "vulkan")
+    factors = vulkan_uses_factor(options.preconditioner, device_type(list_vulkan_devices(), options.device));
   return factors ? "factorised" : "jacobi";
 }
 

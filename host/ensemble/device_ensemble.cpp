@@ -93,6 +93,24 @@ Eigen::SparseMatrix<double> DeviceEnsemble::sigma_system(int s, const Eigen::Vec
   return system_at(theta, effects_.empty() ? PhysicsEffects{} : effects_.at(static_cast<std::size_t>(s)), x, v);
 }
 
+std::unique_ptr<FactorisedPreconditioner> DeviceEnsemble::analysed_factor() const {
+  auto factor = std::make_unique<FactorisedPreconditioner>();
+  const ReferenceSimulation rest(model_);
+  factor->analyse(representative_system(rest.positions(), rest.velocities()));
+  return factor;
+}
+
+SpringCorrection DeviceEnsemble::spring_correction(bool asked) const {
+  std::vector<int> rows = estimated_spring_rows(model_, estimated_);
+  if (!asked || !spring_correction_fits(rows.size(), S_)) return SpringCorrection();
+  return SpringCorrection(std::move(rows));
+}
+
+std::vector<double> DeviceEnsemble::factorised_springs(const SpringCorrection& springs,
+                                                       const std::vector<double>& constants) const {
+  return spring_diagonal(springs, constants, 0, representative_ligament_k());
+}
+
 std::vector<double> DeviceEnsemble::spring_diagonal(const SpringCorrection& springs,
                                                     const std::vector<double>& constants, int s,
                                                     const std::vector<double>& ligament_k) const {

@@ -23,6 +23,7 @@
 #include "host/mesh/observed_points.h"
 #include "host/model/estimated_parameters.h"
 #include "host/model/model.h"
+#include "host/reference/factorised_preconditioner.h"
 #include "host/reference/reference_simulation.h"
 #include "host/reference/spring_correction.h"
 
@@ -100,13 +101,17 @@ class DeviceEnsemble : public SimulationEnsemble {
   // ligament_k_ with every sigma point's estimated ligaments at the representative's
   // stiffnesses (the sigma points' mean log-stiffnesses, as representative_system has them).
   std::vector<double> representative_ligament_k() const;
-  // A shared factor's correction for the sigma points' springs (SpringCorrection, OpenCL's and
-  // Vulkan's): h (h + a) times the estimated ligaments' springs at each of `springs`' rows,
-  // for sigma point s of the step's constants and stiffnesses ligament_k ([l S + s]) ...
-  std::vector<double> spring_diagonal(const SpringCorrection& springs, const std::vector<double>& constants,
-                                      int s, const std::vector<double>& ligament_k) const;
-  // ... and each sigma point's coupling H for its springs (ligament_k_) against `factorised`,
-  // the springs of the factor's system: [(s m + j) m + k], S m^2 reals.
+  // A factor shared by the sigma points (OpenCL's CPU form, Vulkan on a CPU device), analysed
+  // on the representative's system at rest: its size is known before the first step makes it.
+  std::unique_ptr<FactorisedPreconditioner> analysed_factor() const;
+  // Its correction for the sigma points' springs (SpringCorrection) at the estimated
+  // ligaments' rows, where `asked` and m x S stays small (spring_correction_fits); else none.
+  SpringCorrection spring_correction(bool asked) const;
+  // The springs of the factor's system at the correction's rows (the representative's, with
+  // sigma point 0's stiffness factor: its effects, as representative_system has them) ...
+  std::vector<double> factorised_springs(const SpringCorrection& springs, const std::vector<double>& constants) const;
+  // ... and each sigma point's coupling H for its own springs (ligament_k_) against them:
+  // [(s m + j) m + k], S m^2 reals.
   std::vector<double> spring_couplings(const SpringCorrection& springs, const std::vector<double>& constants,
                                        const std::vector<double>& factorised) const;
   // The step's solver report from CG's per-sigma results; notes the iterations for the next
@@ -138,6 +143,10 @@ class DeviceEnsemble : public SimulationEnsemble {
 
  private:
   std::vector<double> column_of(DeviceBuffer buffer, std::size_t rows, int s) const;
+  // h (h + a) times the estimated ligaments' springs at each of `springs`' rows, for sigma
+  // point s of the step's constants and stiffnesses ligament_k ([l S + s]).
+  std::vector<double> spring_diagonal(const SpringCorrection& springs, const std::vector<double>& constants,
+                                      int s, const std::vector<double>& ligament_k) const;
   Eigen::MatrixXd theta_;                       // each sigma point's parameters (none yet: the model's)
   std::vector<PhysicsEffects> effects_;         // and effects (none yet: none)
   // The implicit-Euler matrix of parameters `theta` (empty: the model's) and `effects` at

@@ -90,17 +90,15 @@ OpenClEnsemble::OpenClEnsemble(const Model& model, EstimatedParameters estimated
     if (!cpu_form)
       throw DeviceError("--preconditioner factorised: OpenCL has it on a CPU device only (its "
                         "GPU kernels precondition CG with Jacobi); device " + info.name);
-    factor_ = std::make_unique<FactorisedPreconditioner>();
-    const ReferenceSimulation rest(model_);
-    factor_->analyse(representative_system(rest.positions(), rest.velocities()));
+    factor_ = analysed_factor();
     // Again with the factor's buffers (L alone is 125 MB on the 38k liver; the copies of its
     // values below add at most own_factors_bytes).
     check_device_memory(device_.real_size(), info.name, info.global_memory, info.max_allocation,
                         factor_->nonzeros());
     // The shared factor is corrected for each sigma point's own springs at the estimated
     // ligaments' rows (SpringCorrection) where the kernels' arrays of m x S stay small.
-    std::vector<int> spring_rows = estimated_spring_rows(model_, estimated_);
-    const bool corrected = options.spring_correction && spring_correction_fits(spring_rows.size(), S_);
+    SpringCorrection correction = spring_correction(options.spring_correction);
+    const bool corrected = correction.size() > 0;
     // Each sigma point its own factor where the S copies of L's values stay small enough for a
     // CPU's cache, from kOwnFactorsFromSigmaPoints, and where the sigma points differ by more
     // than the springs the shared factor is corrected for: those that differ by region moduli
@@ -114,7 +112,7 @@ OpenClEnsemble::OpenClEnsemble(const Model& model, EstimatedParameters estimated
     if (!springs_alone && S_ >= kOwnFactorsFromSigmaPoints &&
         static_cast<std::size_t>(S_) * factor_->nonzeros() * device_.real_size() <= options.own_factors_bytes)
       factor_copies_ = S_;
-    if (factor_copies_ == 1 && corrected) springs_ = SpringCorrection(std::move(spring_rows));
+    if (factor_copies_ == 1 && corrected) springs_ = std::move(correction);
     // The copies in the layout of the blocks that solve with them (conjugate_gradient.cl): cg_solve's
     // blocks of their own vectors one after the other, else all S interleaved.
     factor_block_ = whole_solve_ && solve_block_ < S_ ? solve_block_ : S_;
@@ -423,9 +421,7 @@ void OpenClEnsemble::refresh_factor(const std::vector<double>& constants) {
 
 void OpenClEnsemble::prepare_spring_correction(const std::vector<double>& constants) {
   springs_.prepare(*factor_);
-  // The representative's springs, with sigma point 0's stiffness factor (its effects, as
-  // representative_system has them).
-  factorised_springs_ = spring_diagonal(springs_, constants, 0, representative_ligament_k());
+  factorised_springs_ = factorised_springs(springs_, constants);
   const std::vector<int>& reached = springs_.reached();
   std::vector<int> at = {static_cast<int>(reached.size())};
   at.insert(at.end(), reached.begin(), reached.end());
@@ -458,16 +454,11 @@ void OpenClEnsemble::fall_back_to_diagonal(const Eigen::SparseMatrix<double>& A)
 void OpenClEnsemble::upload_diagonal_factor(const Eigen::SparseMatrix<double>& A) {
   const int rows = static_cast<int>(A.rows());
   std::vector<int> columns(static_cast<std::size_t>(rows) + 1), order(static_cast<std::size_t>(rows));
-  std::vector<double> values(static_cast<std::size_t>(rows));
   for (int i = 0; i < rows; ++i) {
     columns[static_cast<std::size_t>(i)] = i;
     order[static_cast<std::size_t>(i)] = i;
-    // |diag A|: a preconditioner must be positive definite (a negative diagonal would be
-    // Jacobi's with the sign of the whole system turned); a row whose diagonal is 0 or not
-    // finite is left unscaled.
-    const double d = std::abs(A.coeff(i, i));
-    values[static_cast<std::size_t>(i)] = std::isfinite(d) && d > 0.0 ? std::sqrt(d) : 1.0;
   }
+  const std::vector<double> values = diagonal_stand_in(A);
   columns.back() = rows;
   write_integers(DeviceBuffer::factor_columns, columns.data(), columns.size());
   write_integers(DeviceBuffer::factor_rows, order.data(), order.size());   // row i: i

@@ -1,10 +1,20 @@
 #include "host/reference/factorised_preconditioner.h"
 
 #include <algorithm>
+#include <cmath>
 #include <iostream>   // Eigen's MetisSupport uses std::cerr without including it
 #include <Eigen/MetisSupport>
 
 namespace sigmafem {
+
+std::vector<double> diagonal_stand_in(const Eigen::SparseMatrix<double>& A) {
+  std::vector<double> values(static_cast<std::size_t>(A.rows()));
+  for (Eigen::Index i = 0; i < A.rows(); ++i) {
+    const double d = std::abs(A.coeff(i, i));
+    values[static_cast<std::size_t>(i)] = std::isfinite(d) && d > 0.0 ? std::sqrt(d) : 1.0;
+  }
+  return values;
+}
 
 bool FactorisedPreconditioner::factorise(const Eigen::SparseMatrix<double>& A) {
   // The ordering and the symbolic analysis depend only on the pattern, and cost more than a

@@ -26,6 +26,13 @@
 
 namespace sigmafem {
 
+// A stand-in for L while no factorisation has succeeded (the device back ends' first steps):
+// sqrt|A_ii| per row, so that solving with it is Jacobi's z = r / |diag A|. The absolute
+// value because a preconditioner must be positive definite (a negative diagonal would be
+// Jacobi's with the sign of the whole system turned); 1, a row left unscaled, where the
+// diagonal is 0 or not finite.
+std::vector<double> diagonal_stand_in(const Eigen::SparseMatrix<double>& A);
+
 class FactorisedPreconditioner {
  public:
   // Factorises A (symmetric positive definite). Returns false, and leaves the object

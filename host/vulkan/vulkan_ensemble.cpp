@@ -63,15 +63,9 @@ VulkanEnsemble::VulkanEnsemble(const Model& model, EstimatedParameters estimated
       throw DeviceError("--preconditioner factorised: Vulkan has it with one CG work-group per "
                         "sigma point only (" + std::to_string(cg_partitions_) + " asked)");
     if (cg_partitions_ == 1) {
-      factor_ = std::make_unique<FactorisedPreconditioner>();
-      const ReferenceSimulation rest(model_);
-      factor_->analyse(representative_system(rest.positions(), rest.velocities()));
+      factor_ = analysed_factor();
       check_device_memory(device_.real_size(), info.name, info.memory, info.max_buffer, factor_->nonzeros());
-      // Corrected for each sigma point's own springs at the estimated ligaments' rows, as
-      // OpenCL's (SpringCorrection), where m x S stays small.
-      std::vector<int> spring_rows = estimated_spring_rows(model_, estimated_);
-      if (options.spring_correction && spring_correction_fits(spring_rows.size(), S_))
-        springs_ = SpringCorrection(std::move(spring_rows));
+      springs_ = spring_correction(options.spring_correction);   // as OpenCL's
     }
   }
 
@@ -224,8 +218,6 @@ void VulkanEnsemble::flush_pending() const {
 void VulkanEnsemble::dispatch_items(VkCommandBuffer cmd, const VulkanKernel& kernel,
                                     VkDescriptorSet set, std::size_t items,
                                     std::uint32_t count) const {
-  static_assert(sizeof(PushConstants) == VulkanDevice::kPushConstantBytes,
-                "SF_PUSH_CONSTANTS: the shaders' 16 bytes of push constants");
   PushConstants push;
   push.S = static_cast<std::uint32_t>(S_);
   push.count = count;
@@ -294,9 +286,7 @@ void VulkanEnsemble::refresh_factor(const std::vector<double>& constants) {
     springs_ = SpringCorrection();   // too large a correction for a dispatch: the factor alone
     return;
   }
-  // The representative's springs, with sigma point 0's stiffness factor (its effects, as
-  // representative_system has them).
-  factorised_springs_ = spring_diagonal(springs_, constants, 0, representative_ligament_k());
+  factorised_springs_ = factorised_springs(springs_, constants);
   coupling_stale_ = true;
 }
 

@@ -30,6 +30,7 @@
 #include "host/reference/factorised_preconditioner.h"
 #include "host/vulkan/vulkan_device.h"
 #include "host/vulkan/vulkan_factor_solve.h"
+#include "host/vulkan/vulkan_push_constants.h"
 
 namespace sigmafem {
 
@@ -72,14 +73,7 @@ class VulkanEnsemble : public DeviceEnsemble {
   int factor_solve_dispatches() const { return factor_solve_ ? factor_solve_->dispatches() : 0; }
 
  private:
-  // The scalar arguments of every shader (SF_PUSH_CONSTANTS, kernels/shared/device_layout.h).
-#define SF_HOST_UINT(name) std::uint32_t name = 0;
-#define SF_HOST_INT(name) std::int32_t name = 0;
-  struct PushConstants {
-    SF_PUSH_CONSTANTS(SF_HOST_UINT, SF_HOST_INT)
-  };
-#undef SF_HOST_UINT
-#undef SF_HOST_INT
+  using PushConstants = VulkanPushConstants;
   std::vector<double> read_reals(DeviceBuffer buffer, std::size_t count) const override;
   void write_reals(DeviceBuffer buffer, const std::vector<double>& values) override;
   void upload_ligament_k() override;

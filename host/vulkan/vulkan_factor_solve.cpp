@@ -6,21 +6,9 @@
 
 #include "device_layout.h"
 #include "host/ensemble/device_readout.h"
+#include "host/vulkan/vulkan_push_constants.h"
 
 namespace sigmafem {
-namespace {
-
-// factor_solve's push constants (SF_PUSH_CONSTANTS): S, the first step, -, one past the last.
-#define SF_HOST_UINT(name) std::uint32_t name = 0;
-#define SF_HOST_INT(name) std::int32_t name = 0;
-struct Push {
-  SF_PUSH_CONSTANTS(SF_HOST_UINT, SF_HOST_INT)
-};
-#undef SF_HOST_UINT
-#undef SF_HOST_INT
-static_assert(sizeof(Push) == VulkanDevice::kPushConstantBytes, "SF_PUSH_CONSTANTS' 16 bytes");
-
-}  // namespace
 
 VulkanFactorSolve::VulkanFactorSolve(VulkanDevice& device, int rows, std::size_t nonzeros,
                                      int spring_rows, int sigma_count, const VulkanBuffer& r,
@@ -134,16 +122,9 @@ void VulkanFactorSolve::upload_spring_rows(int m, const std::vector<int>& reache
 void VulkanFactorSolve::upload_diagonal(const Eigen::SparseMatrix<double>& A) {
   const std::size_t n = static_cast<std::size_t>(rows_);
   std::vector<int> starts(n + 1), identity(n);
-  std::vector<double> values(n);
-  for (std::size_t i = 0; i < n; ++i) {
-    starts[i] = static_cast<int>(i);
-    identity[i] = static_cast<int>(i);
-    // |diag A|: a preconditioner must be positive definite; a row whose diagonal is 0 or not
-    // finite is left unscaled (as OpenClEnsemble's stand-in).
-    const double d = std::abs(A.coeff(static_cast<Eigen::Index>(i), static_cast<Eigen::Index>(i)));
-    values[i] = std::isfinite(d) && d > 0.0 ? std::sqrt(d) : 1.0;
-  }
-  starts[n] = static_cast<int>(n);
+  for (std::size_t i = 0; i <= n; ++i) starts[i] = static_cast<int>(i);
+  for (std::size_t i = 0; i < n; ++i) identity[i] = static_cast<int>(i);
+  const std::vector<double> values = diagonal_stand_in(A);
   upload_pattern(starts, identity, starts, identity, identity);
   upload_values(values, values);
   upload_spring_rows(0, {});
@@ -207,7 +188,7 @@ void VulkanFactorSolve::upload_values(const std::vector<double>& row_values,
 }
 
 void VulkanFactorSolve::record(VkCommandBuffer cmd) const {
-  Push push;
+  VulkanPushConstants push;   // S, the first step, one past the last (factor_solve.comp)
   push.S = static_cast<std::uint32_t>(S_);
   for (const auto& [first, last] : ranges_) {
     push.count = first;

@@ -558,10 +558,7 @@ static inline __attribute__((always_inline)) int sf_block_cg_iteration(
   for (uint row = 0; row < rows; ++row) {
     for (uint i = 0; i < count; ++i) {
       size_t at = (size_t)row * S + first + i;
-      x[at] += alpha[i] * d[at];
-      real ri = r[at] - alpha[i] * q[at];
-      r[at] = ri;
-      rr_new[i] += ri * ri;
+      SF_CG_UPDATE_XR_ROW(at, alpha[i], q[at], x, r, d, rr_new[i])
     }
   }
   sf_block_factor_solve(first, count, S, rows, r, z, rz_new SF_FACTOR_PASS);

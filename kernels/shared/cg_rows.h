@@ -37,6 +37,16 @@
     sum_rz += ri_ * zi_;                                                                        \
   }
 
+/* The same without z, where a factor forms z after the update (OpenCL's SF_FACTOR, Vulkan's
+ * factor_solve): x += alpha d, r -= alpha q; r.r. */
+#define SF_CG_UPDATE_XR_ROW(at, alpha, q_value, x_, r_, d_, sum_rr) \
+  {                                                                 \
+    x_[at] += (alpha) * d_[at];                                     \
+    SF_REAL ri_ = r_[at] - (alpha) * (q_value);                     \
+    r_[at] = ri_;                                                   \
+    sum_rr += ri_ * ri_;                                            \
+  }
+
 /* After the warm start: an overflowed load (|b|^2 not finite) would pass the stop test as
  * inf <= inf, so it is a breakdown, neither converged nor iterating, as in the CPU
  * reference; b = 0 counts as converged (the state update then uses dv = 0, the exact

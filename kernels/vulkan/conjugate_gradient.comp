@@ -260,7 +260,8 @@ real sf_dq_rows(uint s, uint S, uint begin, uint end) {
   return sf_group_sum(sum_dq);
 }
 
-/* x += alpha d, r -= alpha q, z = M^-1 r over the nodes; the group's r.r and r.z. */
+/* x += alpha d, r -= alpha q, z = M^-1 r over the nodes; the group's r.r and r.z (with the
+ * factor no z, and r.z 0: factor_solve forms them). */
 void sf_update_rows(uint s, uint S, uint begin, uint end, real alpha, out real sum_rr,
                     out real sum_rz) {
   sum_rr = real(0);
@@ -268,7 +269,11 @@ void sf_update_rows(uint s, uint S, uint begin, uint end, real alpha, out real s
   for (uint n = begin + gl_LocalInvocationID.x; n < end; n += gl_WorkGroupSize.x)
     for (uint k = 0u; k < 3u; ++k) {
       uint row = (3u * n + k) * S + s;
+#  if defined(SF_FACTOR) /* z is factor_solve's */
+      SF_CG_UPDATE_XR_ROW(row, alpha, SF_Q(row), x, r, d, sum_rr)
+#  else
       SF_CG_UPDATE_ROW(row, alpha, SF_Q(row), x, r, z, d, inverse_diagonal, sum_rr, sum_rz)
+#  endif
     }
   sum_rr = sf_group_sum(sum_rr);
   sum_rz = sf_group_sum(sum_rz);
