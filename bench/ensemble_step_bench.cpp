@@ -77,6 +77,12 @@ const Backend kOpenClUncorrectedFactor{"opencl", Precision::single,
                                        "opencl single, device 0, one shared factor, not corrected for the springs",
                                        SolveLaunch::automatic, Preconditioner::factorised, true, 0,
                                        KernelForm::automatic, false};
+// OpenCL's GPU form (forced: on a GPU it is the device's own) with Jacobi and with the
+// multigrid V-cycle on the refinements that made the mesh (stop 54), its default there.
+const Backend kOpenClGpuForm{"opencl", Precision::single, "opencl single, device 0, GPU form, Jacobi",
+                             SolveLaunch::automatic, Preconditioner::jacobi, false, 0, KernelForm::gpu};
+const Backend kOpenClMultigrid{"opencl", Precision::single, "opencl single, device 0, GPU form, multigrid",
+                               SolveLaunch::automatic, Preconditioner::multigrid, false, 0, KernelForm::gpu};
 // CG with one work-group per sigma point whatever the mesh (on a GPU: before partitions).
 const Backend kOpenClOneGroup{"opencl", Precision::single,
                               "opencl single, device 0, CG a work-group per sigma point",
@@ -418,6 +424,19 @@ BENCHMARK_CAPTURE(BM_ensemble_step, cpu_box_large_117240, kCpu, std::string("box
 BENCHMARK_CAPTURE(BM_ensemble_step, opencl_factorised_box_large_117240, kOpenClFactorised,
                   std::string("box_large"), 0)
     ->Arg(16)->Unit(benchmark::kMillisecond)->UseRealTime();
+// The GPU form's preconditioners side by side on the refined meshes (on PoCL, forced).
+BENCHMARK_CAPTURE(BM_ensemble_step, opencl_gpu_form_liver_4768, kOpenClGpuForm, std::string("liver"), 1)
+    ->Arg(4)->Arg(16)->Unit(benchmark::kMillisecond)->UseRealTime();
+BENCHMARK_CAPTURE(BM_ensemble_step, opencl_multigrid_liver_4768, kOpenClMultigrid, std::string("liver"), 1)
+    ->Arg(4)->Arg(16)->Unit(benchmark::kMillisecond)->UseRealTime();
+BENCHMARK_CAPTURE(BM_ensemble_step, opencl_gpu_form_liver_fine_38144, kOpenClGpuForm, std::string("liver_fine"), 0)
+    ->Arg(16)->Arg(64)->Unit(benchmark::kMillisecond)->UseRealTime();
+BENCHMARK_CAPTURE(BM_ensemble_step, opencl_multigrid_liver_fine_38144, kOpenClMultigrid, std::string("liver_fine"), 0)
+    ->Arg(16)->Arg(64)->Unit(benchmark::kMillisecond)->UseRealTime();
+BENCHMARK_CAPTURE(BM_ensemble_step, opencl_gpu_form_box_large_117240, kOpenClGpuForm, std::string("box_large"), 0)
+    ->Arg(16)->Arg(64)->Unit(benchmark::kMillisecond)->UseRealTime();
+BENCHMARK_CAPTURE(BM_ensemble_step, opencl_multigrid_box_large_117240, kOpenClMultigrid, std::string("box_large"), 0)
+    ->Arg(16)->Arg(64)->Unit(benchmark::kMillisecond)->UseRealTime();
 // A whole filter step on the liver.
 BENCHMARK_CAPTURE(BM_filter_step, opencl, kOpenCl, std::string("liver"))
     ->Unit(benchmark::kMillisecond)->UseRealTime();
@@ -482,6 +501,10 @@ BENCHMARK_CAPTURE(BM_filter_step, opencl_factorised_liver_fine_38144, kOpenClFac
     ->Iterations(20)->Unit(benchmark::kMillisecond)->UseRealTime();
 BENCHMARK_CAPTURE(BM_filter_step, opencl_uncorrected_factor_liver_fine_38144, kOpenClUncorrectedFactor,
                   std::string("liver_fine"))
+    ->Iterations(20)->Unit(benchmark::kMillisecond)->UseRealTime();
+BENCHMARK_CAPTURE(BM_filter_step, opencl_gpu_form_liver_fine_38144, kOpenClGpuForm, std::string("liver_fine"))
+    ->Iterations(20)->Unit(benchmark::kMillisecond)->UseRealTime();
+BENCHMARK_CAPTURE(BM_filter_step, opencl_multigrid_liver_fine_38144, kOpenClMultigrid, std::string("liver_fine"))
     ->Iterations(20)->Unit(benchmark::kMillisecond)->UseRealTime();
 BENCHMARK_CAPTURE(BM_filter_step, cpu_liver_fine_38144, kCpu, std::string("liver_fine"))
     ->Iterations(20)->Unit(benchmark::kMillisecond)->UseRealTime();

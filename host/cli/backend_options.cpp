@@ -10,6 +10,7 @@ DeviceOptions BackendChoice::device_options() const {
   options.precision = precision == "double" ? Precision::double_precision : Precision::single;
   options.preconditioner = preconditioner == "jacobi"       ? Preconditioner::jacobi
                            : preconditioner == "factorised" ? Preconditioner::factorised
+                           : preconditioner == "multigrid"  ? Preconditioner::multigrid
                                                             : Preconditioner::automatic;
   return options;
 }
@@ -34,9 +35,10 @@ void add_backend_options(CLI::App* command, BackendChoice& choice) {
   command->add_option("--preconditioner", choice.preconditioner,
                       "CG's preconditioner: jacobi, factorised (sparse Cholesky factors: on cpu one "
                       "per sigma point or one they share, on OpenCL's and Vulkan's CPU devices one "
-                      "they share; not on a GPU) or auto (factorised on cpu and on a CPU device, "
-                      "else jacobi)")
-      ->check(CLI::IsMember({"auto", "jacobi", "factorised"}))
+                      "they share; not on a GPU), multigrid (a V-cycle on the meshes of mesh.refine: "
+                      "OpenCL on a GPU) or auto (factorised on cpu and on a CPU device, multigrid "
+                      "with OpenCL on a GPU where the mesh was refined, else jacobi)")
+      ->check(CLI::IsMember({"auto", "jacobi", "factorised", "multigrid"}))
       ->capture_default_str();
 }
 

@@ -115,13 +115,14 @@ Action add_diagnose_command(CLI::App& app) {
     // sigma points larger).
     const SigmaPointSet set =
         diagnose_options.sigma_points.value_or(estimation_options(scenario).roukf.sigma_points);
+    const Model declared = make_model(scenario);
     const BackendDecision backend = resolve_backend(
-        options->backend.backend, make_model(scenario),
+        options->backend.backend, declared,
         sigma_point_count(set, static_cast<int>(scenario.filter->estimate.size())),
         EstimatedParameters(scenario.filter->estimate));   // ligaments only: diagnose refuses parameter fields (above)
     diagnose_options.backend = report.backend = backend.backend;
     report.backend_reason = backend.reason;
-    report.preconditioner = preconditioner_used(backend.backend, diagnose_options.device);
+    report.preconditioner = preconditioner_used(backend.backend, diagnose_options.device, declared);
     if (!options->quiet) std::cout << "backend: " << backend.backend << " (" << backend.reason << ")\n" << std::flush;
     std::stringstream names(options->candidates);
     for (std::string name; std::getline(names, name, ',');)

@@ -149,7 +149,7 @@ std::optional<json> run_estimation_job(const Scenario& scenario, const Estimatio
   report.out_dir = job.out_dir;
   report.backend = backend.backend;
   report.backend_reason = backend.reason;
-  report.preconditioner = preconditioner_used(backend.backend, job.device);
+  report.preconditioner = preconditioner_used(backend.backend, job.device, model);
   report.sigma_points = to_string(options.roukf.sigma_points);
   report.outlier_gate = outlier_gate;
   report.sigma_count = sigma_count;

@@ -33,8 +33,10 @@ enum class KernelForm { automatic, cpu, gpu };
 // host/reference/factorised_preconditioner.h), or on OpenCL's CPU form and Vulkan on a CPU
 // device one factor of the mean sigma point's system that all share (OpenClEnsemble,
 // VulkanFactorSolve); automatic is the factors on the CPU back end, OpenCL's CPU form and
-// Vulkan on a CPU device, Jacobi on the GPU forms (they have no other yet).
-enum class Preconditioner { automatic, jacobi, factorised };
+// Vulkan on a CPU device, Jacobi on the GPU forms (they have no other yet). multigrid: a
+// V-cycle on the meshes of a uniform refinement (host/reference/nested_multigrid.h), on
+// OpenCL's GPU form only.
+enum class Preconditioner { automatic, jacobi, factorised, multigrid };
 
 // Own factors pay from this many sigma points (bench/RESULTS.md, stop 49, the liver's filter
 // step on PoCL): at S = 4 they halved the CG iterations but not the time (1.36-1.54 ms against

@@ -5,6 +5,7 @@
 #include "host/ensemble/cpu_ensemble.h"
 #include "host/model/effects.h"
 #include "host/opencl/opencl_ensemble.h"
+#include "host/reference/nested_multigrid.h"
 #include "host/vulkan/vulkan_ensemble.h"
 
 namespace sigmafem {
@@ -18,6 +19,9 @@ std::unique_ptr<SimulationEnsemble> make_ensemble(const std::string& backend, co
   if (backend == "auto")
     return make_ensemble(resolve_backend(backend, model, sigma_count, estimated).backend, model, estimated,
                          observed, sigma_count, options);
+  if (backend == "cpu" && options.preconditioner == Preconditioner::multigrid)
+    throw InputError("--preconditioner multigrid: OpenCL's GPU kernels have it (--backend opencl); the "
+                     "cpu back end has its sparse Cholesky factors (factorised)");
   if (backend == "cpu")
     return std::make_unique<CpuEnsemble>(model, estimated, observed, sigma_count, options.cpu_threads,
                                          options.preconditioner);
@@ -41,12 +45,15 @@ std::string device_type(const std::vector<DeviceInfo>& devices, int index) {
 
 }  // namespace
 
-std::string preconditioner_used(const std::string& backend, const DeviceOptions& options) {
+std::string preconditioner_used(const std::string& backend, const DeviceOptions& options, const Model& model) {
   bool factors = false;
   if (backend == "cpu") factors = options.preconditioner != Preconditioner::jacobi;
-  if (backend == "opencl")
-    factors = opencl_uses_factor(options.preconditioner,
-                                 opencl_cpu_form(options.kernel_form, device_type(list_opencl_devices(), options.device)));
+  if (backend == "opencl") {
+    const bool cpu_form = opencl_cpu_form(options.kernel_form, device_type(list_opencl_devices(), options.device));
+    if (opencl_uses_multigrid(options.preconditioner, cpu_form, !nested_prolongations(model).empty()))
+      return "multigrid";
+    factors = opencl_uses_factor(options.preconditioner, cpu_form);
+  }
   if (backend == "vulkan")
     factors = vulkan_uses_factor(options.preconditioner, device_type(list_vulkan_devices(), options.device));
   return factors ? "factorised" : "jacobi";

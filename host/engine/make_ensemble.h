@@ -30,9 +30,9 @@ std::unique_ptr<SimulationEnsemble> make_ensemble(const std::string& backend, co
                                                   const ObservedPoints& observed, int sigma_count,
                                                   const DeviceOptions& options = {});
 
-// The preconditioner that `backend` (not "auto") runs CG with under `options`: "factorised"
-// or "jacobi", for the reports. For OpenCL it asks the device's type.
-std::string preconditioner_used(const std::string& backend, const DeviceOptions& options);
+// The preconditioner that `backend` (not "auto") runs CG with under `options` on `model`:
+// "factorised", "multigrid" or "jacobi", for the reports. For OpenCL it asks the device's type.
+std::string preconditioner_used(const std::string& backend, const DeviceOptions& options, const Model& model);
 
 // The ensemble of `model` on `backend` with the candidate `effects` estimated (EffectEnsemble):
 // the ligament of every ligament effect is appended to the model and to `estimated` first.

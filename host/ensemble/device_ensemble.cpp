@@ -130,11 +130,11 @@ std::vector<double> DeviceEnsemble::spring_couplings(const SpringCorrection& spr
                                                      const std::vector<double>& constants,
                                                      const std::vector<double>& factorised) const {
   const std::size_t m = static_cast<std::size_t>(springs.size());
+  const std::vector<double> shifts = spring_shifts(springs, constants, factorised);
   std::vector<double> couplings(m * m * static_cast<std::size_t>(S_));
   for (int s = 0; s < S_; ++s) {
-    const std::vector<double> own = spring_diagonal(springs, constants, s, ligament_k_);
     Eigen::VectorXd delta(static_cast<Eigen::Index>(m));
-    for (std::size_t j = 0; j < m; ++j) delta[static_cast<Eigen::Index>(j)] = own[j] - factorised[j];
+    for (std::size_t j = 0; j < m; ++j) delta[static_cast<Eigen::Index>(j)] = shifts[j * static_cast<std::size_t>(S_) + static_cast<std::size_t>(s)];
     const Eigen::MatrixXd H = springs.coupling(delta);
     for (std::size_t j = 0; j < m; ++j)
       for (std::size_t k = 0; k < m; ++k)
@@ -142,6 +142,17 @@ std::vector<double> DeviceEnsemble::spring_couplings(const SpringCorrection& spr
             H(static_cast<Eigen::Index>(j), static_cast<Eigen::Index>(k));
   }
   return couplings;
+}
+
+std::vector<double> DeviceEnsemble::spring_shifts(const SpringCorrection& springs, const std::vector<double>& constants,
+                                                  const std::vector<double>& factorised) const {
+  const std::size_t m = static_cast<std::size_t>(springs.size());
+  std::vector<double> shifts(m * static_cast<std::size_t>(S_));
+  for (int s = 0; s < S_; ++s) {
+    const std::vector<double> own = spring_diagonal(springs, constants, s, ligament_k_);
+    for (std::size_t j = 0; j < m; ++j) shifts[j * static_cast<std::size_t>(S_) + static_cast<std::size_t>(s)] = own[j] - factorised[j];
+  }
+  return shifts;
 }
 
 std::vector<double> DeviceEnsemble::representative_ligament_k() const {

@@ -114,6 +114,10 @@ class DeviceEnsemble : public SimulationEnsemble {
   // [(s m + j) m + k], S m^2 reals.
   std::vector<double> spring_couplings(const SpringCorrection& springs, const std::vector<double>& constants,
                                        const std::vector<double>& factorised) const;
+  // ... and each sigma point's springs there less them (what the multigrid's finest level adds
+  // per sigma point): [j S + s].
+  std::vector<double> spring_shifts(const SpringCorrection& springs, const std::vector<double>& constants,
+                                    const std::vector<double>& factorised) const;
   // The step's solver report from CG's per-sigma results; notes the iterations for the next
   // step's first batch.
   StepReport step_report(const std::vector<std::int32_t>& iterations,

@@ -28,6 +28,11 @@ bool opencl_uses_factor(Preconditioner preconditioner, bool cpu_form) {
          (preconditioner == Preconditioner::automatic && cpu_form);
 }
 
+bool opencl_uses_multigrid(Preconditioner preconditioner, bool cpu_form, bool nested) {
+  return preconditioner == Preconditioner::multigrid ||
+         (preconditioner == Preconditioner::automatic && !cpu_form && nested);
+}
+
 OpenClEnsemble::OpenClEnsemble(const Model& model, EstimatedParameters estimated,
                                ObservedPoints observed, int sigma_count,
                                const DeviceOptions& options)
@@ -117,6 +122,21 @@ OpenClEnsemble::OpenClEnsemble(const Model& model, EstimatedParameters estimated
     // blocks of their own vectors one after the other, else all S interleaved.
     factor_block_ = whole_solve_ && solve_block_ < S_ ? solve_block_ : S_;
   }
+  // The GPU form's multigrid V-cycle, on the refinements that made the mesh.
+  std::vector<RowMajorMatrix> prolongations;
+  if (options.preconditioner == Preconditioner::multigrid || (options.preconditioner == Preconditioner::automatic && !cpu_form))
+    prolongations = nested_prolongations(model_);
+  if (opencl_uses_multigrid(options.preconditioner, cpu_form, !prolongations.empty())) {
+    if (cpu_form)
+      throw DeviceError("--preconditioner multigrid: OpenCL has it in its GPU kernels only (a CPU device "
+                        "has the factor); device " + info.name);
+    if (prolongations.empty())
+      throw DeviceError("--preconditioner multigrid: the mesh is not a uniform refinement of a coarser one "
+                        "(a scenario's mesh.refine makes one)");
+    multigrid_ = std::make_unique<NestedMultigrid>(std::move(prolongations));
+    shift_rows_ = SpringCorrection(estimated_spring_rows(model_, estimated_));
+  }
+  cg_partitioned_ = cg_per_group_ && (cg_partitions_ > 1 || multigrid_);
   // With a factor the solve is most of an iteration, and each block solves with a work vector
   // of its own (conjugate_gradient.cl): a block per compute unit then pays at any S
   // (bench/RESULTS.md, stop 50: the 117k box at S = 16 1155-1222 -> 648-826 ms a step, the 38k
@@ -163,7 +183,7 @@ OpenClEnsemble::OpenClEnsemble(const Model& model, EstimatedParameters estimated
     k_cg_start_ = device_.kernel("cg_start");
     k_cg_iteration_ = device_.kernel("cg_iteration");
     if (whole_solve_) k_cg_solve_ = device_.kernel("cg_solve");
-    if (cg_partitions_ > 1) {
+    if (cg_partitioned_) {
       k_cg_start_partials_ = device_.kernel("cg_start_partials");
       k_cg_start_scalars_ = device_.kernel("cg_start_scalars");
       k_cg_dot_ = device_.kernel("cg_dot");
@@ -205,7 +225,7 @@ OpenClEnsemble::OpenClEnsemble(const Model& model, EstimatedParameters estimated
                                          B::control_k, B::mass, B::element_out});
     iteration.insert(iteration.end(), factor.begin(), factor.end());
     set_arguments(k_cg_iteration_, iteration, S, N, cap);
-    if (cg_partitions_ > 1) {
+    if (cg_partitioned_) {
       set_arguments(k_cg_start_partials_, {B::q, B::rhs, B::inverse_diagonal, B::r, B::z, B::d, B::partial},
                     S, N);
       set_arguments(k_cg_start_scalars_, {B::constants, B::partial, B::bb, B::rr, B::rz, B::active,
@@ -217,6 +237,11 @@ OpenClEnsemble::OpenClEnsemble(const Model& model, EstimatedParameters estimated
       set_arguments(k_cg_direction_, {B::constants, B::z, B::d, B::partial, B::bb, B::rr, B::rz,
                                       B::active, B::converged, B::iterations, B::own_active,
                                       B::own_iterations, B::own_rz}, S, N, cap);
+    }
+    if (multigrid_) {
+      k_cg_preconditioned_ = device_.kernel("cg_preconditioned");
+      set_arguments(k_cg_preconditioned_, {B::r, B::z, B::d, B::partial, B::own_active}, S, N, cl_uint{0});
+      device_multigrid_ = std::make_unique<OpenClMultigrid>(device_, S_);
     }
     if (whole_solve_) {
       std::vector<DeviceBuffer> solve = {B::constants, B::element_nodes, B::element_rest, B::frames,
@@ -275,6 +300,7 @@ std::vector<double> OpenClEnsemble::read_reals(DeviceBuffer id, std::size_t coun
 void OpenClEnsemble::upload_ligament_k() {
   write_reals(DeviceBuffer::ligament_k, ligament_k_);
   coupling_stale_ = springs_.prepared();   // the springs' corrections follow the stiffnesses
+  shift_stale_ = multigrid_on_device_;
 }
 
 void OpenClEnsemble::run(cl::Kernel& kernel, std::size_t items, std::size_t local) const {
@@ -324,8 +350,9 @@ void OpenClEnsemble::conjugate_gradient() {
   // The warm start's residual (dv holds the last step's velocity change).
   element_product(DeviceBuffer::dv, DeviceBuffer::all_active);
   node_product(DeviceBuffer::dv);
-  if (cg_partitions_ > 1) {
+  if (cg_partitioned_) {
     run_partitions(k_cg_start_partials_);
+    precondition_outside(true);
     run(k_cg_start_scalars_, static_cast<std::size_t>(S_));
   } else {
     run_cg(k_cg_start_);
@@ -335,9 +362,10 @@ void OpenClEnsemble::conjugate_gradient() {
     for (int i = 0; i < count; ++i) {
       element_product(DeviceBuffer::d, DeviceBuffer::active);
       if (cg_per_group_) node_product(DeviceBuffer::d);   // on a CPU cg_iteration does it
-      if (cg_partitions_ > 1) {
+      if (cg_partitioned_) {
         run_partitions(k_cg_dot_);
         run_partitions(k_cg_update_);
+        precondition_outside(false);
         run_partitions(k_cg_direction_);
       } else {
         run_cg(k_cg_iteration_);
@@ -349,6 +377,14 @@ void OpenClEnsemble::conjugate_gradient() {
   });
 }
 
+void OpenClEnsemble::precondition_outside(bool start) {
+  // Until a hierarchy has gone down, the Jacobi z that cg_start_partials and cg_update made.
+  if (!multigrid_on_device_) return;
+  device_multigrid_->enqueue(buffer(DeviceBuffer::r), buffer(DeviceBuffer::z));
+  k_cg_preconditioned_.setArg(2, static_cast<cl_uint>(start ? 1 : 0));
+  run_partitions(k_cg_preconditioned_);
+}
+
 StepReport OpenClEnsemble::advance(const Eigen::Vector3d& so_position) {
   const std::size_t dof = 3 * static_cast<std::size_t>(nodes_) * S_;
   StepReport report;
@@ -356,8 +392,10 @@ StepReport OpenClEnsemble::advance(const Eigen::Vector3d& so_position) {
   try {
     const std::vector<double> constants = step_constants_.next_step(model_, so_position);
     if (factor_ && factor_->due()) refresh_factor(constants);
+    if (multigrid_ && multigrid_refresh_.due()) refresh_multigrid(constants);
     write_reals(DeviceBuffer::constants, constants);
     if (coupling_stale_) upload_spring_coupling(constants);
+    if (shift_stale_) upload_multigrid_shift(constants);
     run_elements(k_element_rhs_);
     run(k_node_rhs_, static_cast<std::size_t>(nodes_) * S_);
     conjugate_gradient();
@@ -378,6 +416,7 @@ StepReport OpenClEnsemble::advance(const Eigen::Vector3d& so_position) {
     report = step_report(iterations, converged, from_device_reals(rr_bytes.data(), S_, precision),
                          from_device_reals(bb_bytes.data(), S_, precision));
     if (factor_) factor_->record(*std::max_element(iterations.begin(), iterations.end()));
+    if (multigrid_) multigrid_refresh_.record(*std::max_element(iterations.begin(), iterations.end()));
     report.factorisations = factorisations() - factorisations_before;
   } catch (const cl::Error& error) {
     throw opencl_failure("advancing the OpenCL ensemble", error);
@@ -417,6 +456,29 @@ void OpenClEnsemble::refresh_factor(const std::vector<double>& constants) {
   }
   write_reals(DeviceBuffer::factor_values, values);
   on_device_ = FactorOnDevice::factor;
+}
+
+void OpenClEnsemble::refresh_multigrid(const std::vector<double>& constants) {
+  const bool made = multigrid_->set_matrix(representative_system());
+  multigrid_refresh_.made(made, multigrid_->setup_in_cycles());
+  if (!made) return;   // the last hierarchy stays, or Jacobi until one is made
+  device_multigrid_->upload(*multigrid_);
+  if (!multigrid_on_device_) device_bytes_ += device_multigrid_->device_bytes();
+  multigrid_on_device_ = true;
+  ++multigrid_makings_;
+  multigrid_springs_ = factorised_springs(shift_rows_, constants);
+  shift_stale_ = true;
+}
+
+void OpenClEnsemble::upload_multigrid_shift(const std::vector<double>& constants) {
+  const std::size_t S = static_cast<std::size_t>(S_);
+  std::vector<double> shift(3 * static_cast<std::size_t>(nodes_) * S, 0.0);
+  const std::vector<double> own = spring_shifts(shift_rows_, constants, multigrid_springs_);
+  const std::vector<int>& rows = shift_rows_.rows();
+  for (std::size_t j = 0; j < rows.size(); ++j)
+    for (std::size_t s = 0; s < S; ++s) shift[static_cast<std::size_t>(rows[j]) * S + s] = own[j * S + s];
+  device_multigrid_->upload_shift(shift);
+  shift_stale_ = false;
 }
 
 void OpenClEnsemble::prepare_spring_correction(const std::vector<double>& constants) {

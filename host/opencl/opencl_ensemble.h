@@ -17,7 +17,10 @@
 #include "host/ensemble/device_ensemble.h"
 #include "host/model/model.h"
 #include "host/opencl/opencl_device.h"
+#include "host/opencl/opencl_multigrid.h"
 #include "host/reference/factorised_preconditioner.h"
+#include "host/reference/nested_multigrid.h"
+#include "host/reference/refresh_rule.h"
 #include "host/reference/spring_correction.h"
 
 namespace sigmafem {
@@ -29,6 +32,11 @@ bool opencl_cpu_form(KernelForm form, const std::string& device_type);
 // CPU form, where it is faster on every case measured (bench/RESULTS.md, issue 18); the GPU
 // form has Jacobi only.
 bool opencl_uses_factor(Preconditioner preconditioner, bool cpu_form);
+// Whether it preconditions CG with the multigrid V-cycle (NestedMultigrid): asked, or by default
+// on the GPU form where the mesh is a uniform refinement (`nested`: nested_prolongations() has
+// a level), where it takes CG from hundreds of iterations to tens (bench/RESULTS.md, stop 54).
+// Asked on the CPU form or on a mesh that was not refined so, the constructor throws.
+bool opencl_uses_multigrid(Preconditioner preconditioner, bool cpu_form, bool nested);
 
 class OpenClEnsemble : public DeviceEnsemble {
  public:
@@ -49,8 +57,11 @@ class OpenClEnsemble : public DeviceEnsemble {
   void predicted_observations(Eigen::MatrixXd& y) const override;
   void recenter(const Recentering& recentering) override;
   const OpenClDeviceInfo& device_info() const { return device_.info(); }
-  // Factorisations of the shared factor so far (0 with Jacobi).
-  int factorisations() const { return factor_ ? factor_->factorisations() : 0; }
+  // Factorisations of the shared factor, or makings of the multigrid hierarchy, so far (0 with
+  // Jacobi).
+  int factorisations() const { return factor_ ? factor_->factorisations() : multigrid_makings_; }
+  // Whether CG is preconditioned by the multigrid V-cycle.
+  bool multigrid() const { return multigrid_ != nullptr; }
 
  private:
   std::vector<double> read_reals(DeviceBuffer buffer, std::size_t count) const override;
@@ -71,6 +82,9 @@ class OpenClEnsemble : public DeviceEnsemble {
   void element_product(DeviceBuffer d, DeviceBuffer active);
   void node_product(DeviceBuffer d);   // A d from the element outputs, into q
   void conjugate_gradient();
+  // With the multigrid V-cycle, z = M^-1 r in place of cg_start_partials' or cg_update's
+  // Jacobi z, and the partial r.z again (cg_preconditioned; at the start also d = z).
+  void precondition_outside(bool start);
   void run(cl::Kernel& kernel, std::size_t items, std::size_t local = 0) const;
   void run_cg(cl::Kernel& kernel) const;   // cg_start or cg_iteration, as SF_CG_PER_GROUP
   void run_partitions(cl::Kernel& kernel) const;   // a CG kernel's S x P groups (GPU form)
@@ -91,6 +105,11 @@ class OpenClEnsemble : public DeviceEnsemble {
   void upload_diagonal_factor(const Eigen::SparseMatrix<double>& A);
   // After a failed factorisation: the last factor stays; with none yet, A's diagonal goes down.
   void fall_back_to_diagonal(const Eigen::SparseMatrix<double>& A);
+  // Makes the multigrid hierarchy again of the representative's system and uploads it; after a
+  // failure the last one stays (none yet: Jacobi, from cg_update, for the step).
+  void refresh_multigrid(const std::vector<double>& constants);
+  // Each sigma point's springs against the hierarchy's, the finest level's shift.
+  void upload_multigrid_shift(const std::vector<double>& constants);
 
   mutable OpenClDevice device_;
   bool cg_per_group_ = true;                // SF_CG_PER_GROUP: CG kernels a group per sigma (GPU)
@@ -101,6 +120,9 @@ class OpenClEnsemble : public DeviceEnsemble {
   int solve_block_ = 1;                     // SF_CG_SOLVE_BLOCK: cg_solve's sigma points per work-item
   int cg_block_ = 1;                        // SF_CG_BLOCK: sigma points per CG work-item (CPU)
   int cg_partitions_ = 1;                   // SF_CG_PARTITIONS: CG work-groups per sigma (GPU)
+  // The GPU form's CG in the three kernels of the partitions (cg_dot, cg_update, cg_direction)
+  // with P = cg_partitions_: on a large mesh, and with the multigrid V-cycle between the last two.
+  bool cg_partitioned_ = false;
   std::vector<cl::Buffer> buffers_;         // by DeviceBuffer
   // Writes do not wait for the device (write_reals): each buffer's host copy is kept until
   // its write is done (the event), and the next read waits for them all. A wait on PoCL
@@ -131,12 +153,24 @@ class OpenClEnsemble : public DeviceEnsemble {
   // pattern and ordering later refreshes keep).
   enum class FactorOnDevice { none, diagonal, factor };
   FactorOnDevice on_device_ = FactorOnDevice::none;
+  // CG's preconditioner on the GPU form where the mesh is a refinement (opencl_uses_multigrid):
+  // the hierarchy of the representative's system, its copy on the device (once one has been
+  // made), when to make it again, the estimated ligaments' rows with the hierarchy's springs
+  // there, and whether the sigma points' shifts are out of date.
+  std::unique_ptr<NestedMultigrid> multigrid_;
+  std::unique_ptr<OpenClMultigrid> device_multigrid_;
+  bool multigrid_on_device_ = false;
+  int multigrid_makings_ = 0;
+  RefreshRule multigrid_refresh_;
+  SpringCorrection shift_rows_;
+  std::vector<double> multigrid_springs_;
+  bool shift_stale_ = false;
 
   // Mutable: enqueueing a kernel (also from the const read-outs) changes no visible state.
   mutable cl::Kernel k_element_rhs_, k_node_rhs_, k_element_product_, k_node_product_;
   mutable cl::Kernel k_cg_start_, k_cg_iteration_, k_cg_solve_, k_state_update_;
   mutable cl::Kernel k_cg_start_partials_, k_cg_start_scalars_, k_cg_dot_, k_cg_update_;
-  mutable cl::Kernel k_cg_direction_;
+  mutable cl::Kernel k_cg_direction_, k_cg_preconditioned_;
   mutable cl::Kernel k_observation_gather_;
   mutable cl::Kernel k_recenter_;
 };

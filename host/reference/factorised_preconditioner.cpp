@@ -23,7 +23,7 @@ bool FactorisedPreconditioner::factorise(const Eigen::SparseMatrix<double>& A) {
   if (!same_pattern(A)) analyse(A);
   llt_.factorize(ordered(A));
   ready_ = llt_.info() == Eigen::Success;
-  fresh_ = true;
+  refresh_.made(ready_, factorisation_in_solves_);
   if (ready_) {
     ++factorisations_;
     supernodes_.assign(lower());
@@ -94,16 +94,6 @@ double FactorisedPreconditioner::bytes() const {
   if (!ready_) return 0.0;
   const double nonzeros = static_cast<double>(llt_.matrixL().nestedExpression().nonZeros());
   return nonzeros * static_cast<double>(sizeof(double) + sizeof(int)) + supernodes_.bytes();
-}
-
-void FactorisedPreconditioner::record(int most_iterations) {
-  if (fresh_) {
-    after_ = ready_ ? most_iterations : -1;
-    excess_iterations_ = 0.0;
-  } else if (after_ >= 0) {
-    excess_iterations_ += std::max(0, most_iterations - after_);
-  }
-  fresh_ = false;
 }
 
 }  // namespace sigmafem

@@ -8,12 +8,8 @@
 // factorise; on the small meshes AMD); the solves run on its supernodes in float
 // (host/reference/supernodal_factor.h).
 // Like SOFA's asynchronous preconditioner, the factor is kept over many steps and made again
-// when it stops paying: when the CG iterations the steps took beyond the first step's after
-// the last factorisation (the most over the systems that share it), counted in the work of a
-// solve with the factor, add up to the work of a factorisation (rent until the rent paid
-// would have bought a new one: never more than twice the best cost, whatever comes). The
-// work is counted in arithmetic, not measured time, so a run's results do not depend on the
-// machine's load. On the 38k liver a factorisation is the work of 320 solves (measured: 3-4 s
+// when it stops paying (RefreshRule, host/reference/refresh_rule.h), its work counted in
+// solves with it. On the 38k liver a factorisation is the work of 320 solves (measured: 3-4 s
 // against 10.6-14 ms a solve); on the liver (596 tetrahedra) of 31, on the box of 55.
 // Solving with it is const and thread-safe: sigma points' threads may share one factor.
 #pragma once
@@ -22,6 +18,7 @@
 #include <Eigen/SparseCholesky>
 #include <vector>
 
+#include "host/reference/refresh_rule.h"
 #include "host/reference/supernodal_factor.h"
 
 namespace sigmafem {
@@ -52,11 +49,11 @@ class FactorisedPreconditioner {
   // before the first.
   double bytes() const;
 
-  // Whether to factorise before the next step (the first, after a failure, or the rule
-  // above); not between a factorisation and the record() of its first step.
-  bool due() const { return !fresh_ && (after_ < 0 || excess_iterations_ >= factorisation_in_solves_); }
+  // Whether to factorise before the next step (RefreshRule); not between a factorisation and
+  // the record() of its first step.
+  bool due() const { return refresh_.due(); }
   // The most CG iterations of a step just done with this factor.
-  void record(int most_iterations);
+  void record(int most_iterations) { refresh_.record(most_iterations); }
   // The work of a factorisation in solves with the factor: sum_j c_j^2 multiply-adds (c_j the
   // entries of L's column j) against the 2 nnz(L) of a solve's two substitutions.
   double factorisation_in_solves() const { return factorisation_in_solves_; }
@@ -80,10 +77,8 @@ class FactorisedPreconditioner {
   SupernodalFactor supernodes_;
   std::vector<int> outer_, inner_;   // the pattern analysed (empty: none yet)
   bool ready_ = false;
-  bool fresh_ = false;      // factorised since the last record()
   int factorisations_ = 0;
-  int after_ = -1;          // iterations of the first step after factorising (-1: none yet)
-  double excess_iterations_ = 0.0;        // beyond after_, summed over the steps since
+  RefreshRule refresh_;
   double factorisation_in_solves_ = 0.0;  // of the pattern analysed
 };
 

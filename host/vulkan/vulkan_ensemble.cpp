@@ -50,6 +50,9 @@ VulkanEnsemble::VulkanEnsemble(const Model& model, EstimatedParameters estimated
   // Work-items per sigma point in CG: on a CPU (lavapipe) one SIMD register's worth, so that
   // a group's barriers cost nothing; on a GPU 64 (two warps, one wavefront).
   cg_group_ = info.type == "cpu" ? 8 : 64;
+  if (options.preconditioner == Preconditioner::multigrid)
+    throw DeviceError("--preconditioner multigrid: OpenCL's GPU kernels have it, Vulkan's shaders not yet "
+                      "(they have Jacobi, and the factor on a CPU device); device " + info.name);
   // CG's preconditioner (vulkan_uses_factor): one factor of the representative's system,
   // analysed here for its size, made at the first step and again when due. With one CG
   // work-group per sigma point only (its finishing shaders); on a CPU device more are made

@@ -327,6 +327,30 @@ void cg_direction(uint S, uint node_count, int max_iterations, __global const re
     d[at] = z[at] + beta * d[at];
   }
 }
+/* With the multigrid V-cycle (multigrid.cl) run after cg_start_partials or cg_update, z = M^-1 r
+ * there in place of their Jacobi z: the partial r.z again, and at the start (when every group
+ * runs) d = z. */
+__kernel __attribute__((reqd_work_group_size(SF_GROUP_SIZE, 1, 1)))
+void cg_preconditioned(uint S, uint node_count, uint start, __global const real* r,
+                       __global const real* z, __global real* d, __global real* partial,
+                       __global const uint* own_active) {
+  __local real scratch[SF_GROUP_SIZE];
+  uint g = get_group_id(0);
+  if (!start && !own_active[g]) return;
+  uint s = g / SF_CG_PARTITIONS;
+  uint p = g % SF_CG_PARTITIONS;
+  uint begin, end;
+  sf_partition_rows(3 * node_count, p, &begin, &end);
+  real sum_rz = (real)0;
+  for (uint row = begin + get_local_id(0); row < end; row += SF_GROUP_SIZE) {
+    size_t at = (size_t)row * S + s;
+    real zi = z[at];
+    sum_rz += r[at] * zi;
+    if (start) d[at] = zi;
+  }
+  sum_rz = sf_group_sum(scratch, sum_rz);
+  if (get_local_id(0) == 0) partial[((size_t)SF_PARTIAL_RZ * S + s) * SF_CG_PARTITIONS + p] = sum_rz;
+}
 #endif /* SF_CG_PER_GROUP */
 
 #if !SF_CG_PER_GROUP

@@ -15,38 +15,38 @@
 namespace sigmafem {
 namespace {
 
-constexpr double kTolerance = 1e-6;   // the float devices' CG tolerance (kSingleCgTolerance)
-constexpr int kMaxIterations = 5000;
+constexpr double kMultigridCgTolerance = 1e-6;   // the float devices' CG tolerance (kSingleCgTolerance)
+constexpr int kMultigridCgMaxIterations = 5000;
 
-Model liver_model(int refine) {
+Model nested_liver_model(int refine) {
   Scenario scenario = load_scenario(kScenarios + "liver.json");
   for (int level = 0; level < refine; ++level) scenario.mesh = refine_uniform(scenario.mesh);
   return make_model(scenario);
 }
 
 // A right-hand side with every frequency in it, the same in every run.
-Eigen::VectorXd mixed_rhs(Eigen::Index rows) {
+Eigen::VectorXd mixed_right_hand_side(Eigen::Index rows) {
   Eigen::VectorXd b(rows);
   for (Eigen::Index i = 0; i < rows; ++i) b[i] = std::sin(0.37 * static_cast<double>(i)) + 0.1 * static_cast<double>(i % 5);
   return b;
 }
 
-int cg_iterations(const Eigen::SparseMatrix<double>& A, const Eigen::VectorXd& b,
+int pcg_iterations(const Eigen::SparseMatrix<double>& A, const Eigen::VectorXd& b,
                   const std::function<void(const Eigen::VectorXd&, Eigen::VectorXd&)>& precondition) {
   const auto apply = [&](const Eigen::VectorXd& x, Eigen::VectorXd& y) { y = A * x; };
   Eigen::VectorXd x = Eigen::VectorXd::Zero(b.size());
-  const CgResult result = preconditioned_conjugate_gradient(apply, precondition, b, x, kMaxIterations, kTolerance);
+  const CgResult result = preconditioned_conjugate_gradient(apply, precondition, b, x, kMultigridCgMaxIterations, kMultigridCgTolerance);
   EXPECT_TRUE(result.converged);
   return result.iterations;
 }
 
-int jacobi_iterations(const Eigen::SparseMatrix<double>& A, const Eigen::VectorXd& b) {
+int jacobi_cg_iterations(const Eigen::SparseMatrix<double>& A, const Eigen::VectorXd& b) {
   const Eigen::VectorXd inverse = A.diagonal().cwiseInverse();
-  return cg_iterations(A, b, [&](const Eigen::VectorXd& r, Eigen::VectorXd& z) { z = inverse.cwiseProduct(r); });
+  return pcg_iterations(A, b, [&](const Eigen::VectorXd& r, Eigen::VectorXd& z) { z = inverse.cwiseProduct(r); });
 }
 
 TEST(NestedProlongations, TwoRefinementsAreFoundAgainAndInterpolateLinearFieldsExactly) {
-  const Model coarse = liver_model(0), fine = liver_model(2);
+  const Model coarse = nested_liver_model(0), fine = nested_liver_model(2);
   EXPECT_TRUE(nested_prolongations(coarse).empty()) << "liver.msh itself is not a refinement";
   const std::vector<RowMajorMatrix> P = nested_prolongations(fine);
   ASSERT_EQ(P.size(), 2u);
@@ -60,10 +60,10 @@ TEST(NestedProlongations, TwoRefinementsAreFoundAgainAndInterpolateLinearFieldsE
 }
 
 TEST(NestedProlongations, ElementsOutOfTheRefinementsOrderAreNotTakenForOne) {
-  Model fine = liver_model(1);
+  Model fine = nested_liver_model(1);
   std::swap(fine.elements[3], fine.elements[11]);   // a corner child into another parent's eight
   EXPECT_TRUE(nested_prolongations(fine).empty());
-  Model moved = liver_model(1);
+  Model moved = nested_liver_model(1);
   moved.rest_positions.back() += Eigen::Vector3d(1e-4, 0.0, 0.0);   // a midpoint off its edge
   EXPECT_TRUE(nested_prolongations(moved).empty());
 }
@@ -71,10 +71,10 @@ TEST(NestedProlongations, ElementsOutOfTheRefinementsOrderAreNotTakenForOne) {
 class NestedMultigridTest : public ::testing::Test {
  protected:
   void SetUp() override {
-    model_ = liver_model(1);
+    model_ = nested_liver_model(1);
     ReferenceSimulation simulation(model_);
     A_ = simulation.system_matrix();
-    b_ = mixed_rhs(A_.rows());
+    b_ = mixed_right_hand_side(A_.rows());
   }
   Model model_;
   Eigen::SparseMatrix<double> A_;
@@ -86,7 +86,7 @@ TEST_F(NestedMultigridTest, TheVCycleIsSymmetricAndPositiveDefinite) {
   ASSERT_TRUE(multigrid.set_matrix(A_));
   ASSERT_EQ(multigrid.level_count(), 2);
   EXPECT_EQ(multigrid.coarsest_inverse().rows(), 3 * 181);   // liver.msh's nodes, inverted
-  Eigen::VectorXd u = mixed_rhs(A_.rows()), v = Eigen::VectorXd::LinSpaced(A_.rows(), -1.0, 2.0), Mu, Mv;
+  Eigen::VectorXd u = mixed_right_hand_side(A_.rows()), v = Eigen::VectorXd::LinSpaced(A_.rows(), -1.0, 2.0), Mu, Mv;
   multigrid(u, Mu);
   multigrid(v, Mv);
   EXPECT_NEAR(v.dot(Mu), u.dot(Mv), 1e-10 * std::abs(u.dot(Mv)));
@@ -95,11 +95,11 @@ TEST_F(NestedMultigridTest, TheVCycleIsSymmetricAndPositiveDefinite) {
 }
 
 TEST_F(NestedMultigridTest, CgTakesAFifthOfJacobisIterationsOrFewerInvertedOrSmoothedAtTheCoarsest) {
-  const int jacobi = jacobi_iterations(A_, b_);
+  const int jacobi = jacobi_cg_iterations(A_, b_);
   for (int dense_rows : {NestedMultigrid::kDenseCoarsestRows, 0}) {
     NestedMultigrid multigrid(nested_prolongations(model_), dense_rows);
     ASSERT_TRUE(multigrid.set_matrix(A_));
-    const int cycles = cg_iterations(A_, b_, [&](const Eigen::VectorXd& r, Eigen::VectorXd& z) { multigrid(r, z); });
+    const int cycles = pcg_iterations(A_, b_, [&](const Eigen::VectorXd& r, Eigen::VectorXd& z) { multigrid(r, z); });
     // Measured: Jacobi 328, the V-cycle 18 (inverted) and 22 (smoothed).
     EXPECT_LE(5 * cycles, jacobi) << "coarsest inverted up to " << dense_rows << " rows";
     EXPECT_GT(multigrid.setup_in_cycles(), 1.0);
@@ -120,8 +120,8 @@ TEST_F(NestedMultigridTest, ASigmaPointsOwnSpringsAsAShiftHelpItsSolve) {
             1e-9 * A_.norm());
   NestedMultigrid multigrid(nested_prolongations(model_));
   ASSERT_TRUE(multigrid.set_matrix(A_));
-  const int plain = cg_iterations(A_own, b_, [&](const Eigen::VectorXd& r, Eigen::VectorXd& z) { multigrid(r, z); });
-  const int shifted = cg_iterations(A_own, b_, [&](const Eigen::VectorXd& r, Eigen::VectorXd& z) { multigrid(r, z, shift); });
+  const int plain = pcg_iterations(A_own, b_, [&](const Eigen::VectorXd& r, Eigen::VectorXd& z) { multigrid(r, z); });
+  const int shifted = pcg_iterations(A_own, b_, [&](const Eigen::VectorXd& r, Eigen::VectorXd& z) { multigrid(r, z, shift); });
   EXPECT_LT(shifted, plain);   // measured: 32 -> 23
 }
 

@@ -1,0 +1,64 @@
+// OpenClMultigrid: NestedMultigrid's V-cycle (host/reference/nested_multigrid.h) on an OpenCL
+// device for all S sigma points at once, CG's preconditioner in OpenCL's GPU form, where the
+// factor's triangular solves do not go (issue 18): z = M^-1 r, r and z the ensemble's CG
+// vectors ([row S + s]). Each level's matrices go down in CSR after every
+// NestedMultigrid::set_matrix; the kernels (kernels/opencl/multigrid.cl) then take a level at
+// a time: kSmoothingDegree Chebyshev steps, the residual, its restriction, the coarser level,
+// the prolongation of its correction and the steps again; 2 x 3 + 3 launches a level, one
+// for the coarsest when it is inverted.
+#pragma once
+
+#include <vector>
+
+#include "host/opencl/opencl_device.h"
+#include "host/reference/nested_multigrid.h"
+
+namespace sigmafem {
+
+class OpenClMultigrid {
+ public:
+  // The kernels must be built already (OpenClDevice::build_program). Throws cl::Error.
+  OpenClMultigrid(OpenClDevice& device, int sigma_count);
+
+  // The hierarchy's matrices, diagonals and smoothing steps (`multigrid` ready). Throws
+  // cl::Error.
+  void upload(const NestedMultigrid& multigrid);
+  // Each sigma point's shift at the finest level: rows x S reals, [row S + s].
+  void upload_shift(const std::vector<double>& shift);
+  // Enqueues z = M^-1 r for every sigma point (after upload()).
+  void enqueue(const cl::Buffer& r, const cl::Buffer& z);
+  // Bytes of device memory it holds.
+  std::size_t device_bytes() const { return bytes_; }
+
+ private:
+  struct Matrix {
+    cl::Buffer row_start, columns, values;
+    cl_uint rows = 0;
+  };
+  struct Level {
+    Matrix matrix, prolongation, restriction;   // the coarsest: its inverse in `matrix`
+    cl::Buffer diagonal, steps;
+    int degree = 0;                              // smoothing steps (0: inverted)
+    // [row S + s]: the right-hand side and the result (coarser levels: the finest has CG's r
+    // and z), the smoothing's iterates and steps (two each: a step reads one, writes the
+    // other), the residual.
+    cl::Buffer b, correction, x[2], p[2], r;
+  };
+  Matrix matrix_buffers(const RowMajorMatrix& M);
+  cl::Buffer reals(const std::vector<double>& values);
+  cl::Buffer vector_buffer(Eigen::Index rows);
+  // The level's smoothing from x[*current] (or from zero) in `degree` steps, into x[*current];
+  // its last step writes `last` instead where given.
+  void smooth(int l, const cl::Buffer& b, int& current, bool from_zero, const cl::Buffer* last);
+  void cycle(int l, const cl::Buffer& b, const cl::Buffer& x);
+  void run(cl::Kernel& kernel, cl_uint rows);
+
+  OpenClDevice& device_;
+  cl_uint S_;
+  std::vector<Level> levels_;
+  cl::Buffer shift_;
+  std::size_t bytes_ = 0;
+  cl::Kernel k_smooth_, k_residual_, k_product_;
+};
+
+}  // namespace sigmafem
