@@ -54,8 +54,11 @@ std::string preconditioner_used(const std::string& backend, const DeviceOptions&
       return "multigrid";
     factors = opencl_uses_factor(options.preconditioner, cpu_form);
   }
-  if (backend == "vulkan")
-    factors = vulkan_uses_factor(options.preconditioner, device_type(list_vulkan_devices(), options.device));
+  if (backend == "vulkan") {
+    const std::string type = device_type(list_vulkan_devices(), options.device);
+    if (vulkan_uses_multigrid(options.preconditioner, type, !nested_prolongations(model).empty())) return "multigrid";
+    factors = vulkan_uses_factor(options.preconditioner, type);
+  }
   return factors ? "factorised" : "jacobi";
 }
 

@@ -155,6 +155,18 @@ std::vector<double> DeviceEnsemble::spring_shifts(const SpringCorrection& spring
   return shifts;
 }
 
+std::vector<double> DeviceEnsemble::spring_shift_rows(const SpringCorrection& springs,
+                                                      const std::vector<double>& constants,
+                                                      const std::vector<double>& factorised) const {
+  const std::size_t S = static_cast<std::size_t>(S_);
+  std::vector<double> shift(3 * static_cast<std::size_t>(nodes_) * S, 0.0);
+  const std::vector<double> own = spring_shifts(springs, constants, factorised);
+  const std::vector<int>& rows = springs.rows();
+  for (std::size_t j = 0; j < rows.size(); ++j)
+    for (std::size_t s = 0; s < S; ++s) shift[static_cast<std::size_t>(rows[j]) * S + s] = own[j * S + s];
+  return shift;
+}
+
 std::vector<double> DeviceEnsemble::representative_ligament_k() const {
   std::vector<double> k = ligament_k_;
   if (theta_.size() > 0)

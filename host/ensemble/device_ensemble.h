@@ -118,6 +118,9 @@ class DeviceEnsemble : public SimulationEnsemble {
   // per sigma point): [j S + s].
   std::vector<double> spring_shifts(const SpringCorrection& springs, const std::vector<double>& constants,
                                     const std::vector<double>& factorised) const;
+  // The same at every one of the 3N rows, zero off the springs' rows: [row S + s].
+  std::vector<double> spring_shift_rows(const SpringCorrection& springs, const std::vector<double>& constants,
+                                        const std::vector<double>& factorised) const;
   // The step's solver report from CG's per-sigma results; notes the iterations for the next
   // step's first batch.
   StepReport step_report(const std::vector<std::int32_t>& iterations,

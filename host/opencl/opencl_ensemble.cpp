@@ -471,13 +471,7 @@ void OpenClEnsemble::refresh_multigrid(const std::vector<double>& constants) {
 }
 
 void OpenClEnsemble::upload_multigrid_shift(const std::vector<double>& constants) {
-  const std::size_t S = static_cast<std::size_t>(S_);
-  std::vector<double> shift(3 * static_cast<std::size_t>(nodes_) * S, 0.0);
-  const std::vector<double> own = spring_shifts(shift_rows_, constants, multigrid_springs_);
-  const std::vector<int>& rows = shift_rows_.rows();
-  for (std::size_t j = 0; j < rows.size(); ++j)
-    for (std::size_t s = 0; s < S; ++s) shift[static_cast<std::size_t>(rows[j]) * S + s] = own[j * S + s];
-  device_multigrid_->upload_shift(shift);
+  device_multigrid_->upload_shift(spring_shift_rows(shift_rows_, constants, multigrid_springs_));
   shift_stale_ = false;
 }
 

@@ -28,6 +28,11 @@ bool vulkan_uses_factor(Preconditioner preconditioner, const std::string& device
          (preconditioner == Preconditioner::automatic && device_type == "cpu");
 }
 
+bool vulkan_uses_multigrid(Preconditioner preconditioner, const std::string& device_type, bool nested) {
+  return preconditioner == Preconditioner::multigrid ||
+         (preconditioner == Preconditioner::automatic && device_type != "cpu" && nested);
+}
+
 VulkanEnsemble::VulkanEnsemble(const Model& model, EstimatedParameters estimated,
                                ObservedPoints observed, int sigma_count,
                                const DeviceOptions& options)
@@ -50,9 +55,19 @@ VulkanEnsemble::VulkanEnsemble(const Model& model, EstimatedParameters estimated
   // Work-items per sigma point in CG: on a CPU (lavapipe) one SIMD register's worth, so that
   // a group's barriers cost nothing; on a GPU 64 (two warps, one wavefront).
   cg_group_ = info.type == "cpu" ? 8 : 64;
-  if (options.preconditioner == Preconditioner::multigrid)
-    throw DeviceError("--preconditioner multigrid: OpenCL's GPU kernels have it, Vulkan's shaders not yet "
-                      "(they have Jacobi, and the factor on a CPU device); device " + info.name);
+  // The multigrid V-cycle on a GPU, on the refinements that made the mesh.
+  std::vector<RowMajorMatrix> prolongations;
+  if (options.preconditioner == Preconditioner::multigrid ||
+      (options.preconditioner == Preconditioner::automatic && info.type != "cpu"))
+    prolongations = nested_prolongations(model_);
+  if (vulkan_uses_multigrid(options.preconditioner, info.type, !prolongations.empty())) {
+    if (prolongations.empty())
+      throw DeviceError("--preconditioner multigrid: the mesh is not a uniform refinement of a coarser one "
+                        "(a scenario's mesh.refine makes one)");
+    multigrid_ = std::make_unique<NestedMultigrid>(std::move(prolongations));
+    shift_rows_ = SpringCorrection(estimated_spring_rows(model_, estimated_));
+  }
+  cg_partitioned_ = cg_partitions_ > 1 || multigrid_;
   // CG's preconditioner (vulkan_uses_factor): one factor of the representative's system,
   // analysed here for its size, made at the first step and again when due. With one CG
   // work-group per sigma point only (its finishing shaders); on a CPU device more are made
@@ -114,13 +129,13 @@ VulkanEnsemble::VulkanEnsemble(const Model& model, EstimatedParameters estimated
   // itself), where lavapipe's cost per dispatch outweighs their work; on a larger one the
   // three, where node_product's lanes (a node's sigma points) gather faster than
   // cg_node_iteration's (a sigma point's nodes) (bench/RESULTS.md, stop 52).
-  node_iteration_ = cg_partitions_ == 1 &&
+  node_iteration_ = !cg_partitioned_ &&
                     static_cast<long long>(elements_) * S_ <= options.node_iteration_work;
   // With a factor, the iteration shaders stop at the stop test, and factor_solve and
   // cg_factor_direction follow them.
   if (node_iteration_)
     k_cg_node_iteration_ = cg_kernel(factor_ ? "cg_node_iteration_factor" : "cg_node_iteration", iteration);
-  else if (cg_partitions_ == 1)
+  else if (!cg_partitioned_)
     k_cg_iteration_ = cg_kernel(factor_ ? "cg_iteration_factor" : "cg_iteration", iteration);
   if (factor_) {
     k_cg_factor_start_ = cg_kernel("cg_factor_start", iteration);
@@ -130,7 +145,11 @@ VulkanEnsemble::VulkanEnsemble(const Model& model, EstimatedParameters estimated
         buffer(B::active), options.factor_loop_turns);
     device_bytes_ += factor_solve_->bytes();
   }
-  if (cg_partitions_ > 1) {
+  if (multigrid_) {
+    k_cg_preconditioned_ = cg_kernel("cg_preconditioned", iteration);
+    multigrid_solve_ = std::make_unique<VulkanMultigrid>(device_, S_, buffer(B::r), buffer(B::z));
+  }
+  if (cg_partitioned_) {
     k_cg_start_partials_ = cg_kernel("cg_start_partials", start);
     k_cg_start_scalars_ = cg_kernel("cg_start_scalars", start);
     k_cg_dot_ = cg_kernel("cg_dot", iteration);
@@ -149,9 +168,10 @@ VulkanEnsemble::VulkanEnsemble(const Model& model, EstimatedParameters estimated
   s_cg_start_ = bind(k_cg_start_, start);
   if (node_iteration_)
     s_cg_node_iteration_ = bind(k_cg_node_iteration_, iteration);
-  else if (cg_partitions_ == 1)
+  else if (!cg_partitioned_)
     s_cg_iteration_ = bind(k_cg_iteration_, iteration);
-  if (cg_partitions_ > 1) {
+  if (multigrid_) s_cg_preconditioned_ = bind(k_cg_preconditioned_, iteration);
+  if (cg_partitioned_) {
     s_cg_start_partials_ = bind(k_cg_start_partials_, start);
     s_cg_start_scalars_ = bind(k_cg_start_scalars_, start);
     s_cg_dot_ = bind(k_cg_dot_, iteration);
@@ -188,6 +208,7 @@ std::vector<double> VulkanEnsemble::read_reals(DeviceBuffer id, std::size_t coun
 void VulkanEnsemble::upload_ligament_k() {
   pending_ligament_k_ = to_device_reals(ligament_k_, device_.precision());
   coupling_stale_ = springs_.prepared();   // the springs' corrections follow the stiffnesses
+  shift_stale_ = multigrid_solve_ && multigrid_solve_->ready();
 }
 
 bool VulkanEnsemble::has_pending() const {
@@ -247,12 +268,13 @@ void VulkanEnsemble::record_cg_iterations(VkCommandBuffer cmd, int count) const 
       dispatch_items(cmd, k_element_product_, s_product_cg_, elements_ * static_cast<std::size_t>(S_),
                      elements_);
       device_.dispatch(cmd, k_cg_node_iteration_, s_cg_node_iteration_, &push, groups);
-    } else if (cg_partitions_ > 1) {
+    } else if (cg_partitioned_) {
       record_system_product(cmd, s_product_cg_);
       device_.dispatch(cmd, k_cg_dot_, s_cg_dot_, &push, groups);
       device_.barrier(cmd);
       device_.dispatch(cmd, k_cg_update_, s_cg_update_, &push, groups);
       device_.barrier(cmd);
+      record_multigrid(cmd, false);
       device_.dispatch(cmd, k_cg_direction_, s_cg_direction_, &push, groups);
     } else {
       record_system_product(cmd, s_product_cg_);
@@ -272,6 +294,31 @@ void VulkanEnsemble::record_factor_solve(VkCommandBuffer cmd, const VulkanKernel
   push.max_iterations = model_.solver.cg_max_iterations;
   device_.dispatch(cmd, finish, set, &push, static_cast<std::uint32_t>(S_));
   device_.barrier(cmd);
+}
+
+void VulkanEnsemble::record_multigrid(VkCommandBuffer cmd, bool start) const {
+  // Until a hierarchy has gone down, the Jacobi z of cg_start_partials and cg_update.
+  if (!multigrid_solve_ || !multigrid_solve_->ready()) return;
+  multigrid_solve_->record(cmd);
+  PushConstants push;
+  push.S = static_cast<std::uint32_t>(S_);
+  push.count = static_cast<std::uint32_t>(nodes_);
+  push.max_iterations = model_.solver.cg_max_iterations;
+  push.p = start ? 1u : 0u;
+  device_.dispatch(cmd, k_cg_preconditioned_, s_cg_preconditioned_, &push, static_cast<std::uint32_t>(S_ * cg_partitions_));
+  device_.barrier(cmd);
+}
+
+void VulkanEnsemble::refresh_multigrid(const std::vector<double>& constants) {
+  const bool made = multigrid_->set_matrix(representative_system());
+  multigrid_refresh_.made(made, multigrid_->setup_in_cycles());
+  if (!made) return;   // the last hierarchy stays, or Jacobi until one is made
+  const bool first = !multigrid_solve_->ready();
+  multigrid_solve_->upload(*multigrid_);
+  if (first) device_bytes_ += multigrid_solve_->bytes();
+  ++multigrid_makings_;
+  multigrid_springs_ = factorised_springs(shift_rows_, constants);
+  shift_stale_ = true;
 }
 
 void VulkanEnsemble::refresh_factor(const std::vector<double>& constants) {
@@ -304,6 +351,7 @@ StepReport VulkanEnsemble::advance(const Eigen::Vector3d& so_position) {
   const int factorisations_before = factorisations();
   const std::vector<double> step_constants = step_constants_.next_step(model_, so_position);
   if (factor_ && factor_->due()) refresh_factor(step_constants);
+  if (multigrid_ && multigrid_refresh_.due()) refresh_multigrid(step_constants);
 
   // The right-hand side, the warm start and the first batch of iterations: as many as the
   // last step needed (warm-started steps need about the same).
@@ -315,6 +363,10 @@ StepReport VulkanEnsemble::advance(const Eigen::Vector3d& so_position) {
     factor_solve_->record_couplings(cmd, spring_couplings(springs_, step_constants, factorised_springs_));
     coupling_stale_ = false;
   }
+  if (shift_stale_) {   // the sigma points' springs against the multigrid hierarchy's
+    multigrid_solve_->record_shift(cmd, spring_shift_rows(shift_rows_, step_constants, multigrid_springs_));
+    shift_stale_ = false;
+  }
   device_.barrier(cmd);
   dispatch_items(cmd, k_element_rhs_, s_element_rhs_, elements_ * S, elements_);
   dispatch_items(cmd, k_node_rhs_, s_node_rhs_, nodes_ * S, nodes_);
@@ -323,10 +375,11 @@ StepReport VulkanEnsemble::advance(const Eigen::Vector3d& so_position) {
   PushConstants push;
   push.S = static_cast<std::uint32_t>(S_);
   push.count = static_cast<std::uint32_t>(nodes_);
-  if (cg_partitions_ > 1) {
+  if (cg_partitioned_) {
     device_.dispatch(cmd, k_cg_start_partials_, s_cg_start_partials_, &push,
                      static_cast<std::uint32_t>(S_ * cg_partitions_));
     device_.barrier(cmd);
+    record_multigrid(cmd, true);
     device_.dispatch(cmd, k_cg_start_scalars_, s_cg_start_scalars_, &push,
                      (static_cast<std::uint32_t>(S_) + cg_group_ - 1) / cg_group_);
   } else {
@@ -378,6 +431,7 @@ StepReport VulkanEnsemble::advance(const Eigen::Vector3d& so_position) {
   StepReport report = step_report(iterations, converged, from_device_reals(area + at_rr, S, precision),
                                   from_device_reals(area + at_bb, S, precision));
   if (factor_) factor_->record(*std::max_element(iterations.begin(), iterations.end()));
+  if (multigrid_) multigrid_refresh_.record(*std::max_element(iterations.begin(), iterations.end()));
   report.factorisations = factorisations() - factorisations_before;
   return report;
 }

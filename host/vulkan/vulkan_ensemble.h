@@ -30,6 +30,9 @@
 #include "host/reference/factorised_preconditioner.h"
 #include "host/vulkan/vulkan_device.h"
 #include "host/vulkan/vulkan_factor_solve.h"
+#include "host/vulkan/vulkan_multigrid.h"
+#include "host/reference/nested_multigrid.h"
+#include "host/reference/refresh_rule.h"
 #include "host/vulkan/vulkan_push_constants.h"
 
 namespace sigmafem {
@@ -47,6 +50,11 @@ bool vulkan_texel_reads(KernelForm form, const std::string& device_type,
 // substitutions cost; Jacobi on a GPU, where a lane per sigma point in a sequential solve
 // would leave it idle.
 bool vulkan_uses_factor(Preconditioner preconditioner, const std::string& device_type);
+// Whether it preconditions CG with the multigrid V-cycle (VulkanMultigrid): asked, or by
+// default on a GPU where the mesh is a uniform refinement (`nested`: nested_prolongations()
+// has a level), as OpenCL's GPU form. Asked on a mesh that was not refined so, the
+// constructor throws.
+bool vulkan_uses_multigrid(Preconditioner preconditioner, const std::string& device_type, bool nested);
 
 class VulkanEnsemble : public DeviceEnsemble {
  public:
@@ -69,7 +77,9 @@ class VulkanEnsemble : public DeviceEnsemble {
   // Whether CG is preconditioned by a factor (vulkan_uses_factor), its factorisations so far
   // (0 with Jacobi), and the dispatches of one solve with it.
   bool factorised() const { return factor_ != nullptr; }
-  int factorisations() const { return factor_ ? factor_->factorisations() : 0; }
+  int factorisations() const { return factor_ ? factor_->factorisations() : multigrid_makings_; }
+  // Whether CG is preconditioned by the multigrid V-cycle (its makings: factorisations()).
+  bool multigrid() const { return multigrid_ != nullptr; }
   int factor_solve_dispatches() const { return factor_solve_ ? factor_solve_->dispatches() : 0; }
 
  private:
@@ -93,6 +103,11 @@ class VulkanEnsemble : public DeviceEnsemble {
   // uploads it with its spring correction; with no factor yet and a failed factorisation,
   // A's diagonal (Jacobi) instead.
   void refresh_factor(const std::vector<double>& constants);
+  // Makes the multigrid hierarchy again of the representative's system and uploads it; after
+  // a failure the last one stays (none yet: Jacobi, cg_update's z, for the step).
+  void refresh_multigrid(const std::vector<double>& constants);
+  // With the V-cycle: z = M^-1 r over Jacobi's, then cg_preconditioned (r.z; at the start d = z).
+  void record_multigrid(VkCommandBuffer cmd, bool start) const;
   void record_system_product(VkCommandBuffer cmd, VkDescriptorSet element_product_set) const;
   // Records what set_parameters() and recenter() left for the next submission; flush_pending()
   // submits it alone, before a read-out.
@@ -104,6 +119,7 @@ class VulkanEnsemble : public DeviceEnsemble {
   std::uint32_t cg_group_ = 64;              // work-items per sigma point in the CG shaders
   int cg_partitions_ = 1;                    // work-groups per sigma point in them (constant 1)
   bool node_iteration_ = false;              // CG iterations by element_product and cg_node_iteration
+  bool cg_partitioned_ = false;              // CG in the partitions' shaders (P > 1, or the V-cycle)
   int last_step_waits_ = 0;
   // The observations gathered at the end of the last advance(), until recenter() moves x.
   mutable std::vector<double> observations_cache_;
@@ -119,7 +135,7 @@ class VulkanEnsemble : public DeviceEnsemble {
   VulkanKernel k_element_rhs_, k_node_rhs_, k_element_product_, k_node_product_;
   VulkanKernel k_cg_start_, k_cg_iteration_, k_state_update_, k_observation_gather_, k_recenter_;
   VulkanKernel k_cg_start_partials_, k_cg_start_scalars_, k_cg_dot_, k_cg_update_, k_cg_direction_;
-  VulkanKernel k_cg_node_iteration_, k_cg_factor_start_, k_cg_factor_direction_;
+  VulkanKernel k_cg_node_iteration_, k_cg_factor_start_, k_cg_factor_direction_, k_cg_preconditioned_;
   // CG's shared factor (vulkan_uses_factor), with its refresh rule, and its solve on the device.
   std::unique_ptr<FactorisedPreconditioner> factor_;
   std::unique_ptr<VulkanFactorSolve> factor_solve_;
@@ -128,6 +144,16 @@ class VulkanEnsemble : public DeviceEnsemble {
   SpringCorrection springs_;
   std::vector<double> factorised_springs_;
   bool coupling_stale_ = false;
+  // The GPU form's multigrid V-cycle (vulkan_uses_multigrid): the hierarchy of the
+  // representative's system, its dispatches, when to make it again, the estimated ligaments'
+  // rows with the hierarchy's springs there, and whether the sigma points' shifts are stale.
+  std::unique_ptr<NestedMultigrid> multigrid_;
+  std::unique_ptr<VulkanMultigrid> multigrid_solve_;
+  RefreshRule multigrid_refresh_;
+  int multigrid_makings_ = 0;
+  SpringCorrection shift_rows_;
+  std::vector<double> multigrid_springs_;
+  bool shift_stale_ = false;
   // Descriptor sets; element_product has three: the warm start's product (dv, all active),
   // the CG product (d, the active flags) and system_product()'s (d, all active).
   VkDescriptorSet s_element_rhs_ = VK_NULL_HANDLE, s_node_rhs_ = VK_NULL_HANDLE;
@@ -140,6 +166,7 @@ class VulkanEnsemble : public DeviceEnsemble {
   VkDescriptorSet s_cg_dot_ = VK_NULL_HANDLE, s_cg_update_ = VK_NULL_HANDLE;
   VkDescriptorSet s_cg_direction_ = VK_NULL_HANDLE, s_cg_node_iteration_ = VK_NULL_HANDLE;
   VkDescriptorSet s_cg_factor_start_ = VK_NULL_HANDLE, s_cg_factor_direction_ = VK_NULL_HANDLE;
+  VkDescriptorSet s_cg_preconditioned_ = VK_NULL_HANDLE;
 };
 
 }  // namespace sigmafem

@@ -181,5 +181,25 @@
 #define SF_FACTOR_SOLVE_SPRING_AT 11
 #define SF_FACTOR_SOLVE_SPRING_SOLVES 12
 #define SF_FACTOR_SOLVE_SPRING_COUPLING 13
+/* Vulkan's multigrid shaders (mg_smooth, mg_residual, mg_product: the V-cycle of
+ * host/reference/nested_multigrid.h; host/vulkan/vulkan_multigrid.h): a level's matrix in CSR,
+ * its diagonal, its Chebyshev steps, the finest level's shifts, the input vector (b, or x of a
+ * product), x and p in, the output (x, r or y) and p out. Push constants: count the rows,
+ * max_iterations the step k, p the flags SF_MG_FROM_ZERO | SF_MG_SHIFTED | SF_MG_ACCUMULATE. */
+#define SF_MG_ROW_START 0
+#define SF_MG_COLUMNS 1
+#define SF_MG_VALUES 2
+#define SF_MG_DIAGONAL 3
+#define SF_MG_STEPS 4
+#define SF_MG_SHIFT 5
+#define SF_MG_IN 6
+#define SF_MG_X 7
+#define SF_MG_P 8
+#define SF_MG_OUT 9
+#define SF_MG_P_OUT 10
+#define SF_MG_BINDINGS 11
+#define SF_MG_FROM_ZERO 1u
+#define SF_MG_SHIFTED 2u
+#define SF_MG_ACCUMULATE 4u
 
 #endif /* SIGMAFEM_DEVICE_LAYOUT_H */

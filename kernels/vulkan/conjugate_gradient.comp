@@ -20,6 +20,12 @@
  *   -DSF_ENTRY_CG_FACTOR_START      cg_factor_start: r.z and d = z after the warm start's solve
  *   -DSF_ENTRY_CG_FACTOR_DIRECTION  cg_factor_direction: r.z, beta and d = z + beta d
  *
+ * With the multigrid V-cycle as the preconditioner (multigrid.comp; host/vulkan/vulkan_multigrid.h),
+ * CG runs in the partitions' shaders (with P = 1 on a small mesh) and the V-cycle writes z over
+ * Jacobi's after cg_start_partials and cg_update; then
+ *   -DSF_ENTRY_CG_PRECONDITIONED    cg_preconditioned: the partition's r.z again, and at the
+ *                            start (push constant p = 1, every group) d = z
+ *
  * One work-group per sigma point owns every row of that sigma point, so the dot products are
  * reduced inside the group by a fixed tree (the same bits every run) and the rest of a CG
  * iteration after the product is one dispatch. The group size is specialization constant 0
@@ -356,6 +362,29 @@ void main() {
     d[at] = z[at] + beta * d[at];
 #    endif
   }
+}
+
+#  elif defined(SF_ENTRY_CG_PRECONDITIONED)
+/* After the V-cycle's z = M^-1 r: the partition's r.z, and at the start d = z. */
+void main() {
+  uint S = sf_push.S;
+  uint g = gl_WorkGroupID.x;
+  bool start = sf_push.p != 0u;
+  if (!start && own_active[g] == 0u) return;
+  uint s = g / SF_PARTITIONS;
+  uint p = g % SF_PARTITIONS;
+  uint begin, end;
+  sf_partition_nodes(p, begin, end);
+  real sum_rz = real(0);
+  for (uint n = begin + gl_LocalInvocationID.x; n < end; n += gl_WorkGroupSize.x)
+    for (uint k = 0u; k < 3u; ++k) {
+      uint row = (3u * n + k) * S + s;
+      real z_row = z[row];
+      sum_rz += r[row] * z_row;
+      if (start) d[row] = z_row;
+    }
+  sum_rz = sf_group_sum(sum_rz);
+  if (gl_LocalInvocationID.x == 0u) partial[(SF_PARTIAL_RZ * S + s) * SF_PARTITIONS + p] = sum_rz;
 }
 
 #  elif defined(SF_ENTRY_CG_DOT)

@@ -1,0 +1,185 @@
+#include "host/vulkan/vulkan_multigrid.h"
+
+#include <string>
+
+#include "device_layout.h"
+#include "host/ensemble/device_readout.h"
+
+namespace sigmafem {
+
+VulkanMultigrid::VulkanMultigrid(VulkanDevice& device, int sigma_count, const VulkanBuffer& r,
+                                 const VulkanBuffer& z)
+    : device_(device), S_(sigma_count), r_(r), z_(z),
+      k_smooth_(device.kernel("mg_smooth", SF_MG_BINDINGS)),
+      k_residual_(device.kernel("mg_residual", SF_MG_BINDINGS)),
+      k_product_(device.kernel("mg_product", SF_MG_BINDINGS)) {
+  none_ = make(8);
+}
+
+VulkanBuffer VulkanMultigrid::make(std::size_t bytes) {
+  bytes_ += bytes;
+  return device_.buffer(bytes, "the multigrid levels");
+}
+
+VulkanMultigrid::Matrix VulkanMultigrid::make_matrix(const RowMajorMatrix& M) {
+  Matrix matrix;
+  matrix.rows = static_cast<std::uint32_t>(M.rows());
+  matrix.nonzeros = static_cast<std::size_t>(M.nonZeros());
+  matrix.row_start = make(4 * (static_cast<std::size_t>(M.rows()) + 1));
+  matrix.columns = make(4 * std::max<std::size_t>(1, matrix.nonzeros));
+  matrix.values = make(device_.real_size() * std::max<std::size_t>(1, matrix.nonzeros));
+  return matrix;
+}
+
+void VulkanMultigrid::upload_reals(const VulkanBuffer& to, const std::vector<double>& values) {
+  const std::vector<unsigned char> bytes = to_device_reals(values, device_.precision());
+  device_.upload(to, bytes.data(), bytes.size());
+}
+
+void VulkanMultigrid::upload_matrix(const Matrix& to, const RowMajorMatrix& M) {
+  if (static_cast<std::uint32_t>(M.rows()) != to.rows || static_cast<std::size_t>(M.nonZeros()) != to.nonzeros)
+    throw DeviceError("a multigrid level of " + std::to_string(M.rows()) + " rows and " +
+                      std::to_string(M.nonZeros()) + " entries where the first had " + std::to_string(to.rows) +
+                      " and " + std::to_string(to.nonzeros));
+  device_.upload(to.row_start, M.outerIndexPtr(), 4 * (static_cast<std::size_t>(M.rows()) + 1));
+  device_.upload(to.columns, M.innerIndexPtr(), 4 * to.nonzeros);
+  upload_reals(to.values, std::vector<double>(M.valuePtr(), M.valuePtr() + M.nonZeros()));
+}
+
+void VulkanMultigrid::make_levels(const NestedMultigrid& multigrid) {
+  const std::size_t real = device_.real_size(), S = static_cast<std::size_t>(S_);
+  const auto vector = [&](Eigen::Index rows) { return make(real * static_cast<std::size_t>(rows) * S); };
+  levels_.assign(static_cast<std::size_t>(multigrid.level_count()), Level());
+  for (int l = 0; l < multigrid.level_count(); ++l) {
+    const NestedMultigrid::Level& from = multigrid.level(l);
+    Level& level = levels_[static_cast<std::size_t>(l)];
+    const bool inverted = l + 1 == multigrid.level_count() && multigrid.coarsest_inverse().size() > 0;
+    const Eigen::Index rows = from.matrix.rows();
+    if (inverted) {
+      level.matrix = make_matrix(RowMajorMatrix(multigrid.coarsest_inverse().sparseView(0.0, 0.0)));
+    } else {
+      level.matrix = make_matrix(from.matrix);
+      level.degree = static_cast<int>(from.smoothing.size());
+      level.diagonal = make(real * static_cast<std::size_t>(rows));
+      level.steps = make(real * 2 * from.smoothing.size());
+      for (int i = 0; i < 2; ++i) {
+        level.x[i] = vector(rows);
+        level.p[i] = vector(rows);
+      }
+    }
+    if (l + 1 < multigrid.level_count()) {
+      level.prolongation = make_matrix(from.prolongation);
+      level.restriction = make_matrix(from.restriction);
+      level.r = vector(rows);
+    }
+    if (l > 0) {
+      level.b = vector(rows);
+      level.correction = vector(rows);
+    }
+  }
+  shift_ = vector(multigrid.level(0).matrix.rows());
+  device_.upload(shift_, std::vector<unsigned char>(real * static_cast<std::size_t>(multigrid.level(0).matrix.rows()) * S, 0).data(),
+                 real * static_cast<std::size_t>(multigrid.level(0).matrix.rows()) * S);
+  dispatches_.clear();
+  plan(0, r_, z_);
+}
+
+void VulkanMultigrid::upload(const NestedMultigrid& multigrid) {
+  if (levels_.empty()) make_levels(multigrid);
+  for (int l = 0; l < multigrid.level_count(); ++l) {
+    const NestedMultigrid::Level& from = multigrid.level(l);
+    const Level& level = levels_[static_cast<std::size_t>(l)];
+    if (level.degree == 0) {
+      upload_matrix(level.matrix, RowMajorMatrix(multigrid.coarsest_inverse().sparseView(0.0, 0.0)));
+    } else {
+      upload_matrix(level.matrix, from.matrix);
+      upload_reals(level.diagonal, std::vector<double>(from.diagonal.data(), from.diagonal.data() + from.diagonal.size()));
+      std::vector<double> steps;
+      for (const NestedMultigrid::ChebyshevStep& step : from.smoothing) steps.insert(steps.end(), {step.previous, step.residual});
+      upload_reals(level.steps, steps);
+    }
+    if (l + 1 < multigrid.level_count()) {
+      upload_matrix(level.prolongation, from.prolongation);
+      upload_matrix(level.restriction, from.restriction);
+    }
+  }
+}
+
+void VulkanMultigrid::add(const VulkanKernel& kernel, const Matrix& matrix, std::vector<VulkanBuffer> bound,
+                          std::uint32_t step, std::uint32_t flags) {
+  bound[SF_MG_ROW_START] = matrix.row_start;
+  bound[SF_MG_COLUMNS] = matrix.columns;
+  bound[SF_MG_VALUES] = matrix.values;
+  Dispatch dispatch{&kernel, device_.bind(kernel, bound), VulkanPushConstants(), 0};
+  dispatch.push.S = static_cast<std::uint32_t>(S_);
+  dispatch.push.count = matrix.rows;
+  dispatch.push.max_iterations = static_cast<std::int32_t>(step);
+  dispatch.push.p = flags;
+  const std::size_t items = static_cast<std::size_t>(matrix.rows) * static_cast<std::size_t>(S_);
+  dispatch.groups = static_cast<std::uint32_t>((items + SF_ITEMS_PER_GROUP - 1) / SF_ITEMS_PER_GROUP);
+  dispatches_.push_back(dispatch);
+}
+
+void VulkanMultigrid::plan_smoothing(int l, const VulkanBuffer& b, int& current, bool from_zero,
+                                     const VulkanBuffer* last) {
+  const Level& level = levels_[static_cast<std::size_t>(l)];
+  for (int k = 0; k < level.degree; ++k) {
+    const int next = 1 - current;
+    std::vector<VulkanBuffer> bound(SF_MG_BINDINGS, none_);
+    bound[SF_MG_DIAGONAL] = level.diagonal;
+    bound[SF_MG_STEPS] = level.steps;
+    bound[SF_MG_SHIFT] = l == 0 ? shift_ : none_;
+    bound[SF_MG_IN] = b;
+    bound[SF_MG_X] = level.x[current];
+    bound[SF_MG_P] = level.p[k % 2];
+    bound[SF_MG_OUT] = last && k + 1 == level.degree ? *last : level.x[next];
+    bound[SF_MG_P_OUT] = level.p[(k + 1) % 2];
+    add(k_smooth_, level.matrix, bound, static_cast<std::uint32_t>(k),
+        (from_zero && k == 0 ? SF_MG_FROM_ZERO : 0u) | (l == 0 ? SF_MG_SHIFTED : 0u));
+    current = next;
+  }
+}
+
+void VulkanMultigrid::plan(int l, const VulkanBuffer& b, const VulkanBuffer& x) {
+  Level& level = levels_[static_cast<std::size_t>(l)];
+  const auto product = [&](const Matrix& M, bool accumulate, const VulkanBuffer& in, const VulkanBuffer& out) {
+    std::vector<VulkanBuffer> bound(SF_MG_BINDINGS, none_);
+    bound[SF_MG_IN] = in;
+    bound[SF_MG_OUT] = out;
+    add(k_product_, M, bound, 0, accumulate ? SF_MG_ACCUMULATE : 0u);
+  };
+  int current = 0;
+  if (l + 1 == static_cast<int>(levels_.size())) {
+    if (level.degree == 0)
+      product(level.matrix, false, b, x);
+    else
+      plan_smoothing(l, b, current, true, &x);
+    return;
+  }
+  plan_smoothing(l, b, current, true, nullptr);
+  std::vector<VulkanBuffer> bound(SF_MG_BINDINGS, none_);
+  bound[SF_MG_SHIFT] = l == 0 ? shift_ : none_;
+  bound[SF_MG_IN] = b;
+  bound[SF_MG_X] = level.x[current];
+  bound[SF_MG_OUT] = level.r;
+  add(k_residual_, level.matrix, bound, 0, l == 0 ? SF_MG_SHIFTED : 0u);
+  Level& coarser = levels_[static_cast<std::size_t>(l) + 1];
+  product(level.restriction, false, level.r, coarser.b);
+  plan(l + 1, coarser.b, coarser.correction);
+  product(level.prolongation, true, coarser.correction, level.x[current]);
+  plan_smoothing(l, b, current, false, &x);
+}
+
+void VulkanMultigrid::record_shift(VkCommandBuffer cmd, const std::vector<double>& shift) const {
+  const std::vector<unsigned char> bytes = to_device_reals(shift, device_.precision());
+  device_.update(cmd, shift_, bytes.data(), bytes.size());
+}
+
+void VulkanMultigrid::record(VkCommandBuffer cmd) const {
+  for (const Dispatch& dispatch : dispatches_) {
+    device_.dispatch(cmd, *dispatch.kernel, dispatch.set, &dispatch.push, dispatch.groups);
+    device_.barrier(cmd);
+  }
+}
+
+}  // namespace sigmafem
