@@ -29,7 +29,7 @@ done
 # The WholeSolve cases force the CPU devices' one-work-item CG solve; a GPU never chooses it.
 echo "== conformance (limit ${SIGMAFEM_GPU_TEST_LIMIT:-240} s)"
 SIGMAFEM_TESTS_REQUIRE=all timeout "${SIGMAFEM_GPU_TEST_LIMIT:-240}" "$build/tests/sigmafem_tests" \
-  --gtest_filter='Backends/*:Precisions/*:OpenClDeviceTest.*:VulkanDeviceTest.*-*WholeSolve*' \
+  --gtest_filter='Backends/*:Precisions/*:OpenClDeviceTest.*:VulkanDeviceTest.*:OpenClMultigridTest.*:VulkanMultigridTest.*-*WholeSolve*' \
   --gtest_output="xml:$out/conformance.xml" >"$out/conformance.log" 2>&1
 code=$?
 echo "conformance exit $code"
@@ -40,7 +40,7 @@ grep -E 'tests ran|FAILED TEST' "$out/conformance.log"
 
 echo "== benchmarks (limit ${SIGMAFEM_GPU_BENCH_LIMIT:-240} s)"
 timeout "${SIGMAFEM_GPU_BENCH_LIMIT:-240}" "$build/bench/sigmafem_bench" \
-  --benchmark_filter='BM_ensemble_step/(opencl|vulkan)_(liver_4768|liver_596|liver_fine_38144|box_large_117240)/|BM_ensemble_step/(opencl|vulkan)_polar_liver_4768/|BM_ensemble_step/cpu_liver_(596|4768)/16/|BM_filter_step/(opencl|vulkan|cpu)/|BM_filter_step/(opencl|vulkan|opencl_multigrid)_liver_fine_38144/|BM_ensemble_step/opencl_multigrid_(liver_4768|liver_fine_38144|box_large_117240)/|BM_filter_step_parameters/(opencl|vulkan)/|BM_filter_step/vulkan_(texel|storage)_reads/|BM_ensemble_step/vulkan_(texel|storage)_reads_liver_4768/' \
+  --benchmark_filter='BM_ensemble_step/(opencl|vulkan)_(liver_4768|liver_596|liver_fine_38144|box_large_117240)/|BM_ensemble_step/(opencl|vulkan)_polar_liver_4768/|BM_ensemble_step/cpu_liver_(596|4768)/16/|BM_filter_step/(opencl|vulkan|cpu)/|BM_filter_step/(opencl|vulkan|opencl_multigrid|vulkan_multigrid)_liver_fine_38144/|BM_ensemble_step/(opencl|vulkan)_multigrid_(liver_4768|liver_fine_38144|box_large_117240)/|BM_filter_step_parameters/(opencl|vulkan)/|BM_filter_step/vulkan_(texel|storage)_reads/|BM_ensemble_step/vulkan_(texel|storage)_reads_liver_4768/' \
   --benchmark_min_time=0.3 --benchmark_out="$out/bench.json" --benchmark_out_format=json \
   >"$out/bench.log" 2>&1
 code=$?

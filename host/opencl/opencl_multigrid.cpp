@@ -51,7 +51,6 @@ void OpenClMultigrid::upload(const NestedMultigrid& multigrid) {
       level.matrix = matrix_buffers(RowMajorMatrix(multigrid.coarsest_inverse().sparseView(0.0, 0.0)));
     } else {
       level.matrix = matrix_buffers(from.matrix);
-      level.degree = static_cast<int>(from.smoothing.size());
       std::vector<double> steps;
       for (const NestedMultigrid::ChebyshevStep& step : from.smoothing) steps.insert(steps.end(), {step.previous, step.residual});
       level.steps = reals(steps);
@@ -71,6 +70,7 @@ void OpenClMultigrid::upload(const NestedMultigrid& multigrid) {
       level.correction = vector_buffer(from.matrix.rows());
     }
   }
+  launches_ = multigrid.launches();
   upload_shift(std::vector<double>(static_cast<std::size_t>(multigrid.level(0).matrix.rows()) * S_, 0.0));
 }
 
@@ -92,67 +92,67 @@ void OpenClMultigrid::run(cl::Kernel& kernel, cl_uint rows) {
   device_.record(kernel, event);
 }
 
-void OpenClMultigrid::smooth(int l, const cl::Buffer& b, int& current, bool from_zero, const cl::Buffer* last) {
-  Level& level = levels_[static_cast<std::size_t>(l)];
-  k_smooth_.setArg(4, static_cast<cl_uint>(l == 0 ? 1 : 0));
-  k_smooth_.setArg(5, level.matrix.row_start);
-  k_smooth_.setArg(6, level.matrix.columns);
-  k_smooth_.setArg(7, level.matrix.values);
-  k_smooth_.setArg(8, level.diagonal);
-  k_smooth_.setArg(9, level.steps);
-  k_smooth_.setArg(10, shift_);
-  k_smooth_.setArg(11, b);
-  for (int k = 0; k < level.degree; ++k) {
-    const int next = 1 - current;
-    k_smooth_.setArg(2, static_cast<cl_uint>(k));
-    k_smooth_.setArg(3, static_cast<cl_uint>(from_zero && k == 0 ? 1 : 0));
-    k_smooth_.setArg(12, level.x[current]);
-    k_smooth_.setArg(13, level.p[k % 2]);
-    k_smooth_.setArg(14, last && k + 1 == level.degree ? *last : level.x[next]);
-    k_smooth_.setArg(15, level.p[(k + 1) % 2]);
-    run(k_smooth_, level.matrix.rows);
-    current = next;
+const cl::Buffer& OpenClMultigrid::vector(const MultigridVector& v, const cl::Buffer& r, const cl::Buffer& z) const {
+  const Level& level = levels_[static_cast<std::size_t>(v.level)];
+  using Role = MultigridVector::Role;
+  switch (v.role) {
+    case Role::rhs: return v.level == 0 ? r : level.b;
+    case Role::result: return v.level == 0 ? z : level.correction;
+    case Role::x0: return level.x[0];
+    case Role::x1: return level.x[1];
+    case Role::p0: return level.p[0];
+    case Role::p1: return level.p[1];
+    case Role::residual: break;
   }
-}
-
-void OpenClMultigrid::cycle(int l, const cl::Buffer& b, const cl::Buffer& x) {
-  Level& level = levels_[static_cast<std::size_t>(l)];
-  const auto product = [&](const Matrix& M, bool accumulate, const cl::Buffer& in, const cl::Buffer& out) {
-    k_product_.setArg(2, static_cast<cl_uint>(accumulate ? 1 : 0));
-    k_product_.setArg(3, M.row_start);
-    k_product_.setArg(4, M.columns);
-    k_product_.setArg(5, M.values);
-    k_product_.setArg(6, in);
-    k_product_.setArg(7, out);
-    run(k_product_, M.rows);
-  };
-  int current = 0;
-  if (l + 1 == static_cast<int>(levels_.size())) {
-    if (level.degree == 0)
-      product(level.matrix, false, b, x);
-    else
-      smooth(l, b, current, true, &x);
-    return;
-  }
-  smooth(l, b, current, true, nullptr);
-  k_residual_.setArg(2, static_cast<cl_uint>(l == 0 ? 1 : 0));
-  k_residual_.setArg(3, level.matrix.row_start);
-  k_residual_.setArg(4, level.matrix.columns);
-  k_residual_.setArg(5, level.matrix.values);
-  k_residual_.setArg(6, shift_);
-  k_residual_.setArg(7, b);
-  k_residual_.setArg(8, level.x[current]);
-  k_residual_.setArg(9, level.r);
-  run(k_residual_, level.matrix.rows);
-  Level& coarser = levels_[static_cast<std::size_t>(l) + 1];
-  product(level.restriction, false, level.r, coarser.b);
-  cycle(l + 1, coarser.b, coarser.correction);
-  product(level.prolongation, true, coarser.correction, level.x[current]);
-  smooth(l, b, current, false, &x);
+  return level.r;
 }
 
 void OpenClMultigrid::enqueue(const cl::Buffer& r, const cl::Buffer& z) {
-  cycle(0, r, z);
+  using Kind = MultigridLaunch::Kind;
+  for (const MultigridLaunch& launch : launches_) {
+    const Level& level = levels_[static_cast<std::size_t>(launch.level)];
+    const cl::Buffer& in = vector(launch.in, r, z);
+    const cl::Buffer& out = vector(launch.out, r, z);
+    const cl_uint shifted = launch.shifted ? 1 : 0;
+    if (launch.kind == Kind::smooth) {
+      k_smooth_.setArg(2, static_cast<cl_uint>(launch.step));
+      k_smooth_.setArg(3, static_cast<cl_uint>(launch.from_zero ? 1 : 0));
+      k_smooth_.setArg(4, shifted);
+      k_smooth_.setArg(5, level.matrix.row_start);
+      k_smooth_.setArg(6, level.matrix.columns);
+      k_smooth_.setArg(7, level.matrix.values);
+      k_smooth_.setArg(8, level.diagonal);
+      k_smooth_.setArg(9, level.steps);
+      k_smooth_.setArg(10, shift_);
+      k_smooth_.setArg(11, in);
+      k_smooth_.setArg(12, vector(launch.x, r, z));
+      k_smooth_.setArg(13, vector(launch.p, r, z));
+      k_smooth_.setArg(14, out);
+      k_smooth_.setArg(15, vector(launch.p_out, r, z));
+      run(k_smooth_, level.matrix.rows);
+    } else if (launch.kind == Kind::residual) {
+      k_residual_.setArg(2, shifted);
+      k_residual_.setArg(3, level.matrix.row_start);
+      k_residual_.setArg(4, level.matrix.columns);
+      k_residual_.setArg(5, level.matrix.values);
+      k_residual_.setArg(6, shift_);
+      k_residual_.setArg(7, in);
+      k_residual_.setArg(8, vector(launch.x, r, z));
+      k_residual_.setArg(9, out);
+      run(k_residual_, level.matrix.rows);
+    } else {
+      const Matrix& M = launch.kind == Kind::restriction    ? level.restriction
+                        : launch.kind == Kind::prolongation ? level.prolongation
+                                                            : level.matrix;
+      k_product_.setArg(2, static_cast<cl_uint>(launch.kind == Kind::prolongation ? 1 : 0));
+      k_product_.setArg(3, M.row_start);
+      k_product_.setArg(4, M.columns);
+      k_product_.setArg(5, M.values);
+      k_product_.setArg(6, in);
+      k_product_.setArg(7, out);
+      run(k_product_, M.rows);
+    }
+  }
 }
 
 }  // namespace sigmafem

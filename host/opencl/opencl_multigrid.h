@@ -2,10 +2,10 @@
 // device for all S sigma points at once, CG's preconditioner in OpenCL's GPU form, where the
 // factor's triangular solves do not go (issue 18): z = M^-1 r, r and z the ensemble's CG
 // vectors ([row S + s]). Each level's matrices go down in CSR after every
-// NestedMultigrid::set_matrix; the kernels (kernels/opencl/multigrid.cl) then take a level at
-// a time: kSmoothingDegree Chebyshev steps, the residual, its restriction, the coarser level,
-// the prolongation of its correction and the steps again; 2 x 3 + 3 launches a level, one
-// for the coarsest when it is inverted.
+// NestedMultigrid::set_matrix; the kernels (kernels/opencl/multigrid.cl) then run the V-cycle's
+// launches (NestedMultigrid::launches): at each level but the coarsest kSmoothingDegree
+// Chebyshev steps, the residual, its restriction, the coarser level, the prolongation of its
+// result and the steps again, 2 x 3 + 3 launches; one for the coarsest when it is inverted.
 #pragma once
 
 #include <vector>
@@ -38,7 +38,6 @@ class OpenClMultigrid {
   struct Level {
     Matrix matrix, prolongation, restriction;   // the coarsest: its inverse in `matrix`
     cl::Buffer diagonal, steps;
-    int degree = 0;                              // smoothing steps (0: inverted)
     // [row S + s]: the right-hand side and the result (coarser levels: the finest has CG's r
     // and z), the smoothing's iterates and steps (two each: a step reads one, writes the
     // other), the residual.
@@ -47,15 +46,14 @@ class OpenClMultigrid {
   Matrix matrix_buffers(const RowMajorMatrix& M);
   cl::Buffer reals(const std::vector<double>& values);
   cl::Buffer vector_buffer(Eigen::Index rows);
-  // The level's smoothing from x[*current] (or from zero) in `degree` steps, into x[*current];
-  // its last step writes `last` instead where given.
-  void smooth(int l, const cl::Buffer& b, int& current, bool from_zero, const cl::Buffer* last);
-  void cycle(int l, const cl::Buffer& b, const cl::Buffer& x);
+  // The buffer of a level's vector (the finest level's right-hand side r, its result z).
+  const cl::Buffer& vector(const MultigridVector& v, const cl::Buffer& r, const cl::Buffer& z) const;
   void run(cl::Kernel& kernel, cl_uint rows);
 
   OpenClDevice& device_;
   cl_uint S_;
   std::vector<Level> levels_;
+  std::vector<MultigridLaunch> launches_;   // the V-cycle (NestedMultigrid::launches)
   cl::Buffer shift_;
   std::size_t bytes_ = 0;
   cl::Kernel k_smooth_, k_residual_, k_product_;

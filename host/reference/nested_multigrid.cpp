@@ -208,6 +208,66 @@ Eigen::VectorXd NestedMultigrid::cycle(int l, const Eigen::VectorXd& b, const Ei
   return x;
 }
 
+std::vector<MultigridLaunch> NestedMultigrid::launches() const {
+  if (!ready_) throw std::logic_error("NestedMultigrid: launches before a successful set_matrix");
+  std::vector<MultigridLaunch> launches;
+  plan(0, launches);
+  return launches;
+}
+
+void NestedMultigrid::plan_smoothing(int l, int& current, bool from_zero, bool to_result,
+                                     std::vector<MultigridLaunch>& launches) const {
+  using Role = MultigridVector::Role;
+  const int degree = static_cast<int>(levels_[static_cast<std::size_t>(l)].smoothing.size());
+  for (int k = 0; k < degree; ++k) {
+    const int next = 1 - current;
+    MultigridLaunch launch;
+    launch.kind = MultigridLaunch::Kind::smooth;
+    launch.level = l;
+    launch.step = k;
+    launch.from_zero = from_zero && k == 0;
+    launch.shifted = l == 0;
+    launch.in = {l, Role::rhs};
+    launch.x = {l, current == 0 ? Role::x0 : Role::x1};
+    launch.p = {l, k % 2 == 0 ? Role::p0 : Role::p1};
+    launch.out = {l, to_result && k + 1 == degree ? Role::result : (next == 0 ? Role::x0 : Role::x1)};
+    launch.p_out = {l, k % 2 == 0 ? Role::p1 : Role::p0};
+    launches.push_back(launch);
+    current = next;
+  }
+}
+
+void NestedMultigrid::plan(int l, std::vector<MultigridLaunch>& launches) const {
+  using Role = MultigridVector::Role;
+  using Kind = MultigridLaunch::Kind;
+  const auto launch = [&](Kind kind, MultigridVector in, MultigridVector out) {
+    MultigridLaunch one;
+    one.kind = kind;
+    one.level = l;
+    one.in = in;
+    one.out = out;
+    return one;
+  };
+  int current = 0;
+  if (l + 1 == level_count()) {   // the same as cycle()'s coarsest
+    if (coarsest_inverse_.size() > 0)
+      launches.push_back(launch(Kind::inverse, {l, Role::rhs}, {l, Role::result}));
+    else
+      plan_smoothing(l, current, true, true, launches);
+    return;
+  }
+  plan_smoothing(l, current, true, false, launches);
+  const MultigridVector x = {l, current == 0 ? Role::x0 : Role::x1};
+  MultigridLaunch residual = launch(Kind::residual, {l, Role::rhs}, {l, Role::residual});
+  residual.x = x;
+  residual.shifted = l == 0;
+  launches.push_back(residual);
+  launches.push_back(launch(Kind::restriction, {l, Role::residual}, {l + 1, Role::rhs}));
+  plan(l + 1, launches);
+  launches.push_back(launch(Kind::prolongation, {l + 1, Role::result}, x));
+  plan_smoothing(l, current, false, true, launches);
+}
+
 void NestedMultigrid::operator()(const Eigen::VectorXd& r, Eigen::VectorXd& z, const Eigen::VectorXd& shift) const {
   if (!ready_) throw std::logic_error("NestedMultigrid: applied before a successful set_matrix");
   z = cycle(0, r, shift);

@@ -37,6 +37,31 @@ using RowMajorMatrix = Eigen::SparseMatrix<double, Eigen::RowMajor>;
 // node a corner. Empty for a mesh that was not refined so.
 std::vector<RowMajorMatrix> nested_prolongations(const Model& model);
 
+// A vector of a level as the devices hold it, for every sigma point: the level's right-hand
+// side and result (the finest level's are CG's r and z), the smoothing's two iterates and two
+// steps (a step reads one and writes the other), the residual.
+struct MultigridVector {
+  enum class Role { rhs, result, x0, x1, p0, p1, residual };
+  int level = 0;
+  Role role = Role::rhs;
+};
+
+// One launch of the V-cycle on a device (OpenClMultigrid, VulkanMultigrid), the same arithmetic
+// as NestedMultigrid's operator(): a Chebyshev step of `level`'s smoothing (`step` k, from zero
+// or not; in: b, x, p -> out: x, p_out), its residual (in: b, x -> out), the restriction of
+// the residual to the next level's right-hand side, the prolongation of that level's result
+// added into x (in -> out), or the coarsest level's inverse (in -> out). `shifted`: the finest
+// level, where each sigma point adds its shift.
+struct MultigridLaunch {
+  enum class Kind { smooth, residual, restriction, prolongation, inverse };
+  Kind kind = Kind::smooth;
+  int level = 0;
+  int step = 0;
+  bool from_zero = false;
+  bool shifted = false;
+  MultigridVector in, x, p, out, p_out;
+};
+
 class NestedMultigrid {
  public:
   static constexpr int kSmoothingDegree = 3;
@@ -74,6 +99,9 @@ class NestedMultigrid {
   const Eigen::MatrixXd& coarsest_inverse() const { return coarsest_inverse_; }
   // Multiply-adds of set_matrix against one V-cycle's (for a refresh rule, as the factor's).
   double setup_in_cycles() const { return setup_in_cycles_; }
+  // The V-cycle as launches, in order (after set_matrix; the same for every matrix of the
+  // hierarchy's meshes).
+  std::vector<MultigridLaunch> launches() const;
 
   // z = M^-1 r, one V-cycle from zero; `shift`, empty or one per finest row, added to the
   // finest level's matrix and diagonal.
@@ -84,6 +112,8 @@ class NestedMultigrid {
   void smooth(int l, const Eigen::VectorXd& b, Eigen::VectorXd& x, bool from_zero,
               const Eigen::VectorXd& shift) const;
   Eigen::VectorXd cycle(int l, const Eigen::VectorXd& b, const Eigen::VectorXd& shift) const;
+  void plan(int l, std::vector<MultigridLaunch>& launches) const;
+  void plan_smoothing(int l, int& current, bool from_zero, bool to_result, std::vector<MultigridLaunch>& launches) const;
   std::vector<RowMajorMatrix> prolongations_;
   int dense_coarsest_rows_;
   std::vector<Level> levels_;

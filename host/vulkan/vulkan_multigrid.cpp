@@ -80,8 +80,7 @@ void VulkanMultigrid::make_levels(const NestedMultigrid& multigrid) {
   shift_ = vector(multigrid.level(0).matrix.rows());
   device_.upload(shift_, std::vector<unsigned char>(real * static_cast<std::size_t>(multigrid.level(0).matrix.rows()) * S, 0).data(),
                  real * static_cast<std::size_t>(multigrid.level(0).matrix.rows()) * S);
-  dispatches_.clear();
-  plan(0, r_, z_);
+  plan(multigrid.launches());
 }
 
 void VulkanMultigrid::upload(const NestedMultigrid& multigrid) {
@@ -120,54 +119,49 @@ void VulkanMultigrid::add(const VulkanKernel& kernel, const Matrix& matrix, std:
   dispatches_.push_back(dispatch);
 }
 
-void VulkanMultigrid::plan_smoothing(int l, const VulkanBuffer& b, int& current, bool from_zero,
-                                     const VulkanBuffer* last) {
-  const Level& level = levels_[static_cast<std::size_t>(l)];
-  for (int k = 0; k < level.degree; ++k) {
-    const int next = 1 - current;
-    std::vector<VulkanBuffer> bound(SF_MG_BINDINGS, none_);
-    bound[SF_MG_DIAGONAL] = level.diagonal;
-    bound[SF_MG_STEPS] = level.steps;
-    bound[SF_MG_SHIFT] = l == 0 ? shift_ : none_;
-    bound[SF_MG_IN] = b;
-    bound[SF_MG_X] = level.x[current];
-    bound[SF_MG_P] = level.p[k % 2];
-    bound[SF_MG_OUT] = last && k + 1 == level.degree ? *last : level.x[next];
-    bound[SF_MG_P_OUT] = level.p[(k + 1) % 2];
-    add(k_smooth_, level.matrix, bound, static_cast<std::uint32_t>(k),
-        (from_zero && k == 0 ? SF_MG_FROM_ZERO : 0u) | (l == 0 ? SF_MG_SHIFTED : 0u));
-    current = next;
+const VulkanBuffer& VulkanMultigrid::vector(const MultigridVector& v) const {
+  const Level& level = levels_[static_cast<std::size_t>(v.level)];
+  using Role = MultigridVector::Role;
+  switch (v.role) {
+    case Role::rhs: return v.level == 0 ? r_ : level.b;
+    case Role::result: return v.level == 0 ? z_ : level.correction;
+    case Role::x0: return level.x[0];
+    case Role::x1: return level.x[1];
+    case Role::p0: return level.p[0];
+    case Role::p1: return level.p[1];
+    case Role::residual: break;
   }
+  return level.r;
 }
 
-void VulkanMultigrid::plan(int l, const VulkanBuffer& b, const VulkanBuffer& x) {
-  Level& level = levels_[static_cast<std::size_t>(l)];
-  const auto product = [&](const Matrix& M, bool accumulate, const VulkanBuffer& in, const VulkanBuffer& out) {
+void VulkanMultigrid::plan(const std::vector<MultigridLaunch>& launches) {
+  using Kind = MultigridLaunch::Kind;
+  dispatches_.clear();
+  for (const MultigridLaunch& launch : launches) {
+    const Level& level = levels_[static_cast<std::size_t>(launch.level)];
     std::vector<VulkanBuffer> bound(SF_MG_BINDINGS, none_);
-    bound[SF_MG_IN] = in;
-    bound[SF_MG_OUT] = out;
-    add(k_product_, M, bound, 0, accumulate ? SF_MG_ACCUMULATE : 0u);
-  };
-  int current = 0;
-  if (l + 1 == static_cast<int>(levels_.size())) {
-    if (level.degree == 0)
-      product(level.matrix, false, b, x);
-    else
-      plan_smoothing(l, b, current, true, &x);
-    return;
+    bound[SF_MG_IN] = vector(launch.in);
+    bound[SF_MG_OUT] = vector(launch.out);
+    const std::uint32_t shifted = launch.shifted ? SF_MG_SHIFTED : 0u;
+    if (launch.shifted) bound[SF_MG_SHIFT] = shift_;
+    if (launch.kind == Kind::smooth) {
+      bound[SF_MG_DIAGONAL] = level.diagonal;
+      bound[SF_MG_STEPS] = level.steps;
+      bound[SF_MG_X] = vector(launch.x);
+      bound[SF_MG_P] = vector(launch.p);
+      bound[SF_MG_P_OUT] = vector(launch.p_out);
+      add(k_smooth_, level.matrix, bound, static_cast<std::uint32_t>(launch.step),
+          (launch.from_zero ? SF_MG_FROM_ZERO : 0u) | shifted);
+    } else if (launch.kind == Kind::residual) {
+      bound[SF_MG_X] = vector(launch.x);
+      add(k_residual_, level.matrix, bound, 0, shifted);
+    } else {
+      const Matrix& M = launch.kind == Kind::restriction    ? level.restriction
+                        : launch.kind == Kind::prolongation ? level.prolongation
+                                                            : level.matrix;
+      add(k_product_, M, bound, 0, launch.kind == Kind::prolongation ? SF_MG_ACCUMULATE : 0u);
+    }
   }
-  plan_smoothing(l, b, current, true, nullptr);
-  std::vector<VulkanBuffer> bound(SF_MG_BINDINGS, none_);
-  bound[SF_MG_SHIFT] = l == 0 ? shift_ : none_;
-  bound[SF_MG_IN] = b;
-  bound[SF_MG_X] = level.x[current];
-  bound[SF_MG_OUT] = level.r;
-  add(k_residual_, level.matrix, bound, 0, l == 0 ? SF_MG_SHIFTED : 0u);
-  Level& coarser = levels_[static_cast<std::size_t>(l) + 1];
-  product(level.restriction, false, level.r, coarser.b);
-  plan(l + 1, coarser.b, coarser.correction);
-  product(level.prolongation, true, coarser.correction, level.x[current]);
-  plan_smoothing(l, b, current, false, &x);
 }
 
 void VulkanMultigrid::record_shift(VkCommandBuffer cmd, const std::vector<double>& shift) const {

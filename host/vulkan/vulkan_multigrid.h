@@ -60,9 +60,10 @@ class VulkanMultigrid {
   void upload_reals(const VulkanBuffer& to, const std::vector<double>& values);
   // The buffers of every level, at the first upload.
   void make_levels(const NestedMultigrid& multigrid);
-  // The V-cycle's dispatches, from level l down, with `b` its right-hand side and `x` its result.
-  void plan(int l, const VulkanBuffer& b, const VulkanBuffer& x);
-  void plan_smoothing(int l, const VulkanBuffer& b, int& current, bool from_zero, const VulkanBuffer* last);
+  // The buffer of a level's vector (the finest level's right-hand side r, its result z).
+  const VulkanBuffer& vector(const MultigridVector& v) const;
+  // The dispatches of the V-cycle's launches (NestedMultigrid::launches), with their sets.
+  void plan(const std::vector<MultigridLaunch>& launches);
   void add(const VulkanKernel& kernel, const Matrix& matrix, std::vector<VulkanBuffer> bound,
            std::uint32_t step, std::uint32_t flags);
 

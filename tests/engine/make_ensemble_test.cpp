@@ -11,7 +11,7 @@
 
 #include <gtest/gtest.h>
 
-#include "tests/scenario_directory.h"
+#include "tests/refined_liver.h"
 
 namespace sigmafem {
 namespace {
@@ -23,11 +23,7 @@ DeviceOptions with(Preconditioner preconditioner) {
 }
 
 // The liver as shipped (not a refinement) or refined once.
-Model liver_refined(int refine) {
-  Scenario scenario = load_scenario(kScenarios + "liver.json");
-  for (int level = 0; level < refine; ++level) scenario.mesh = refine_uniform(scenario.mesh);
-  return make_model(scenario);
-}
+Model liver_refined(int refine) { return make_model(test::refined_liver(refine)); }
 
 // preconditioner_used on the shipped liver.
 std::string used_on_liver(const std::string& backend, const DeviceOptions& options) {

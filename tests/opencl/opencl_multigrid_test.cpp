@@ -15,25 +15,18 @@
 #include "host/reference/reference_simulation.h"
 #include "host/scenario/scenario.h"
 #include "requirement.h"
-#include "tests/scenario_directory.h"
+#include "tests/refined_liver.h"
 
 namespace sigmafem {
 namespace {
 
 constexpr int kMultigridSigmaPoints = 4;
 
-// liver.json on its mesh refined once (4768 tetrahedra): its node lists keep their nodes.
-Scenario multigrid_liver(int refine) {
-  Scenario scenario = load_scenario(kScenarios + "liver.json");
-  for (int level = 0; level < refine; ++level) scenario.mesh = refine_uniform(scenario.mesh);
-  return scenario;
-}
-
 class OpenClMultigridTest : public ::testing::Test {
  protected:
   void SetUp() override {
     if (list_opencl_devices().empty()) SIGMAFEM_MISSING("no OpenCL platform on this machine");
-    scenario_ = multigrid_liver(1);
+    scenario_ = test::refined_liver(1);
     model_ = make_model(scenario_);
   }
   Scenario scenario_;
@@ -95,30 +88,17 @@ INSTANTIATE_TEST_SUITE_P(Precisions, OpenClMultigridPrecisionTest,
 // The GPU form on PoCL, float32: 10 steps of the refined liver with the ligaments of each
 // sigma point apart, Jacobi against the V-cycle, in one CG partition and in three.
 TEST_F(OpenClMultigridTest, TheGpuFormsCgFollowsJacobiInAFifthOfItsIterationsOrFewer) {
-  const std::vector<int>& estimated = scenario_.filter->estimate;
-  Eigen::MatrixXd theta(static_cast<Eigen::Index>(estimated.size()), kMultigridSigmaPoints);
-  for (Eigen::Index j = 0; j < theta.rows(); ++j)
-    for (int s = 0; s < kMultigridSigmaPoints; ++s)
-      theta(j, s) = std::log(model_.ligaments[static_cast<std::size_t>(estimated[static_cast<std::size_t>(j)])].stiffness) +
-                    0.5 * std::sin(static_cast<double>(s + j));
+  const Eigen::MatrixXd theta = test::spread_log_stiffness(scenario_, model_, kMultigridSigmaPoints, 0.5);
   const auto run = [&](Preconditioner preconditioner, int partitions, long& iterations, int& makings) {
     DeviceOptions options;
     options.kernel_form = KernelForm::gpu;
     options.preconditioner = preconditioner;
     options.cg_partitions = partitions;
-    OpenClEnsemble ensemble(model_, estimated, scenario_.observations.observed, kMultigridSigmaPoints, options);
+    OpenClEnsemble ensemble(model_, scenario_.filter->estimate, scenario_.observations.observed, kMultigridSigmaPoints,
+                            options);
     EXPECT_EQ(ensemble.multigrid(), preconditioner == Preconditioner::automatic);
-    ensemble.set_parameters(theta);
-    for (int step = 1; step <= 10; ++step) {
-      const StepReport report = ensemble.advance(scenario_.control.trajectory.position(step * scenario_.time.dt, scenario_.control.start));
-      for (int s = 0; s < kMultigridSigmaPoints; ++s) {
-        EXPECT_TRUE(report.converged[s]) << "step " << step << ", sigma point " << s;
-        iterations += report.cg_iterations[s];
-      }
-    }
+    const Eigen::MatrixXd x = test::run_steps(ensemble, scenario_, theta, 10, iterations);
     makings = ensemble.factorisations();
-    Eigen::MatrixXd x(model_.dof_count(), kMultigridSigmaPoints);
-    for (int s = 0; s < kMultigridSigmaPoints; ++s) x.col(s) = ensemble.positions(s);
     return x;
   };
   long jacobi_iterations = 0;
@@ -145,7 +125,7 @@ TEST_F(OpenClMultigridTest, IsRefusedOnTheCpuFormAndOnAMeshThatNoRefinementMade)
   EXPECT_THROW(OpenClEnsemble(model_, scenario_.filter->estimate, scenario_.observations.observed, kMultigridSigmaPoints, options),
                DeviceError);
   options.kernel_form = KernelForm::gpu;
-  const Scenario shipped = multigrid_liver(0);
+  const Scenario shipped = test::refined_liver(0);
   EXPECT_THROW(OpenClEnsemble(make_model(shipped), shipped.filter->estimate, shipped.observations.observed, kMultigridSigmaPoints,
                               options),
                DeviceError);

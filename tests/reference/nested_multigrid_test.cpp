@@ -10,7 +10,7 @@
 #include "host/reference/conjugate_gradient.h"
 #include "host/reference/reference_simulation.h"
 #include "host/scenario/scenario.h"
-#include "tests/scenario_directory.h"
+#include "tests/refined_liver.h"
 
 namespace sigmafem {
 namespace {
@@ -18,11 +18,7 @@ namespace {
 constexpr double kMultigridCgTolerance = 1e-6;   // the float devices' CG tolerance (kSingleCgTolerance)
 constexpr int kMultigridCgMaxIterations = 5000;
 
-Model nested_liver_model(int refine) {
-  Scenario scenario = load_scenario(kScenarios + "liver.json");
-  for (int level = 0; level < refine; ++level) scenario.mesh = refine_uniform(scenario.mesh);
-  return make_model(scenario);
-}
+Model nested_liver_model(int refine) { return make_model(test::refined_liver(refine)); }
 
 // A right-hand side with every frequency in it, the same in every run.
 Eigen::VectorXd mixed_right_hand_side(Eigen::Index rows) {

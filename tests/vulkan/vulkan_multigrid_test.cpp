@@ -17,26 +17,19 @@
 #include "host/scenario/scenario.h"
 #include "host/vulkan/vulkan_ensemble.h"
 #include "requirement.h"
-#include "tests/scenario_directory.h"
+#include "tests/refined_liver.h"
 
 namespace sigmafem {
 namespace {
 
 constexpr int kVulkanMultigridSigmaPoints = 4;
 
-// liver.json on its mesh refined `refine` times: its node lists keep their nodes.
-Scenario vulkan_multigrid_liver(int refine) {
-  Scenario scenario = load_scenario(kScenarios + "liver.json");
-  for (int level = 0; level < refine; ++level) scenario.mesh = refine_uniform(scenario.mesh);
-  return scenario;
-}
-
 class VulkanMultigridTest : public ::testing::Test {
  protected:
   void SetUp() override {
     std::string why;
     if (list_vulkan_devices(&why).empty()) SIGMAFEM_MISSING(why);
-    scenario_ = vulkan_multigrid_liver(1);
+    scenario_ = test::refined_liver(1);
     model_ = make_model(scenario_);
   }
   Scenario scenario_;
@@ -90,29 +83,15 @@ TEST_F(VulkanMultigridTest, TheDeviceVCycleIsTheHostsForEverySigmaPointInBothFor
 // partition and in three.
 TEST_F(VulkanMultigridTest, TheEnsemblesCgFollowsJacobiInAFifthOfItsIterationsOrFewer) {
   const int S = kVulkanMultigridSigmaPoints;
-  const std::vector<int>& estimated = scenario_.filter->estimate;
-  Eigen::MatrixXd theta(static_cast<Eigen::Index>(estimated.size()), S);
-  for (Eigen::Index j = 0; j < theta.rows(); ++j)
-    for (int s = 0; s < S; ++s)
-      theta(j, s) = std::log(model_.ligaments[static_cast<std::size_t>(estimated[static_cast<std::size_t>(j)])].stiffness) +
-                    0.5 * std::sin(static_cast<double>(s + j));
+  const Eigen::MatrixXd theta = test::spread_log_stiffness(scenario_, model_, S, 0.5);
   const auto run = [&](Preconditioner preconditioner, int partitions, long& iterations, int& makings) {
     DeviceOptions options;
     options.preconditioner = preconditioner;
     options.cg_partitions = partitions;
-    VulkanEnsemble ensemble(model_, estimated, scenario_.observations.observed, S, options);
+    VulkanEnsemble ensemble(model_, scenario_.filter->estimate, scenario_.observations.observed, S, options);
     EXPECT_EQ(ensemble.multigrid(), preconditioner == Preconditioner::multigrid);
-    ensemble.set_parameters(theta);
-    for (int step = 1; step <= 6; ++step) {
-      const StepReport report = ensemble.advance(scenario_.control.trajectory.position(step * scenario_.time.dt, scenario_.control.start));
-      for (int s = 0; s < S; ++s) {
-        EXPECT_TRUE(report.converged[s]) << "step " << step << ", sigma point " << s;
-        iterations += report.cg_iterations[s];
-      }
-    }
+    const Eigen::MatrixXd x = test::run_steps(ensemble, scenario_, theta, 6, iterations);
     makings = ensemble.factorisations();
-    Eigen::MatrixXd x(model_.dof_count(), S);
-    for (int s = 0; s < S; ++s) x.col(s) = ensemble.positions(s);
     return x;
   };
   long jacobi_iterations = 0;
@@ -133,7 +112,7 @@ TEST_F(VulkanMultigridTest, TheEnsemblesCgFollowsJacobiInAFifthOfItsIterationsOr
 TEST_F(VulkanMultigridTest, IsRefusedOnAMeshThatNoRefinementMade) {
   DeviceOptions options;
   options.preconditioner = Preconditioner::multigrid;
-  const Scenario shipped = vulkan_multigrid_liver(0);
+  const Scenario shipped = test::refined_liver(0);
   EXPECT_THROW(VulkanEnsemble(make_model(shipped), shipped.filter->estimate, shipped.observations.observed,
                               kVulkanMultigridSigmaPoints, options),
                DeviceError);
