@@ -36,8 +36,8 @@ void add_backend_options(CLI::App* command, BackendChoice& choice) {
                       "CG's preconditioner: jacobi, factorised (sparse Cholesky factors: on cpu one "
                       "per sigma point or one they share, on OpenCL's and Vulkan's CPU devices one "
                       "they share; not on a GPU), multigrid (a V-cycle on the meshes of mesh.refine: "
-                      "OpenCL on a GPU) or auto (factorised on cpu and on a CPU device, multigrid "
-                      "with OpenCL on a GPU where the mesh was refined, else jacobi)")
+                      "OpenCL's GPU form and Vulkan) or auto (factorised on cpu and on a CPU device, "
+                      "multigrid on a GPU where the mesh was refined, else jacobi)")
       ->check(CLI::IsMember({"auto", "jacobi", "factorised", "multigrid"}))
       ->capture_default_str();
 }

@@ -32,10 +32,10 @@ enum class KernelForm { automatic, cpu, gpu };
 // factors, one per sigma point of the CPU ensemble or one they share (CpuEnsemble,
 // host/reference/factorised_preconditioner.h), or on OpenCL's CPU form and Vulkan on a CPU
 // device one factor of the mean sigma point's system that all share (OpenClEnsemble,
-// VulkanFactorSolve); automatic is the factors on the CPU back end, OpenCL's CPU form and
-// Vulkan on a CPU device, Jacobi on the GPU forms (they have no other yet). multigrid: a
-// V-cycle on the meshes of a uniform refinement (host/reference/nested_multigrid.h), on
-// OpenCL's GPU form only.
+// VulkanFactorSolve), or a multigrid V-cycle on the meshes of a uniform refinement
+// (host/reference/nested_multigrid.h; OpenCL's GPU form and Vulkan, OpenClMultigrid and
+// VulkanMultigrid); automatic is the factors on the CPU back end, OpenCL's CPU form and Vulkan
+// on a CPU device, on a GPU the V-cycle where the mesh is a refinement, else Jacobi.
 enum class Preconditioner { automatic, jacobi, factorised, multigrid };
 
 // Own factors pay from this many sigma points (bench/RESULTS.md, stop 49, the liver's filter

@@ -94,7 +94,7 @@ OpenClEnsemble::OpenClEnsemble(const Model& model, EstimatedParameters estimated
   if (opencl_uses_factor(options.preconditioner, cpu_form)) {
     if (!cpu_form)
       throw DeviceError("--preconditioner factorised: OpenCL has it on a CPU device only (its "
-                        "GPU kernels precondition CG with Jacobi); device " + info.name);
+                        "GPU kernels precondition CG with the multigrid V-cycle or Jacobi); device " + info.name);
     factor_ = analysed_factor();
     // Again with the factor's buffers (L alone is 125 MB on the 38k liver; the copies of its
     // values below add at most own_factors_bytes).

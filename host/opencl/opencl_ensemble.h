@@ -29,8 +29,8 @@ namespace sigmafem {
 // OpenClDeviceInfo::type): `form`, or the device's own unless a test forces one.
 bool opencl_cpu_form(KernelForm form, const std::string& device_type);
 // Whether it preconditions CG with one shared factor: asked, or by default (automatic) on the
-// CPU form, where it is faster on every case measured (bench/RESULTS.md, issue 18); the GPU
-// form has Jacobi only.
+// CPU form, where it is faster on every case measured (bench/RESULTS.md, issue 18); not on
+// the GPU form (the V-cycle or Jacobi there).
 bool opencl_uses_factor(Preconditioner preconditioner, bool cpu_form);
 // Whether it preconditions CG with the multigrid V-cycle (NestedMultigrid): asked, or by default
 // on the GPU form where the mesh is a uniform refinement (`nested`: nested_prolongations() has

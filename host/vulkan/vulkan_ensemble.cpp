@@ -76,7 +76,7 @@ VulkanEnsemble::VulkanEnsemble(const Model& model, EstimatedParameters estimated
     const bool asked = options.preconditioner == Preconditioner::factorised;
     if (asked && info.type != "cpu")
       throw DeviceError("--preconditioner factorised: Vulkan has it on a CPU device only (its "
-                        "GPU shaders precondition CG with Jacobi); device " + info.name);
+                        "GPU shaders precondition CG with the multigrid V-cycle or Jacobi); device " + info.name);
     if (asked && cg_partitions_ > 1)
       throw DeviceError("--preconditioner factorised: Vulkan has it with one CG work-group per "
                         "sigma point only (" + std::to_string(cg_partitions_) + " asked)");

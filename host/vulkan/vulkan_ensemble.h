@@ -16,7 +16,8 @@
 // Arithmetic and tolerances as OpenClEnsemble: float32 by default, the CG tolerance raised
 // to kSingleCgTolerance; --precision double needs shaderFloat64. CG's preconditioner: on a
 // CPU device OpenCL's shared factor corrected for each sigma point's springs
-// (VulkanFactorSolve), on a GPU Jacobi (vulkan_uses_factor).
+// (VulkanFactorSolve), on a GPU the multigrid V-cycle where the mesh is a refinement
+// (VulkanMultigrid), else Jacobi (vulkan_uses_factor, vulkan_uses_multigrid).
 #pragma once
 
 #include <Eigen/Core>
@@ -47,8 +48,8 @@ bool vulkan_texel_reads(KernelForm form, const std::string& device_type,
 
 // Whether Vulkan preconditions CG with one shared factor (VulkanFactorSolve): asked, or by
 // default on a CPU device (lavapipe), where fewer iterations save more dispatches than the
-// substitutions cost; Jacobi on a GPU, where a lane per sigma point in a sequential solve
-// would leave it idle.
+// substitutions cost; not on a GPU, where a lane per sigma point in a sequential solve would
+// leave it idle (the V-cycle or Jacobi there).
 bool vulkan_uses_factor(Preconditioner preconditioner, const std::string& device_type);
 // Whether it preconditions CG with the multigrid V-cycle (VulkanMultigrid): asked, or by
 // default on a GPU where the mesh is a uniform refinement (`nested`: nested_prolongations()
