@@ -18,6 +18,7 @@
 #include "host/engine/choose_backend.h"
 #include "host/engine/make_ensemble.h"
 #include "host/scenario/scenario.h"
+#include "host/opencl/opencl_device.h"
 #include "host/vulkan/vulkan_device.h"
 #include "requirement.h"
 #include "temp_path.h"
@@ -229,7 +230,7 @@ TEST_F(CliTest, DiagnoseFindsAnInjectedEffectAndWritesItsReport) {
 // 53 Vulkan's too): asked of Vulkan on lavapipe, the run goes through and its data are
 // written. A back end or a preconditioner that does not exist: exit 2 and a message that
 // names the option, before any device is opened, and no data file.
-TEST_F(CliTest, TheFactorisedPreconditionerRunsOnVulkanOnACpuAndUnknownOnesAreErrors) {
+TEST_F(CliTest, TheFactorisedPreconditionerRunsOnVulkanOnACpuAndUnknownOrMisplacedOnesAreErrors) {
   std::ofstream(dir_ / "box.json") << box_.dump(2);
   const std::string generate =
       "generate " + (dir_ / "box.json").string() + " --out " + (dir_ / "out").string() + " --quiet ";
@@ -248,6 +249,13 @@ TEST_F(CliTest, TheFactorisedPreconditionerRunsOnVulkanOnACpuAndUnknownOnesAreEr
   const CommandRun no_such_backend = run_sigmafem(generate + "--backend gpu");
   EXPECT_EQ(no_such_backend.exit_code, 2) << no_such_backend.output;
   EXPECT_NE(no_such_backend.output.find("--backend"), std::string::npos) << no_such_backend.output;
+  // The multigrid V-cycle needs a refined mesh and OpenCL's GPU form: the box's mesh is
+  // neither, so OpenCL refuses it, naming the option, on any device (exit 3: a device error).
+  if (!list_opencl_devices().empty()) {
+    const CommandRun multigrid = run_sigmafem(generate + "--backend opencl --preconditioner multigrid");
+    EXPECT_EQ(multigrid.exit_code, 3) << multigrid.output;
+    EXPECT_NE(multigrid.output.find("--preconditioner multigrid"), std::string::npos) << multigrid.output;
+  }
   const CommandRun unknown = run_sigmafem(generate + "--preconditioner cholesky");
   EXPECT_NE(unknown.exit_code, 0) << unknown.output;
   EXPECT_NE(unknown.output.find("--preconditioner"), std::string::npos) << unknown.output;
