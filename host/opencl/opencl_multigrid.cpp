@@ -12,6 +12,13 @@ OpenClMultigrid::OpenClMultigrid(OpenClDevice& device, int sigma_count)
   for (cl::Kernel* kernel : {&k_smooth_, &k_residual_, &k_product_}) kernel->setArg(0, S_);
 }
 
+OpenClMultigrid::~OpenClMultigrid() {
+  try {
+    if (shift_written_()) shift_written_.wait();
+  } catch (const cl::Error&) {   // nothing to report to from a destructor
+  }
+}
+
 cl::Buffer OpenClMultigrid::reals(const std::vector<double>& values) {
   std::vector<unsigned char> bytes = to_device_reals(values, device_.precision());
   bytes_ += bytes.size();
@@ -46,14 +53,9 @@ void OpenClMultigrid::upload(const NestedMultigrid& multigrid) {
   for (int l = 0; l < multigrid.level_count(); ++l) {
     const NestedMultigrid::Level& from = multigrid.level(l);
     Level& level = levels_[static_cast<std::size_t>(l)];
-    const bool inverted = l + 1 == multigrid.level_count() && multigrid.coarsest_inverse().size() > 0;
-    if (inverted) {
-      level.matrix = matrix_buffers(RowMajorMatrix(multigrid.coarsest_inverse().sparseView(0.0, 0.0)));
-    } else {
-      level.matrix = matrix_buffers(from.matrix);
-      std::vector<double> steps;
-      for (const NestedMultigrid::ChebyshevStep& step : from.smoothing) steps.insert(steps.end(), {step.previous, step.residual});
-      level.steps = reals(steps);
+    level.matrix = matrix_buffers(multigrid.launch_matrix(l));
+    if (!from.smoothing.empty()) {
+      level.steps = reals(multigrid.smoothing_coefficients(l));
       level.diagonal = reals(std::vector<double>(from.diagonal.data(), from.diagonal.data() + from.diagonal.size()));
       for (int i = 0; i < 2; ++i) {
         level.x[i] = vector_buffer(from.matrix.rows());
@@ -79,8 +81,12 @@ void OpenClMultigrid::upload_shift(const std::vector<double>& shift) {
     shift_ = reals(shift);
     return;
   }
-  const std::vector<unsigned char> bytes = to_device_reals(shift, device_.precision());
-  device_.queue().enqueueWriteBuffer(shift_, CL_TRUE, 0, bytes.size(), bytes.data());
+  // Not waited for (a host wait each filter step otherwise): the copy is kept until its write
+  // is done, as OpenClEnsemble's writes.
+  if (shift_written_()) shift_written_.wait();
+  shift_bytes_ = to_device_reals(shift, device_.precision());
+  device_.queue().enqueueWriteBuffer(shift_, CL_FALSE, 0, shift_bytes_.size(), shift_bytes_.data(), nullptr,
+                                     &shift_written_);
 }
 
 void OpenClMultigrid::run(cl::Kernel& kernel, cl_uint rows) {
@@ -92,27 +98,13 @@ void OpenClMultigrid::run(cl::Kernel& kernel, cl_uint rows) {
   device_.record(kernel, event);
 }
 
-const cl::Buffer& OpenClMultigrid::vector(const MultigridVector& v, const cl::Buffer& r, const cl::Buffer& z) const {
-  const Level& level = levels_[static_cast<std::size_t>(v.level)];
-  using Role = MultigridVector::Role;
-  switch (v.role) {
-    case Role::rhs: return v.level == 0 ? r : level.b;
-    case Role::result: return v.level == 0 ? z : level.correction;
-    case Role::x0: return level.x[0];
-    case Role::x1: return level.x[1];
-    case Role::p0: return level.p[0];
-    case Role::p1: return level.p[1];
-    case Role::residual: break;
-  }
-  return level.r;
-}
-
 void OpenClMultigrid::enqueue(const cl::Buffer& r, const cl::Buffer& z) {
   using Kind = MultigridLaunch::Kind;
   for (const MultigridLaunch& launch : launches_) {
     const Level& level = levels_[static_cast<std::size_t>(launch.level)];
-    const cl::Buffer& in = vector(launch.in, r, z);
-    const cl::Buffer& out = vector(launch.out, r, z);
+    const auto vector = [&](const MultigridVector& v) -> const cl::Buffer& { return multigrid_buffer(levels_, v, r, z); };
+    const cl::Buffer& in = vector(launch.in);
+    const cl::Buffer& out = vector(launch.out);
     const cl_uint shifted = launch.shifted ? 1 : 0;
     if (launch.kind == Kind::smooth) {
       k_smooth_.setArg(2, static_cast<cl_uint>(launch.step));
@@ -125,10 +117,10 @@ void OpenClMultigrid::enqueue(const cl::Buffer& r, const cl::Buffer& z) {
       k_smooth_.setArg(9, level.steps);
       k_smooth_.setArg(10, shift_);
       k_smooth_.setArg(11, in);
-      k_smooth_.setArg(12, vector(launch.x, r, z));
-      k_smooth_.setArg(13, vector(launch.p, r, z));
+      k_smooth_.setArg(12, vector(launch.x));
+      k_smooth_.setArg(13, vector(launch.p));
       k_smooth_.setArg(14, out);
-      k_smooth_.setArg(15, vector(launch.p_out, r, z));
+      k_smooth_.setArg(15, vector(launch.p_out));
       run(k_smooth_, level.matrix.rows);
     } else if (launch.kind == Kind::residual) {
       k_residual_.setArg(2, shifted);
@@ -137,7 +129,7 @@ void OpenClMultigrid::enqueue(const cl::Buffer& r, const cl::Buffer& z) {
       k_residual_.setArg(5, level.matrix.values);
       k_residual_.setArg(6, shift_);
       k_residual_.setArg(7, in);
-      k_residual_.setArg(8, vector(launch.x, r, z));
+      k_residual_.setArg(8, vector(launch.x));
       k_residual_.setArg(9, out);
       run(k_residual_, level.matrix.rows);
     } else {

@@ -19,6 +19,9 @@ class OpenClMultigrid {
  public:
   // The kernels must be built already (OpenClDevice::build_program). Throws cl::Error.
   OpenClMultigrid(OpenClDevice& device, int sigma_count);
+  ~OpenClMultigrid();   // waits for the shift's write still reading its host copy
+  OpenClMultigrid(const OpenClMultigrid&) = delete;
+  OpenClMultigrid& operator=(const OpenClMultigrid&) = delete;
 
   // The hierarchy's matrices, diagonals and smoothing steps (`multigrid` ready). Throws
   // cl::Error.
@@ -36,7 +39,7 @@ class OpenClMultigrid {
     cl_uint rows = 0;
   };
   struct Level {
-    Matrix matrix, prolongation, restriction;   // the coarsest: its inverse in `matrix`
+    Matrix matrix, prolongation, restriction;   // matrix: NestedMultigrid::launch_matrix
     cl::Buffer diagonal, steps;
     // [row S + s]: the right-hand side and the result (coarser levels: the finest has CG's r
     // and z), the smoothing's iterates and steps (two each: a step reads one, writes the
@@ -46,8 +49,6 @@ class OpenClMultigrid {
   Matrix matrix_buffers(const RowMajorMatrix& M);
   cl::Buffer reals(const std::vector<double>& values);
   cl::Buffer vector_buffer(Eigen::Index rows);
-  // The buffer of a level's vector (the finest level's right-hand side r, its result z).
-  const cl::Buffer& vector(const MultigridVector& v, const cl::Buffer& r, const cl::Buffer& z) const;
   void run(cl::Kernel& kernel, cl_uint rows);
 
   OpenClDevice& device_;
@@ -55,6 +56,8 @@ class OpenClMultigrid {
   std::vector<Level> levels_;
   std::vector<MultigridLaunch> launches_;   // the V-cycle (NestedMultigrid::launches)
   cl::Buffer shift_;
+  std::vector<unsigned char> shift_bytes_;   // the last write's copy, until shift_written_
+  cl::Event shift_written_;
   std::size_t bytes_ = 0;
   cl::Kernel k_smooth_, k_residual_, k_product_;
 };

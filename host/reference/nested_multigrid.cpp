@@ -156,7 +156,10 @@ bool NestedMultigrid::set_matrix(const Eigen::SparseMatrix<double>& A) {
     if (coarsest && level.matrix.rows() <= dense_coarsest_rows_) {
       const Eigen::LLT<Eigen::MatrixXd> llt{Eigen::MatrixXd(level.matrix)};
       if (llt.info() != Eigen::Success) return false;
-      coarsest_inverse_ = llt.solve(Eigen::MatrixXd::Identity(level.matrix.rows(), level.matrix.rows()));
+      coarsest_inverse_ =
+          Eigen::MatrixXd(llt.solve(Eigen::MatrixXd::Identity(level.matrix.rows(), level.matrix.rows())))
+              .sparseView(0.0, 0.0);
+      coarsest_inverse_.makeCompressed();
       const double n = static_cast<double>(level.matrix.rows());
       setup += n * n * n;   // the factorisation and the n solves
       cycle += n * n;
@@ -165,7 +168,7 @@ bool NestedMultigrid::set_matrix(const Eigen::SparseMatrix<double>& A) {
     level.lambda_max = largest_eigenvalue(level.matrix, level.diagonal);
     if (!std::isfinite(level.lambda_max) || level.lambda_max <= 0.0) return false;
     level.smoothing = chebyshev_steps(level.lambda_max, coarsest ? kCoarsestDegree : kSmoothingDegree);
-    if (coarsest) coarsest_inverse_.resize(0, 0);
+    if (coarsest) coarsest_inverse_ = RowMajorMatrix();
     setup += (4.0 + 40.0) * nonzeros;   // the Galerkin product, roughly, and the power iteration
     cycle += coarsest ? kCoarsestDegree * nonzeros
                       : (2.0 * kSmoothingDegree + 1.0) * nonzeros + 2.0 * static_cast<double>(level.prolongation.nonZeros());
@@ -196,7 +199,7 @@ Eigen::VectorXd NestedMultigrid::cycle(int l, const Eigen::VectorXd& b, const Ei
   const Level& level = levels_[static_cast<std::size_t>(l)];
   Eigen::VectorXd x = Eigen::VectorXd::Zero(b.size());
   if (l + 1 == level_count()) {
-    if (coarsest_inverse_.size() > 0) return coarsest_inverse_ * b;
+    if (coarsest_inverted()) return coarsest_inverse_ * b;
     smooth(l, b, x, true, shift);
     return x;
   }
@@ -206,6 +209,12 @@ Eigen::VectorXd NestedMultigrid::cycle(int l, const Eigen::VectorXd& b, const Ei
   x += level.prolongation * cycle(l + 1, level.restriction * r, shift);
   smooth(l, b, x, false, shift);
   return x;
+}
+
+std::vector<double> NestedMultigrid::smoothing_coefficients(int l) const {
+  std::vector<double> coefficients;
+  for (const ChebyshevStep& step : level(l).smoothing) coefficients.insert(coefficients.end(), {step.previous, step.residual});
+  return coefficients;
 }
 
 std::vector<MultigridLaunch> NestedMultigrid::launches() const {
@@ -250,7 +259,7 @@ void NestedMultigrid::plan(int l, std::vector<MultigridLaunch>& launches) const 
   };
   int current = 0;
   if (l + 1 == level_count()) {   // the same as cycle()'s coarsest
-    if (coarsest_inverse_.size() > 0)
+    if (coarsest_inverted())
       launches.push_back(launch(Kind::inverse, {l, Role::rhs}, {l, Role::result}));
     else
       plan_smoothing(l, current, true, true, launches);

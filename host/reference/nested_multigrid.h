@@ -62,6 +62,25 @@ struct MultigridLaunch {
   MultigridVector in, x, p, out, p_out;
 };
 
+// The buffer a device back end holds for `v` (OpenClMultigrid, VulkanMultigrid), from its
+// levels (each with b, correction, x[2], p[2], r): the finest level's right-hand side and
+// result are CG's r and z.
+template <class Buffer, class Level>
+const Buffer& multigrid_buffer(const std::vector<Level>& levels, const MultigridVector& v, const Buffer& r,
+                               const Buffer& z) {
+  const Level& level = levels[static_cast<std::size_t>(v.level)];
+  switch (v.role) {
+    case MultigridVector::Role::rhs: return v.level == 0 ? r : level.b;
+    case MultigridVector::Role::result: return v.level == 0 ? z : level.correction;
+    case MultigridVector::Role::x0: return level.x[0];
+    case MultigridVector::Role::x1: return level.x[1];
+    case MultigridVector::Role::p0: return level.p[0];
+    case MultigridVector::Role::p1: return level.p[1];
+    case MultigridVector::Role::residual: break;
+  }
+  return level.r;
+}
+
 class NestedMultigrid {
  public:
   static constexpr int kSmoothingDegree = 3;
@@ -94,9 +113,16 @@ class NestedMultigrid {
   bool ready() const { return ready_; }
   int level_count() const { return static_cast<int>(levels_.size()); }
   const Level& level(int l) const { return levels_[static_cast<std::size_t>(l)]; }
-  // The coarsest level's inverse (rows x rows) where it is solved exactly; else empty, and the
-  // coarsest level's `smoothing` (kCoarsestDegree steps) stands in.
-  const Eigen::MatrixXd& coarsest_inverse() const { return coarsest_inverse_; }
+  // The coarsest level's inverse (rows x rows, every entry stored) where it is solved exactly;
+  // else empty, and the coarsest level's `smoothing` (kCoarsestDegree steps) stands in.
+  const RowMajorMatrix& coarsest_inverse() const { return coarsest_inverse_; }
+  bool coarsest_inverted() const { return coarsest_inverse_.rows() > 0; }
+  // The matrix level l's launches read: A_l, or the coarsest level's inverse where inverted.
+  const RowMajorMatrix& launch_matrix(int l) const {
+    return l + 1 == level_count() && coarsest_inverted() ? coarsest_inverse_ : level(l).matrix;
+  }
+  // Level l's smoothing as the devices read it: [2k] previous, [2k + 1] residual of step k.
+  std::vector<double> smoothing_coefficients(int l) const;
   // Multiply-adds of set_matrix against one V-cycle's (for a refresh rule, as the factor's).
   double setup_in_cycles() const { return setup_in_cycles_; }
   // The V-cycle as launches, in order (after set_matrix; the same for every matrix of the
@@ -117,7 +143,7 @@ class NestedMultigrid {
   std::vector<RowMajorMatrix> prolongations_;
   int dense_coarsest_rows_;
   std::vector<Level> levels_;
-  Eigen::MatrixXd coarsest_inverse_;
+  RowMajorMatrix coarsest_inverse_;
   double setup_in_cycles_ = 0.0;
   bool ready_ = false;
 };

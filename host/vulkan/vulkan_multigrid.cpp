@@ -53,13 +53,9 @@ void VulkanMultigrid::make_levels(const NestedMultigrid& multigrid) {
   for (int l = 0; l < multigrid.level_count(); ++l) {
     const NestedMultigrid::Level& from = multigrid.level(l);
     Level& level = levels_[static_cast<std::size_t>(l)];
-    const bool inverted = l + 1 == multigrid.level_count() && multigrid.coarsest_inverse().size() > 0;
     const Eigen::Index rows = from.matrix.rows();
-    if (inverted) {
-      level.matrix = make_matrix(RowMajorMatrix(multigrid.coarsest_inverse().sparseView(0.0, 0.0)));
-    } else {
-      level.matrix = make_matrix(from.matrix);
-      level.degree = static_cast<int>(from.smoothing.size());
+    level.matrix = make_matrix(multigrid.launch_matrix(l));
+    if (!from.smoothing.empty()) {
       level.diagonal = make(real * static_cast<std::size_t>(rows));
       level.steps = make(real * 2 * from.smoothing.size());
       for (int i = 0; i < 2; ++i) {
@@ -88,14 +84,10 @@ void VulkanMultigrid::upload(const NestedMultigrid& multigrid) {
   for (int l = 0; l < multigrid.level_count(); ++l) {
     const NestedMultigrid::Level& from = multigrid.level(l);
     const Level& level = levels_[static_cast<std::size_t>(l)];
-    if (level.degree == 0) {
-      upload_matrix(level.matrix, RowMajorMatrix(multigrid.coarsest_inverse().sparseView(0.0, 0.0)));
-    } else {
-      upload_matrix(level.matrix, from.matrix);
+    upload_matrix(level.matrix, multigrid.launch_matrix(l));
+    if (!from.smoothing.empty()) {
       upload_reals(level.diagonal, std::vector<double>(from.diagonal.data(), from.diagonal.data() + from.diagonal.size()));
-      std::vector<double> steps;
-      for (const NestedMultigrid::ChebyshevStep& step : from.smoothing) steps.insert(steps.end(), {step.previous, step.residual});
-      upload_reals(level.steps, steps);
+      upload_reals(level.steps, multigrid.smoothing_coefficients(l));
     }
     if (l + 1 < multigrid.level_count()) {
       upload_matrix(level.prolongation, from.prolongation);
@@ -119,24 +111,10 @@ void VulkanMultigrid::add(const VulkanKernel& kernel, const Matrix& matrix, std:
   dispatches_.push_back(dispatch);
 }
 
-const VulkanBuffer& VulkanMultigrid::vector(const MultigridVector& v) const {
-  const Level& level = levels_[static_cast<std::size_t>(v.level)];
-  using Role = MultigridVector::Role;
-  switch (v.role) {
-    case Role::rhs: return v.level == 0 ? r_ : level.b;
-    case Role::result: return v.level == 0 ? z_ : level.correction;
-    case Role::x0: return level.x[0];
-    case Role::x1: return level.x[1];
-    case Role::p0: return level.p[0];
-    case Role::p1: return level.p[1];
-    case Role::residual: break;
-  }
-  return level.r;
-}
-
 void VulkanMultigrid::plan(const std::vector<MultigridLaunch>& launches) {
   using Kind = MultigridLaunch::Kind;
   dispatches_.clear();
+  const auto vector = [&](const MultigridVector& v) -> const VulkanBuffer& { return multigrid_buffer(levels_, v, r_, z_); };
   for (const MultigridLaunch& launch : launches) {
     const Level& level = levels_[static_cast<std::size_t>(launch.level)];
     std::vector<VulkanBuffer> bound(SF_MG_BINDINGS, none_);

@@ -40,9 +40,8 @@ class VulkanMultigrid {
     std::size_t nonzeros = 0;
   };
   struct Level {
-    Matrix matrix, prolongation, restriction;   // the coarsest: its inverse in `matrix`
+    Matrix matrix, prolongation, restriction;   // matrix: NestedMultigrid::launch_matrix
     VulkanBuffer diagonal, steps;
-    int degree = 0;                              // smoothing steps (0: inverted)
     // [row S + s]: the right-hand side and the result (coarser levels; the finest has CG's r
     // and z), the smoothing's iterates and steps (a step reads one, writes the other), the
     // residual.
@@ -60,8 +59,6 @@ class VulkanMultigrid {
   void upload_reals(const VulkanBuffer& to, const std::vector<double>& values);
   // The buffers of every level, at the first upload.
   void make_levels(const NestedMultigrid& multigrid);
-  // The buffer of a level's vector (the finest level's right-hand side r, its result z).
-  const VulkanBuffer& vector(const MultigridVector& v) const;
   // The dispatches of the V-cycle's launches (NestedMultigrid::launches), with their sets.
   void plan(const std::vector<MultigridLaunch>& launches);
   void add(const VulkanKernel& kernel, const Matrix& matrix, std::vector<VulkanBuffer> bound,
