@@ -15,7 +15,7 @@ constexpr std::uint32_t kOpTypeSampledImage = 27, kOpTypePointer = 32, kOpVariab
 constexpr std::uint32_t kOpDecorate = 71;
 constexpr std::uint32_t kDecorationBinding = 33, kDecorationDescriptorSet = 34;
 constexpr std::uint32_t kDimBuffer = 5;
-constexpr std::uint32_t kImageFormatR32f = 3;
+constexpr std::uint32_t kImageFormatRgba32f = 1, kImageFormatR32f = 3;
 
 }  // namespace
 
@@ -57,7 +57,7 @@ std::map<std::uint32_t, SpirvBinding> spirv_bindings(const std::uint32_t* words,
     at += length;
   }
   // What a variable's pointee is: a sampled buffer image of 32-bit texels, a buffer image
-  // itself (a storage texel buffer, of r32f only), or else storage.
+  // itself (a storage texel buffer, of r32f or rgba32f only), or else storage.
   auto find = [](const auto& map, std::uint32_t key, std::uint32_t& value) {
     const auto it = map.find(key);
     if (it == map.end()) return false;
@@ -77,10 +77,10 @@ std::map<std::uint32_t, SpirvBinding> spirv_bindings(const std::uint32_t* words,
     } else if (find(variable_type, variable, pointer) && find(pointee, pointer, type) &&
                find(buffer_image, type, texel)) {
       std::uint32_t format = 0;
-      if (!find(image_format, type, format) || format != kImageFormatR32f)
+      if (!find(image_format, type, format) || (format != kImageFormatR32f && format != kImageFormatRgba32f))
         throw std::invalid_argument("binding " + std::to_string(binding) +
-                                    " is a storage texel buffer of a format other than r32f");
-      kind = SpirvBinding::float_image;
+                                    " is a storage texel buffer of a format other than r32f or rgba32f");
+      kind = format == kImageFormatR32f ? SpirvBinding::float_image : SpirvBinding::float4_image;
     }
     result[binding] = kind;
   }

@@ -17,12 +17,18 @@ enum class SpirvBinding {
   uint_texels,      // uniform usamplerBuffer: R32_UINT (in a float64 shader, R32G32_UINT:
                     // a double's two halves; kernels/vulkan/ensemble_layout.h)
   float_image,      // imageBuffer, r32f: a storage texel buffer (read and written)
+  float4_image,     // imageBuffer, rgba32f: a storage texel buffer of four floats a texel
 };
+
+// Whether a binding of this kind is a storage texel buffer.
+inline bool storage_texels(SpirvBinding kind) {
+  return kind == SpirvBinding::float_image || kind == SpirvBinding::float4_image;
+}
 
 // Binding number -> kind, for the variables of descriptor set 0 that carry a Binding
 // decoration. Throws std::invalid_argument when the words are not a well-formed SPIR-V
 // module (no magic number, an instruction that runs past the end, a zero word count) or
-// declare a storage texel buffer of a format other than r32f.
+// declare a storage texel buffer of a format other than r32f or rgba32f.
 std::map<std::uint32_t, SpirvBinding> spirv_bindings(const std::uint32_t* words, std::size_t count);
 
 }  // namespace sigmafem

@@ -303,7 +303,7 @@ VulkanKernel VulkanDevice::kernel_from_spirv(const std::string& name, const std:
       slots[b].binding = static_cast<std::uint32_t>(b);
       slots[b].descriptorType = k.kinds[b] == SpirvBinding::storage_buffer
                                     ? VK_DESCRIPTOR_TYPE_STORAGE_BUFFER
-                                : k.kinds[b] == SpirvBinding::float_image
+                                : storage_texels(k.kinds[b])
                                     ? VK_DESCRIPTOR_TYPE_STORAGE_TEXEL_BUFFER
                                     : VK_DESCRIPTOR_TYPE_UNIFORM_TEXEL_BUFFER;
       slots[b].descriptorCount = 1;
@@ -386,7 +386,7 @@ VkDescriptorSet VulkanDevice::bind(const VulkanKernel& kernel, const std::vector
       writes[b].pBufferInfo = &infos[b];
     } else {
       views[b] = texel_view(buffers[b], kernel.kinds[b], kernel.name);
-      writes[b].descriptorType = kernel.kinds[b] == SpirvBinding::float_image
+      writes[b].descriptorType = storage_texels(kernel.kinds[b])
                                      ? VK_DESCRIPTOR_TYPE_STORAGE_TEXEL_BUFFER
                                      : VK_DESCRIPTOR_TYPE_UNIFORM_TEXEL_BUFFER;
       writes[b].pTexelBufferView = &views[b];
@@ -402,12 +402,13 @@ VkBufferView VulkanDevice::texel_view(const VulkanBuffer& buffer, SpirvBinding k
   const bool doubles = kind == SpirvBinding::uint_texels && precision_ == Precision::double_precision;
   const VkFormat format = kind == SpirvBinding::float_texels || kind == SpirvBinding::float_image
                               ? VK_FORMAT_R32_SFLOAT
+                          : kind == SpirvBinding::float4_image ? VK_FORMAT_R32G32B32A32_SFLOAT
                           : kind == SpirvBinding::int_texels ? VK_FORMAT_R32_SINT
                           : doubles                          ? VK_FORMAT_R32G32_UINT
                                                              : VK_FORMAT_R32_UINT;
   for (const TexelView& v : views_)
     if (v.buffer == buffer.buffer && v.format == format) return v.view;
-  const std::size_t texels = buffer.bytes / (doubles ? 8 : 4);
+  const std::size_t texels = buffer.bytes / (doubles ? 8 : kind == SpirvBinding::float4_image ? 16 : 4);
   if (texels > info_.max_texel_elements)
     throw DeviceError("the Vulkan shader " + kernel + " reads a buffer of " +
                       std::to_string(texels) + " texels; " + info_.name +

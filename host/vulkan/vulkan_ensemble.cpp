@@ -140,9 +140,8 @@ VulkanEnsemble::VulkanEnsemble(const Model& model, EstimatedParameters estimated
   if (factor_) {
     k_cg_factor_start_ = cg_kernel("cg_factor_start", iteration);
     k_cg_factor_direction_ = cg_kernel("cg_factor_direction", iteration);
-    factor_solve_ = std::make_unique<VulkanFactorSolve>(
-        device_, 3 * nodes_, factor_->nonzeros(), springs_.size(), S_, buffer(B::r), buffer(B::z),
-        buffer(B::active), options.factor_loop_turns);
+    factor_solve_ = std::make_unique<VulkanFactorSolve>(device_, 3 * nodes_, springs_.size(), S_, buffer(B::r),
+                                                        buffer(B::z), buffer(B::active), options.factor_loop_turns);
     device_bytes_ += factor_solve_->bytes();
   }
   if (multigrid_) {
@@ -325,11 +324,14 @@ void VulkanEnsemble::refresh_factor(const std::vector<double>& constants) {
   // A matrix that is not positive definite (a diverged state?) leaves the last factor in
   // place, and the next step tries again.
   const Eigen::SparseMatrix<double> A = representative_system();
+  const std::size_t before = factor_solve_->bytes();   // a new pattern's buffers are made at its upload
   if (!factor_->factorise(A)) {
     if (!factor_solve_->ready()) factor_solve_->upload_diagonal(A);
+    device_bytes_ += factor_solve_->bytes() - before;
     return;
   }
   factor_solve_->upload(*factor_);
+  device_bytes_ += factor_solve_->bytes() - before;
   if (springs_.size() == 0) return;
   springs_.prepare(*factor_);
   if (!factor_solve_->upload_springs(springs_)) {

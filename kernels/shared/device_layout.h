@@ -162,25 +162,28 @@
 #define SF_CG_ITERATION_CONTROL_K 22
 #define SF_CG_ITERATION_MASS 23
 #define SF_CG_ITERATION_ELEMENT_OUT 24
-/* Vulkan's factor_solve (z = M^-1 r with a sparse Cholesky factor; host/vulkan/vulkan_factor_solve.h):
- * L by rows (for L y = P r) and by columns (for L^T w = y), each row's L position's original
- * row, CG's r, z and active flags, the work vector y, and the factor's correction for each
- * sigma point's springs (host/reference/spring_correction.h): [m, reached rows u, the rows],
- * V there by rows and each sigma point's m x m H. */
-#define SF_FACTOR_SOLVE_ROW_STARTS 0
-#define SF_FACTOR_SOLVE_ROW_COLUMNS 1
-#define SF_FACTOR_SOLVE_ROW_VALUES 2
-#define SF_FACTOR_SOLVE_COLUMN_STARTS 3
-#define SF_FACTOR_SOLVE_COLUMN_ROWS 4
-#define SF_FACTOR_SOLVE_COLUMN_VALUES 5
-#define SF_FACTOR_SOLVE_ORIGINAL_ROW 6
-#define SF_FACTOR_SOLVE_R 7
-#define SF_FACTOR_SOLVE_Z 8
-#define SF_FACTOR_SOLVE_ACTIVE 9
-#define SF_FACTOR_SOLVE_WORK 10
-#define SF_FACTOR_SOLVE_SPRING_AT 11
-#define SF_FACTOR_SOLVE_SPRING_SOLVES 12
-#define SF_FACTOR_SOLVE_SPRING_COUPLING 13
+/* Vulkan's factor_solve (z = M^-1 r with a sparse Cholesky factor in 4 x 4 blocks;
+ * host/vulkan/vulkan_factor_solve.h, host/reference/factor_blocks.h): the blocks by rows (for
+ * L y = P r: each block row's start, each block's column panel) and by columns (for L^T w = y),
+ * each slot's original row, CG's r, z and active flags, the factor's correction for each sigma
+ * point's springs (host/reference/spring_correction.h): [m, reached slots u, the slots], V
+ * there by rows and each sigma point's m x m H; the panels' triangles, the blocks' values by
+ * rows and by columns, and the work vector y. */
+#define SF_FACTOR_SOLVE_FORWARD_STARTS 0
+#define SF_FACTOR_SOLVE_FORWARD_PANEL 1
+#define SF_FACTOR_SOLVE_BACKWARD_STARTS 2
+#define SF_FACTOR_SOLVE_BACKWARD_PANEL 3
+#define SF_FACTOR_SOLVE_SLOT_ROWS 4
+#define SF_FACTOR_SOLVE_R 5
+#define SF_FACTOR_SOLVE_Z 6
+#define SF_FACTOR_SOLVE_ACTIVE 7
+#define SF_FACTOR_SOLVE_SPRING_AT 8
+#define SF_FACTOR_SOLVE_SPRING_SOLVES 9
+#define SF_FACTOR_SOLVE_SPRING_COUPLING 10
+#define SF_FACTOR_SOLVE_TRIANGLES 11
+#define SF_FACTOR_SOLVE_FORWARD_BLOCKS 12
+#define SF_FACTOR_SOLVE_BACKWARD_BLOCKS 13
+#define SF_FACTOR_SOLVE_WORK 14
 /* Vulkan's multigrid shaders (mg_smooth, mg_residual, mg_product: the V-cycle of
  * host/reference/nested_multigrid.h; host/vulkan/vulkan_multigrid.h): a level's matrix in CSR,
  * its diagonal, its Chebyshev steps, the finest level's shifts, the input vector (b, or x of a

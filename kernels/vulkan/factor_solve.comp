@@ -6,44 +6,44 @@
  * A lane per sigma point (work-group g holds sigma points g G .. g G + G - 1, G the group
  * size, specialization constant 0): the substitutions are sequential along L's rows, while
  * the sigma points are independent, and L's entries are read once for the group at the same
- * address in every lane. Both substitutions read, never scatter: L y = P r by L's rows
- * (y_j = ((P r)_j - sum_k<j L_jk y_k) / L_jj) and L^T w = y by its columns (w_j = (y_j -
- * sum_k>j L_kj w_k) / L_jj), each w_j also stored as z at its original row. Between them,
- * the correction for the sigma point's own springs (SpringCorrection, host/reference/
- * spring_correction.h; OpenCL's SF_SPRING_ROWS): y -= V H_s V^T y at the rows V reaches, with
- * V^T y and H_s V^T y kept in y's rows n .. n + 2m - 1 (none where m = 0: no steps).
+ * address in every lane. L comes in dense 4 x 4 blocks (host/reference/factor_blocks.h): the
+ * vector y by slots, a vec4 per panel of 4 rows, and a block's 16 entries in 4 vec4 reads,
+ * so that a substitution turns once per block where it turned once per entry (the liver's
+ * factor: 2334 blocks for 26 088 entries; bench/RESULTS.md, stop 55). Both substitutions read,
+ * never scatter: L y = P r by block rows (y_q = T_q^-1 ((P r)_q - sum_p<q L_qp y_p)) and
+ * L^T w = y by block columns (w_p = T_p^-T (y_p - sum_q>p L_qp^T w_q)), each w_p also stored
+ * as z at its original rows. Between them, the correction for the sigma point's own springs
+ * (SpringCorrection, host/reference/spring_correction.h; OpenCL's SF_SPRING_ROWS): y -= V H_s
+ * V^T y at the slots V reaches, with V^T y and H_s V^T y kept in slots 4 P .. 4 P + 2m - 1.
  *
  * llvmpipe ends every loop of an invocation, silently, once its loops together have turned
- * 65535 times (gallivm's LP_MAX_TGSI_LOOP_ITERATIONS; bench/RESULTS.md, stop 52), and a
- * factor has far more entries than that beyond the smallest meshes. So the solve is a
- * sequence of steps, each a short loop, and one dispatch does a range of them, cut by the
- * host to a bound of loop turns (push constants: count = the first step, p = one past the
- * last; S the sigma points). The steps, with m spring rows reaching u rows of L:
- *   [0, n)                   the forward rows
- *   [n, n + m)               V^T y, a sum over the u rows each
- *   [n + m, n + 2m)          H_s V^T y, a sum over m each
- *   [n + 2m, n + 2m + u)     y -= V H_s V^T y at one reached row each
- *   [n + 2m + u, 2n + 2m + u)  the backward columns, from the last.
+ * 65535 times (gallivm's LP_MAX_TGSI_LOOP_ITERATIONS; bench/RESULTS.md, stop 52). So the
+ * solve is a sequence of steps, each a short loop, and one dispatch does a range of them, cut
+ * by the host to a bound of loop turns (push constants: count = the first step, p = one past
+ * the last; S the sigma points). The steps, with P panels and m spring rows reaching u slots:
+ *   [0, P)                    the forward block rows
+ *   [P, P + m)                V^T y, a sum over the u slots each
+ *   [P + m, P + 2m)           H_s V^T y, a sum over m each
+ *   [P + 2m, P + 2m + u)      y -= V H_s V^T y at one reached slot each
+ *   [P + 2m + u, 2P + 2m + u) the backward block columns, from the last.
  * An inactive sigma point (CG done) is left alone.
  *
- * The work vector y ([row S + s], in L's order) is a storage texel buffer in float32: llvmpipe
- * loads a storage buffer at lane-varying addresses one lane at a time, an image in one gather
- * (the liver's solve at S = 4 1.02 -> 0.70 ms; bench/RESULTS.md, stop 53). */
+ * In float32, y and the blocks are rgba32f storage texel buffers: llvmpipe loads a storage
+ * buffer at lane-varying addresses one lane at a time, an image in one gather (bench/
+ * RESULTS.md, stop 53); in float64 (no 64-bit texel format) storage buffers. */
 #version 450
 #extension GL_GOOGLE_include_directive : require
 #include "ensemble_layout.h"
 
 layout(local_size_x_id = 0) in;
-/* n, the rows of L (3 x nodes), set at pipeline creation. */
-layout(constant_id = 1) const uint SF_FACTOR_ROWS = 1u;
+/* P, the panels of L (host/reference/factor_blocks.h), set at pipeline creation. */
+layout(constant_id = 1) const uint SF_FACTOR_PANELS = 1u;
 
-SF_READ_INTS(SF_FACTOR_SOLVE_ROW_STARTS, row_starts)
-SF_READ_INTS(SF_FACTOR_SOLVE_ROW_COLUMNS, row_columns)
-SF_READ_REALS(SF_FACTOR_SOLVE_ROW_VALUES, row_values)
-SF_READ_INTS(SF_FACTOR_SOLVE_COLUMN_STARTS, column_starts)
-SF_READ_INTS(SF_FACTOR_SOLVE_COLUMN_ROWS, column_rows)
-SF_READ_REALS(SF_FACTOR_SOLVE_COLUMN_VALUES, column_values)
-SF_READ_INTS(SF_FACTOR_SOLVE_ORIGINAL_ROW, original_row)
+SF_READ_INTS(SF_FACTOR_SOLVE_FORWARD_STARTS, forward_starts)
+SF_READ_INTS(SF_FACTOR_SOLVE_FORWARD_PANEL, forward_panel)
+SF_READ_INTS(SF_FACTOR_SOLVE_BACKWARD_STARTS, backward_starts)
+SF_READ_INTS(SF_FACTOR_SOLVE_BACKWARD_PANEL, backward_panel)
+SF_READ_INTS(SF_FACTOR_SOLVE_SLOT_ROWS, slot_rows)
 SF_READ_REALS(SF_FACTOR_SOLVE_R, r)
 layout(std430, binding = SF_FACTOR_SOLVE_Z) restrict writeonly buffer Z { real z[]; };
 SF_READ_UINTS(SF_FACTOR_SOLVE_ACTIVE, active_flags)
@@ -51,61 +51,112 @@ SF_READ_INTS(SF_FACTOR_SOLVE_SPRING_AT, spring_at)
 SF_READ_REALS(SF_FACTOR_SOLVE_SPRING_SOLVES, spring_solves)
 SF_READ_REALS(SF_FACTOR_SOLVE_SPRING_COUPLING, spring_coupling)
 #if defined(SF_USE_DOUBLE)
-layout(std430, binding = SF_FACTOR_SOLVE_WORK) restrict buffer Work { real y[]; };
-#  define SF_Y(i) y[i]
-#  define SF_SET_Y(i, value) y[i] = (value)
+#  define real4 dvec4
+layout(std430, binding = SF_FACTOR_SOLVE_TRIANGLES) restrict readonly buffer Triangles { dvec4 triangles[]; };
+layout(std430, binding = SF_FACTOR_SOLVE_FORWARD_BLOCKS) restrict readonly buffer Forward { dvec4 forward_blocks[]; };
+layout(std430, binding = SF_FACTOR_SOLVE_BACKWARD_BLOCKS) restrict readonly buffer Backward { dvec4 backward_blocks[]; };
+layout(std430, binding = SF_FACTOR_SOLVE_WORK) restrict buffer Work { dvec4 y[]; };
+#  define SF_COLUMN(blocks, i) blocks[i]
+#  define SF_Y4(t) y[t]
+#  define SF_SET_Y4(t, value) y[t] = (value)
 #else
-layout(binding = SF_FACTOR_SOLVE_WORK, r32f) uniform restrict imageBuffer y;
-#  define SF_Y(i) imageLoad(y, int(i)).x
-#  define SF_SET_Y(i, value) imageStore(y, int(i), vec4(value))
+#  define real4 vec4
+layout(binding = SF_FACTOR_SOLVE_TRIANGLES, rgba32f) uniform restrict readonly imageBuffer triangles;
+layout(binding = SF_FACTOR_SOLVE_FORWARD_BLOCKS, rgba32f) uniform restrict readonly imageBuffer forward_blocks;
+layout(binding = SF_FACTOR_SOLVE_BACKWARD_BLOCKS, rgba32f) uniform restrict readonly imageBuffer backward_blocks;
+layout(binding = SF_FACTOR_SOLVE_WORK, rgba32f) uniform restrict imageBuffer y;
+#  define SF_COLUMN(blocks, i) imageLoad(blocks, int(i))
+#  define SF_Y4(t) imageLoad(y, int(t))
+#  define SF_SET_Y4(t, value) imageStore(y, int(t), value)
 #endif
 
+uint S, s;
+
+/* One slot of y, and one set, for this lane's sigma point. */
+real y_at(uint slot) { return SF_Y4((slot >> 2u) * S + s)[slot & 3u]; }
+void set_y_at(uint slot, real value) {
+  uint t = (slot >> 2u) * S + s;
+  real4 four = SF_Y4(t);
+  four[slot & 3u] = value;
+  SF_SET_Y4(t, four);
+}
+
 void main() {
-  uint S = sf_push.S;
-  uint s = gl_WorkGroupID.x * gl_WorkGroupSize.x + gl_LocalInvocationID.x;
+  S = sf_push.S;
+  s = gl_WorkGroupID.x * gl_WorkGroupSize.x + gl_LocalInvocationID.x;
   if (s >= S || SF_LOAD(active_flags, s) == 0u) return;
-  uint n = SF_FACTOR_ROWS;
+  uint P = SF_FACTOR_PANELS;
   uint m = uint(SF_LOAD(spring_at, 0)), reached = uint(SF_LOAD(spring_at, 1));
-  uint projected = n, coupled = n + m, updated = n + 2u * m, backward = n + 2u * m + reached;
+  uint projected = P, coupled = P + m, updated = P + 2u * m, backward = P + 2u * m + reached;
+  uint sums = 4u * P;   /* the slot of (V^T y)_0 */
   uint first = sf_push.count, last = sf_push.p;
-  for (uint j = first; j < min(last, projected); ++j) { /* L y = P r: row j, its diagonal last */
-    int begin = SF_LOAD(row_starts, j), end = SF_LOAD(row_starts, j + 1u) - 1;
-    real sum = real(0);
-    for (int k = begin; k < end; ++k)
-      sum += SF_LOAD(row_values, k) * SF_Y(uint(SF_LOAD(row_columns, k)) * S + s);
-    real b = SF_LOAD(r, uint(SF_LOAD(original_row, j)) * S + s);
-    SF_SET_Y(j * S + s, (b - sum) / SF_LOAD(row_values, end));
+  for (uint q = first; q < min(last, projected); ++q) { /* L y = P r: block row q */
+    real4 b;
+    for (uint c = 0u; c < 4u; ++c) {   /* constant bounds: unrolled, no loop turns */
+      int row = SF_LOAD(slot_rows, 4u * q + c);
+      b[c] = row < 0 ? real(0) : SF_LOAD(r, uint(row) * S + s);
+    }
+    for (int k = SF_LOAD(forward_starts, q); k < SF_LOAD(forward_starts, q + 1u); ++k) {
+      real4 yp = SF_Y4(uint(SF_LOAD(forward_panel, k)) * S + s);
+      uint at = 4u * uint(k);
+      b -= SF_COLUMN(forward_blocks, at) * yp.x + SF_COLUMN(forward_blocks, at + 1u) * yp.y +
+           SF_COLUMN(forward_blocks, at + 2u) * yp.z + SF_COLUMN(forward_blocks, at + 3u) * yp.w;
+    }
+    /* T y_q = b, T's columns t0..t3 lower triangular: y_c, then b -= t_c y_c. */
+    real4 t0 = SF_COLUMN(triangles, 4u * q), t1 = SF_COLUMN(triangles, 4u * q + 1u);
+    real4 t2 = SF_COLUMN(triangles, 4u * q + 2u), t3 = SF_COLUMN(triangles, 4u * q + 3u);
+    real4 yq;
+    yq.x = b.x / t0.x;
+    b -= t0 * yq.x;
+    yq.y = b.y / t1.y;
+    b -= t1 * yq.y;
+    yq.z = b.z / t2.z;
+    yq.w = (b.w - t2.w * yq.z) / t3.w;
+    SF_SET_Y4(q * S + s, yq);
   }
   /* The springs' correction, each sum in a register (no arrays of m per lane). */
   for (uint step = max(first, projected); step < min(last, coupled); ++step) { /* (V^T y)_j */
     uint j = step - projected;
     real sum = real(0);
     for (uint u = 0u; u < reached; ++u)
-      sum += SF_LOAD(spring_solves, u * m + j) * SF_Y(uint(SF_LOAD(spring_at, 2u + u)) * S + s);
-    SF_SET_Y(step * S + s, sum);
+      sum += SF_LOAD(spring_solves, u * m + j) * y_at(uint(SF_LOAD(spring_at, 2u + u)));
+    set_y_at(sums + j, sum);
   }
   for (uint step = max(first, coupled); step < min(last, updated); ++step) { /* (H_s V^T y)_j */
     uint j = step - coupled;
     real sum = real(0);
     for (uint k = 0u; k < m; ++k)
-      sum += SF_LOAD(spring_coupling, (s * m + j) * m + k) * SF_Y((projected + k) * S + s);
-    SF_SET_Y(step * S + s, sum);
+      sum += SF_LOAD(spring_coupling, (s * m + j) * m + k) * y_at(sums + k);
+    set_y_at(sums + m + j, sum);
   }
   for (uint step = max(first, updated); step < min(last, backward); ++step) { /* y -= V H_s V^T y */
     uint u = step - updated;
-    uint at = uint(SF_LOAD(spring_at, 2u + u)) * S + s;
+    uint at = uint(SF_LOAD(spring_at, 2u + u));
     real sum = real(0);
-    for (uint j = 0u; j < m; ++j) sum += SF_LOAD(spring_solves, u * m + j) * SF_Y((coupled + j) * S + s);
-    SF_SET_Y(at, SF_Y(at) - sum);
+    for (uint j = 0u; j < m; ++j) sum += SF_LOAD(spring_solves, u * m + j) * y_at(sums + m + j);
+    set_y_at(at, y_at(at) - sum);
   }
-  for (uint step = max(first, backward); step < last; ++step) { /* L^T w = y: column j, diagonal first */
-    uint j = backward + n - 1u - step;
-    int begin = SF_LOAD(column_starts, j), end = SF_LOAD(column_starts, j + 1u);
-    real sum = real(0);
-    for (int k = begin + 1; k < end; ++k)
-      sum += SF_LOAD(column_values, k) * SF_Y(uint(SF_LOAD(column_rows, k)) * S + s);
-    real w = (SF_Y(j * S + s) - sum) / SF_LOAD(column_values, begin);
-    SF_SET_Y(j * S + s, w);
-    z[uint(SF_LOAD(original_row, j)) * S + s] = w;
+  for (uint step = max(first, backward); step < last; ++step) { /* L^T w = y: block column p */
+    uint p = backward + P - 1u - step;
+    real4 a = SF_Y4(p * S + s);
+    for (int k = SF_LOAD(backward_starts, p); k < SF_LOAD(backward_starts, p + 1u); ++k) {
+      real4 w = SF_Y4(uint(SF_LOAD(backward_panel, k)) * S + s);
+      uint at = 4u * uint(k);
+      a -= real4(dot(SF_COLUMN(backward_blocks, at), w), dot(SF_COLUMN(backward_blocks, at + 1u), w),
+                 dot(SF_COLUMN(backward_blocks, at + 2u), w), dot(SF_COLUMN(backward_blocks, at + 3u), w));
+    }
+    /* T^T w_p = a, from the last: w_c = (a_c - sum_i>c T_ic w_i) / T_cc. */
+    real4 t0 = SF_COLUMN(triangles, 4u * p), t1 = SF_COLUMN(triangles, 4u * p + 1u);
+    real4 t2 = SF_COLUMN(triangles, 4u * p + 2u), t3 = SF_COLUMN(triangles, 4u * p + 3u);
+    real4 wp;
+    wp.w = a.w / t3.w;
+    wp.z = (a.z - t2.w * wp.w) / t2.z;
+    wp.y = (a.y - t1.z * wp.z - t1.w * wp.w) / t1.y;
+    wp.x = (a.x - t0.y * wp.y - t0.z * wp.z - t0.w * wp.w) / t0.x;
+    SF_SET_Y4(p * S + s, wp);
+    for (uint c = 0u; c < 4u; ++c) {
+      int row = SF_LOAD(slot_rows, 4u * p + c);
+      if (row >= 0) z[uint(row) * S + s] = wp[c];
+    }
   }
 }

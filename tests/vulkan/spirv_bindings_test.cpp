@@ -65,14 +65,16 @@ TEST(SpirvBindings, EveryShaderHasATexelVariantWithTheSameBindings) {
   }
 }
 
-// factor_solve's work vector in float32 is an r32f imageBuffer (a storage texel buffer, read
-// and written); in float64 a storage buffer. A storage texel buffer of another format is
-// refused (the host makes r32f views only).
+// factor_solve's work vector and blocks in float32 are rgba32f imageBuffers (storage texel
+// buffers of four floats a texel); in float64 storage buffers. A storage texel buffer of
+// another format than r32f or rgba32f is refused (the host makes views of those only).
 TEST(SpirvBindings, TheFactorSolvesWorkVectorIsAStorageTexelBufferInFloat32) {
   for (const bool texel_reads : {false, true}) {
     const EmbeddedShader& shader = embedded("factor_solve", false, texel_reads);
-    EXPECT_EQ(spirv_bindings(shader.words, shader.word_count).at(SF_FACTOR_SOLVE_WORK), SpirvBinding::float_image);
-    EXPECT_EQ(spirv_bindings(shader.words, shader.word_count).at(SF_FACTOR_SOLVE_Z), SpirvBinding::storage_buffer);
+    const auto kinds = spirv_bindings(shader.words, shader.word_count);
+    EXPECT_EQ(kinds.at(SF_FACTOR_SOLVE_WORK), SpirvBinding::float4_image);
+    EXPECT_EQ(kinds.at(SF_FACTOR_SOLVE_FORWARD_BLOCKS), SpirvBinding::float4_image);
+    EXPECT_EQ(kinds.at(SF_FACTOR_SOLVE_Z), SpirvBinding::storage_buffer);
     const EmbeddedShader& doubles = embedded("factor_solve", true, texel_reads);
     EXPECT_EQ(spirv_bindings(doubles.words, doubles.word_count).at(SF_FACTOR_SOLVE_WORK), SpirvBinding::storage_buffer);
   }
@@ -83,7 +85,7 @@ TEST(SpirvBindings, TheFactorSolvesWorkVectorIsAStorageTexelBufferInFloat32) {
     const bool storage_image = (words[at] & 0xffffu) == 25u && (words[at] >> 16) >= 9 &&
                                words[at + 3] == 5u && words[at + 7] == 2u;   // OpTypeImage, Buffer, Sampled 2
     if (storage_image) {
-      words[at + 8] = 1u;   // Rgba32f
+      words[at + 8] = 6u;   // Rg32f
       changed = true;
     }
   }

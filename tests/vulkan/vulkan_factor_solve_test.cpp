@@ -67,7 +67,7 @@ class VulkanFactorSolveTest : public ::testing::Test {
     const std::vector<float> sentinel(r.size(), untouched);
     device.upload(z_buffer, sentinel.data(), bytes);
     SpringCorrection correction(springs ? spring_rows_ : std::vector<int>{});
-    VulkanFactorSolve solve(device, n_, factor_.nonzeros(), correction.size(), S, r_buffer, z_buffer,
+    VulkanFactorSolve solve(device, n_, correction.size(), S, r_buffer, z_buffer,
                             active, loop_turns);
     if (diagonal)
       solve.upload_diagonal(A_);
