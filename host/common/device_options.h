@@ -57,6 +57,11 @@ constexpr long long kNodeIterationWork = 32768;
 // DeviceOptions::factor_loop_turns' default: under llvmpipe's 65535 loop turns an invocation
 // (kernels/vulkan/factor_solve.comp).
 constexpr long long kFactorLoopTurns = 61440;
+// DeviceOptions::lavapipe_serial_work's default, measured on lavapipe on a 2-core machine
+// (bench/RESULTS.md, stop 55): serial on the liver (596 tetrahedra) at S = 4 (3.3 against 4.3 ms
+// a filter step) and the box (1344) at S = 4 (9.8 against 11.6), threads on the liver at
+// S = 16 (6.4 against 7.9 ms a step) and the 4768 liver at S = 4 (20 against 23).
+constexpr long long kLavapipeSerialWork = 8192;
 
 struct DeviceOptions {
   int device = 0;                   // index in `sigmafem devices`' list for the back end
@@ -81,9 +86,15 @@ struct DeviceOptions {
   // an iteration instead of three: cg_node_iteration, kernels/vulkan/conjugate_gradient.comp)
   // up to this many element-sigma pairs (elements x S); 0: never (tests compare).
   long long node_iteration_work = kNodeIterationWork;
-  // Vulkan with a factor: the loop turns of one factor_solve dispatch (each of L's entries
-  // and rows is one), below llvmpipe's limit; tests make it small to cut a solve into many.
+  // Vulkan with a factor: the loop turns of one factor_solve dispatch (each of L's 4 x 4
+  // blocks is one; host/reference/factor_blocks.h), below llvmpipe's limit; tests make it small
+  // to cut a solve into many.
   long long factor_loop_turns = kFactorLoopTurns;
+  // Vulkan on lavapipe: below this many element-sigma pairs (elements x S) its shaders run on
+  // the thread that submits them, where handing each dispatch to its threads costs more than
+  // they give back (choose_lavapipe_threads, host/vulkan/vulkan_instance.h; a user's
+  // LP_NUM_THREADS wins); 0: lavapipe's threads always.
+  long long lavapipe_serial_work = kLavapipeSerialWork;
   // The CPU back end's worker threads: 0, the machine's cores (over MPI ranks, shared among
   // the ranks on one machine: estimation_job.cpp).
   int cpu_threads = 0;

@@ -10,8 +10,9 @@
 
 namespace sigmafem {
 
-VulkanDevice::VulkanDevice(int index, Precision precision) : precision_(precision) {
+VulkanDevice::VulkanDevice(int index, Precision precision, bool lavapipe_serial) : precision_(precision) {
   std::string why;
+  choose_lavapipe_threads(lavapipe_serial);
   VulkanInstance instance = create_vulkan_instance(why, true);
   if (!instance.instance) throw DeviceError(why);
   api_ = instance.api;

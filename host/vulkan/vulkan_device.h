@@ -57,6 +57,15 @@ struct VulkanBuffer {
   VkDeviceSize bytes = 0;
 };
 
+// Whether lavapipe (Mesa's CPU Vulkan driver) runs the shaders of the devices enumerated from
+// here on on the thread that submits them (serial) or hands each dispatch to its threads, one
+// per core (its default): LP_NUM_THREADS, which lavapipe reads when an instance enumerates its
+// devices. On a small mesh the hand-over costs more than the threads give back (on a 2-core
+// virtual machine about 70 us a dispatch, 1.2 of the liver's 4.3 ms filter step; bench/
+// RESULTS.md, stop 55). Left alone where the user set LP_NUM_THREADS (returns false then); no
+// effect on other drivers.
+bool choose_lavapipe_threads(bool serial);
+
 // A compute pipeline: one entry shader, `bindings` buffers at bindings 0..n-1 of set 0 (each
 // a storage buffer, a uniform texel buffer or a storage texel buffer, as the SPIR-V declares
 // it), and 16 bytes of push constants. Owned by the VulkanDevice that made it.
@@ -72,7 +81,9 @@ struct VulkanKernel {
 class VulkanDevice {
  public:
   // Throws DeviceError: no loader, no device `index`, no shaderFloat64 for double precision.
-  VulkanDevice(int index, Precision precision);
+  // `lavapipe_serial`: on lavapipe, the shaders on the submitting thread
+  // (choose_lavapipe_threads in vulkan_instance.h).
+  VulkanDevice(int index, Precision precision, bool lavapipe_serial = false);
   ~VulkanDevice();
   VulkanDevice(const VulkanDevice&) = delete;
   VulkanDevice& operator=(const VulkanDevice&) = delete;

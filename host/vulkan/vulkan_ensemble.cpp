@@ -38,7 +38,8 @@ VulkanEnsemble::VulkanEnsemble(const Model& model, EstimatedParameters estimated
                                const DeviceOptions& options)
     : DeviceEnsemble(model, std::move(estimated), std::move(observed), sigma_count,
                      options.precision, "vulkan", "VulkanEnsemble"),
-      device_(options.device, options.precision) {
+      device_(options.device, options.precision,
+              static_cast<long long>(model.element_count()) * sigma_count < options.lavapipe_serial_work) {
   // Check the memory before asking for it, to say how much is needed.
   const VulkanDeviceInfo& info = device_.info();
   check_device_memory(device_.real_size(), info.name, info.memory, info.max_buffer);

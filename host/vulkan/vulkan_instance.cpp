@@ -8,6 +8,8 @@
 #include <cstring>
 #include <iostream>
 #include <mutex>
+#include <string>
+#include <thread>
 
 namespace sigmafem {
 
@@ -107,6 +109,19 @@ std::string device_type_name(VkPhysicalDeviceType type) {
 
 // An instance (no surface extensions: compute only), with the validation layer and its
 // messenger when asked for and installed. Null instance with `why` set when there is none.
+bool choose_lavapipe_threads(bool serial) {
+  static const bool users_own = std::getenv("LP_NUM_THREADS") != nullptr;   // before any set here
+  static bool set_here = false;
+  if (users_own) return false;
+  if (!serial && !set_here) return true;   // unset: lavapipe's default
+  // setenv once the variable exists swaps its string, leaving environ's array as it is.
+  const unsigned cores = std::thread::hardware_concurrency();   // lavapipe's default (0 on one core)
+  const std::string threads = serial ? "0" : std::to_string(cores > 1 ? cores : 0);
+  setenv("LP_NUM_THREADS", threads.c_str(), 1);
+  set_here = true;
+  return true;
+}
+
 VulkanInstance create_vulkan_instance(std::string& why, bool with_validation) {
   VulkanInstance result;
   result.api = open_loader(why);

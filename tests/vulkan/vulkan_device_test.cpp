@@ -9,6 +9,7 @@
 #include <cstdint>
 #include <cstdlib>
 #include <string>
+#include <thread>
 #include <vector>
 
 #include "host/model/model.h"
@@ -209,6 +210,44 @@ TEST_F(VulkanDeviceTest, CgInTwoDispatchesGivesTheBitsOfThree) {
     EXPECT_TRUE(two_dispatches.positions(s) == three_dispatches.positions(s)) << "sigma point " << s;
     EXPECT_TRUE(two_dispatches.velocities(s) == three_dispatches.velocities(s)) << "sigma point " << s;
   }
+}
+
+// Lavapipe's threads by the ensemble's work (DeviceOptions::lavapipe_serial_work): the box at
+// S = 4 (5376 element-sigma pairs) runs its shaders on the submitting thread (LP_NUM_THREADS
+// "0" while its device is made), the same box asked to take the threads gets lavapipe's default
+// (a thread a core), a user's own LP_NUM_THREADS is kept; the bits are the same either way.
+TEST_F(VulkanDeviceTest, SmallEnsemblesRunLavapipeSeriallyWithTheSameBits) {
+  const Scenario scenario = load_scenario(std::string(SIGMAFEM_SOURCE_DIR) + "/scenarios/box.json");
+  const Model model = make_model(scenario);
+  const std::vector<int>& estimated = scenario.filter->estimate;
+  const int S = static_cast<int>(estimated.size()) + 1;
+  ASSERT_LT(static_cast<long long>(model.element_count()) * S, kLavapipeSerialWork);
+  const char* users = std::getenv("LP_NUM_THREADS");
+  const std::string before = users ? users : "";
+  const bool ours = choose_lavapipe_threads(false);
+  VulkanEnsemble serial(model, estimated, scenario.observations.nodes, S, DeviceOptions{});
+  const char* now = std::getenv("LP_NUM_THREADS");
+  if (ours) {
+    EXPECT_STREQ(now, "0");
+  } else {
+    EXPECT_EQ(std::string(now ? now : ""), before) << "the user's LP_NUM_THREADS is kept";
+  }
+  DeviceOptions threads;
+  threads.lavapipe_serial_work = 0;
+  VulkanEnsemble threaded(model, estimated, scenario.observations.nodes, S, threads);
+  now = std::getenv("LP_NUM_THREADS");
+  const unsigned cores = std::thread::hardware_concurrency();
+  if (ours) {
+    EXPECT_EQ(std::string(now ? now : ""), std::to_string(cores > 1 ? cores : 0));
+  }
+  for (int k = 1; k <= 5; ++k) {
+    const Eigen::Vector3d so = scenario.control.trajectory.position(k * scenario.time.dt, scenario.control.start);
+    const StepReport a = serial.advance(so);
+    const StepReport b = threaded.advance(so);
+    EXPECT_EQ(a.unconverged_count(), 0);
+    EXPECT_EQ(a.cg_iterations, b.cg_iterations) << "step " << k;
+  }
+  for (int s = 0; s < S; ++s) EXPECT_TRUE(serial.positions(s) == threaded.positions(s)) << "sigma point " << s;
 }
 
 // The form of the shaders: the CPU form (texel reads) on a CPU device by default or when asked,
