@@ -22,6 +22,8 @@ FactorBlocks::FactorBlocks(const Eigen::SparseMatrix<double>& L, const int* orde
     throw std::invalid_argument("FactorBlocks: L must be square and compressed");
   const int* starts = L.outerIndexPtr();
   const int* rows = L.innerIndexPtr();
+  pattern_starts_.assign(starts, starts + n + 1);
+  pattern_rows_.assign(rows, rows + L.nonZeros());
   for (int j = 0; j < n; ++j)
     if (starts[j] == starts[j + 1] || rows[starts[j]] != j)
       throw std::invalid_argument("FactorBlocks: L's column " + std::to_string(j) + " does not start at its diagonal");
@@ -105,9 +107,15 @@ FactorBlocks::FactorBlocks(const Eigen::SparseMatrix<double>& L, const int* orde
   assign_values(L);
 }
 
+bool FactorBlocks::same_pattern(const Eigen::SparseMatrix<double>& L) const {
+  const std::size_t n = pattern_starts_.size() - 1;
+  return L.isCompressed() && static_cast<std::size_t>(L.rows()) == n && static_cast<std::size_t>(L.cols()) == n &&
+         std::equal(pattern_starts_.begin(), pattern_starts_.end(), L.outerIndexPtr()) &&
+         std::equal(pattern_rows_.begin(), pattern_rows_.end(), L.innerIndexPtr());
+}
+
 void FactorBlocks::assign_values(const Eigen::SparseMatrix<double>& L) {
-  if (static_cast<std::size_t>(L.nonZeros()) != entry_at_.size())
-    throw std::invalid_argument("FactorBlocks: a factor of another pattern");
+  if (!same_pattern(L)) throw std::invalid_argument("FactorBlocks: a factor of another pattern");
   const int P = panels();
   triangles_.assign(16 * static_cast<std::size_t>(P), 0.0);
   for (int p = 0; p < P; ++p)

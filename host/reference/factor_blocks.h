@@ -29,6 +29,8 @@ class FactorBlocks {
   // Fills triangles() and the blocks from L's values (L of the pattern given to the
   // constructor: a later factorisation of the same analysis).
   void assign_values(const Eigen::SparseMatrix<double>& L);
+  // Whether L has the pattern given to the constructor.
+  bool same_pattern(const Eigen::SparseMatrix<double>& L) const;
 
   int panels() const { return static_cast<int>(first_column_.size()) - 1; }
   std::size_t blocks() const { return forward_panel_.size(); }
@@ -53,6 +55,7 @@ class FactorBlocks {
   void solve(Eigen::VectorXd& y) const;
 
  private:
+  std::vector<int> pattern_starts_, pattern_rows_;   // L's pattern, as given
   std::vector<int> first_column_;            // panel q: L's columns first_column_[q] .. [q + 1]
   std::vector<int> slot_of_row_, slot_rows_;
   std::vector<int> forward_starts_, forward_panel_, backward_starts_, backward_panel_;

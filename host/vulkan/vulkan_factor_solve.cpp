@@ -46,9 +46,8 @@ void VulkanFactorSolve::upload_reals(const VulkanBuffer& buffer, const std::vect
   if (!bytes.empty()) device_.upload(buffer, bytes.data(), bytes.size());
 }
 
-void VulkanFactorSolve::make_layout(const Eigen::SparseMatrix<double>& L, const int* order, bool diagonal) {
+void VulkanFactorSolve::make_layout(const Eigen::SparseMatrix<double>& L, const int* order) {
   auto layout = std::make_unique<Layout>();
-  layout->diagonal = diagonal;
   layout->blocks = std::make_unique<FactorBlocks>(L, order);
   const FactorBlocks& b = *layout->blocks;
   const std::size_t P = static_cast<std::size_t>(b.panels()), B = std::max<std::size_t>(b.blocks(), 1);
@@ -89,16 +88,21 @@ void VulkanFactorSolve::upload(const FactorisedPreconditioner& factor) {
   if (L.rows() != rows_)
     throw DeviceError("the factor has " + std::to_string(L.rows()) + " rows; the Vulkan solve was made for " +
                       std::to_string(rows_));
-  if (!layout_ || layout_->diagonal)
-    make_layout(L, factor.order(), false);
-  else
-    layout_->blocks->assign_values(L);
-  upload_values();
+  send(L, factor.order());
   upload_spring_rows(0, {});   // the last correction was the last factor's
 }
 
+void VulkanFactorSolve::send(const Eigen::SparseMatrix<double>& L, const int* order) {
+  if (layout_ && layout_->blocks->same_pattern(L))
+    layout_->blocks->assign_values(L);
+  else
+    make_layout(L, order);
+  upload_values();
+}
+
 bool VulkanFactorSolve::upload_springs(const SpringCorrection& springs) {
-  if (springs.size() != spring_rows_ || !springs.prepared() || !layout_)
+  if (!layout_) throw DeviceError("the factor's spring correction sent before the factor");
+  if (springs.size() != spring_rows_ || !springs.prepared())
     throw DeviceError("the factor's spring correction has " + std::to_string(springs.size()) +
                       " rows (prepared: " + (springs.prepared() ? "yes" : "no") +
                       "); the Vulkan buffers hold " + std::to_string(spring_rows_));
@@ -140,8 +144,7 @@ void VulkanFactorSolve::upload_diagonal(const Eigen::SparseMatrix<double>& A) {
   L.makeCompressed();
   std::vector<int> identity(static_cast<std::size_t>(n));
   for (Eigen::Index i = 0; i < n; ++i) identity[static_cast<std::size_t>(i)] = static_cast<int>(i);
-  make_layout(L, identity.data(), true);
-  upload_values();
+  send(L, identity.data());
   upload_spring_rows(0, {});
 }
 

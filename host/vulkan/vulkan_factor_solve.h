@@ -33,8 +33,9 @@ class VulkanFactorSolve {
   VulkanFactorSolve(VulkanDevice& device, int rows, int spring_rows, int sigma_count, const VulkanBuffer& r,
                     const VulkanBuffer& z, const VulkanBuffer& active, long long loop_turns);
 
-  // Sends a fresh factorisation (factor.ready(); its pattern is the analysis's, so after the
-  // first only the values go), uncorrected until upload_springs().
+  // Sends a fresh factorisation (factor.ready(); after the first only the values go while
+  // L's pattern stays, else the blocks' buffers are made anew), uncorrected until
+  // upload_springs().
   void upload(const FactorisedPreconditioner& factor);
   // The correction of the factor just uploaded (springs.prepare()d with it; its m the
   // constructor's). False, and the factor left uncorrected, where one of the correction's sums
@@ -60,16 +61,19 @@ class VulkanFactorSolve {
  private:
   // A pattern on the device: its blocks and their buffers, the pipeline (specialised to its
   // panels) and the descriptor set.
+  // A new pattern's buffers are new ones (the last pattern's stay with the device: L's
+  // pattern changes only from the stand-in to the first factor, or if A's does).
   struct Layout {
-    bool diagonal = false;
     std::unique_ptr<FactorBlocks> blocks;
     VulkanBuffer forward_starts, forward_panel, backward_starts, backward_panel, slot_rows, triangles,
         forward_blocks, backward_blocks, work;
     VulkanKernel kernel;
     VkDescriptorSet set = VK_NULL_HANDLE;
   };
-  // A layout for L's pattern, its values sent.
-  void make_layout(const Eigen::SparseMatrix<double>& L, const int* order, bool diagonal);
+  // L's values to the device: into the layout of its pattern, made if L's is another.
+  void send(const Eigen::SparseMatrix<double>& L, const int* order);
+  // A layout for L's pattern: its blocks, buffers, pipeline and descriptor set.
+  void make_layout(const Eigen::SparseMatrix<double>& L, const int* order);
   void upload_values();
   // The correction's slots on the device: m and `reached`, then the reached rows' slots
   // (none: m = 0).

@@ -97,6 +97,7 @@ TEST(FactorBlocks, NewValuesOfTheSamePatternSolveTheNewSystem) {
   Eigen::SparseMatrix<double> stiffer = A;
   for (Eigen::Index i = 0; i < A.rows(); i += 7) stiffer.coeffRef(i, i) *= 1.5;
   ASSERT_TRUE(factor.factorise(stiffer));   // the same pattern: the analysis is kept
+  ASSERT_TRUE(blocks.same_pattern(factor.lower()));
   blocks.assign_values(factor.lower());
   const Eigen::VectorXd b = Eigen::VectorXd::Ones(A.rows());
   const Eigen::VectorXd x = block_solve(blocks, factor, b);
@@ -112,6 +113,11 @@ TEST(FactorBlocks, ADiagonalFactorIsPanelsOfFourWithoutBlocks) {
   std::vector<int> identity(n);
   for (int i = 0; i < n; ++i) identity[static_cast<std::size_t>(i)] = i;
   const FactorBlocks blocks(L, identity.data());
+  Eigen::SparseMatrix<double> other = L;
+  other.insert(3, 1) = 0.5;
+  other.makeCompressed();
+  EXPECT_FALSE(blocks.same_pattern(other));
+  EXPECT_THROW(FactorBlocks(blocks).assign_values(other), std::invalid_argument);
   EXPECT_EQ(blocks.panels(), 3);
   EXPECT_EQ(blocks.blocks(), 0u);
   ASSERT_EQ(blocks.slot_rows().size(), 12u);

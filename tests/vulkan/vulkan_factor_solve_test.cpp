@@ -1,7 +1,7 @@
 // VulkanFactorSolve (kernels/vulkan/factor_solve.comp): z = M^-1 r on the device against the
 // same factor's substitutions on the host in double precision, cut into many dispatches or
-// few, in both forms of the shader; the diagonal stand-in; a factor that no dispatch could
-// hold; and the ensemble that uses it by default on a CPU device.
+// few, in both forms of the shader; the diagonal stand-in, and the factor in its place; a
+// factor that no dispatch could hold; and the ensemble that uses it by default on a CPU device.
 #include "host/vulkan/vulkan_factor_solve.h"
 
 #include <Eigen/SparseCholesky>
@@ -185,6 +185,38 @@ TEST_F(VulkanFactorSolveTest, TheSpringCorrectionSolvesEachSigmaPointsOwnSystem)
   }
 }
 
+// The stand-in, then the first factor (another pattern: new blocks and buffers), then the
+// factor again (the same pattern: its values only): each solve as a fresh solve's, bit for bit.
+TEST_F(VulkanFactorSolveTest, AFactorAfterTheStandInSolvesAsAFreshOne) {
+  const int S = 4;
+  const std::vector<float> r = residuals(S);
+  const std::vector<float> fresh = device_solve(r, S, -1, true, kFactorLoopTurns, false);
+  VulkanDevice device(0, Precision::single);
+  device.set_texel_reads(true);
+  const std::size_t bytes = r.size() * sizeof(float);
+  const VulkanBuffer r_buffer = device.buffer(bytes, "r"), z_buffer = device.buffer(bytes, "z");
+  const VulkanBuffer active = device.buffer(4 * static_cast<std::size_t>(S), "active");
+  const std::vector<std::uint32_t> flags(static_cast<std::size_t>(S), 1u);
+  device.upload(r_buffer, r.data(), bytes);
+  device.upload(active, flags.data(), 4 * flags.size());
+  VulkanFactorSolve solve(device, n_, 0, S, r_buffer, z_buffer, active, kFactorLoopTurns);
+  solve.upload_diagonal(A_);
+  const std::size_t stand_in_bytes = solve.bytes();
+  std::size_t factor_bytes = 0;
+  for (int upload = 0; upload < 2; ++upload) {
+    solve.upload(factor_);
+    if (upload == 0) factor_bytes = solve.bytes();
+    EXPECT_EQ(solve.bytes(), factor_bytes) << "the same pattern again: the same buffers";
+    VkCommandBuffer cmd = device.begin();
+    solve.record(cmd);
+    device.submit_and_wait(cmd);
+    std::vector<float> z(r.size());
+    device.download(z_buffer, z.data(), bytes);
+    EXPECT_EQ(0, std::memcmp(z.data(), fresh.data(), bytes)) << "upload " << upload;
+  }
+  EXPECT_GT(factor_bytes, stand_in_bytes) << "the factor's pattern got its own buffers";
+}
+
 // Until a factorisation succeeds: z = r / |diag A|, Jacobi's preconditioner, in one dispatch.
 TEST_F(VulkanFactorSolveTest, TheDiagonalStandInIsJacobi) {
   const int S = 4;
@@ -199,9 +231,9 @@ TEST_F(VulkanFactorSolveTest, TheDiagonalStandInIsJacobi) {
     }
 }
 
-// A bound on loop turns that a single row of L exceeds is a DeviceError that says so, not a
-// solve that llvmpipe would end silently.
-TEST_F(VulkanFactorSolveTest, ARowBeyondTheLoopBoundIsADeviceError) {
+// A bound on loop turns that a single block row of L exceeds is a DeviceError that says so,
+// not a solve that llvmpipe would end silently.
+TEST_F(VulkanFactorSolveTest, ABlockRowBeyondTheLoopBoundIsADeviceError) {
   try {
     device_solve(residuals(4), 4, -1, true, 8, false);
     FAIL() << "no error";
