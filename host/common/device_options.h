@@ -92,7 +92,7 @@ struct DeviceOptions {
   long long factor_loop_turns = kFactorLoopTurns;
   // Vulkan on lavapipe: below this many element-sigma pairs (elements x S) its shaders run on
   // the thread that submits them, where handing each dispatch to its threads costs more than
-  // they give back (choose_lavapipe_threads, host/vulkan/vulkan_instance.h; a user's
+  // they give back (choose_lavapipe_threads, host/vulkan/vulkan_device.h; a user's
   // LP_NUM_THREADS wins); 0: lavapipe's threads always.
   long long lavapipe_serial_work = kLavapipeSerialWork;
   // The CPU back end's worker threads: 0, the machine's cores (over MPI ranks, shared among

@@ -63,7 +63,8 @@ struct VulkanBuffer {
 // devices. On a small mesh the hand-over costs more than the threads give back (on a 2-core
 // virtual machine about 70 us a dispatch, 1.2 of the liver's 4.3 ms filter step; bench/
 // RESULTS.md, stop 55). Left alone where the user set LP_NUM_THREADS (returns false then); no
-// effect on other drivers.
+// effect on other drivers. Not thread-safe (it sets the environment; the choice holds until the
+// device's instance has enumerated): devices are made on one thread at a time.
 bool choose_lavapipe_threads(bool serial);
 
 // A compute pipeline: one entry shader, `bindings` buffers at bindings 0..n-1 of set 0 (each
@@ -82,7 +83,7 @@ class VulkanDevice {
  public:
   // Throws DeviceError: no loader, no device `index`, no shaderFloat64 for double precision.
   // `lavapipe_serial`: on lavapipe, the shaders on the submitting thread
-  // (choose_lavapipe_threads in vulkan_instance.h).
+  // (choose_lavapipe_threads above).
   VulkanDevice(int index, Precision precision, bool lavapipe_serial = false);
   ~VulkanDevice();
   VulkanDevice(const VulkanDevice&) = delete;

@@ -107,8 +107,6 @@ std::string device_type_name(VkPhysicalDeviceType type) {
 
 }  // namespace
 
-// An instance (no surface extensions: compute only), with the validation layer and its
-// messenger when asked for and installed. Null instance with `why` set when there is none.
 bool choose_lavapipe_threads(bool serial) {
   static const bool users_own = std::getenv("LP_NUM_THREADS") != nullptr;   // before any set here
   static bool set_here = false;
@@ -122,6 +120,8 @@ bool choose_lavapipe_threads(bool serial) {
   return true;
 }
 
+// An instance (no surface extensions: compute only), with the validation layer and its
+// messenger when asked for and installed. Null instance with `why` set when there is none.
 VulkanInstance create_vulkan_instance(std::string& why, bool with_validation) {
   VulkanInstance result;
   result.api = open_loader(why);
