@@ -5,6 +5,7 @@
 #include <cstring>
 #include <iostream>
 
+#include "host/ensemble/device_readout.h"
 #include "host/vulkan/vulkan_instance.h"
 #include "host/vulkan/vulkan_shaders.h"
 
@@ -547,6 +548,16 @@ void VulkanDevice::print_profile() const {
               << " s, " << 1e6 * time.seconds / static_cast<double>(time.dispatches)
               << " us each\n";
   std::cerr << "  between dispatches (barriers, copies, updates): " << profile_between_ << " s\n";
+}
+
+void VulkanDevice::upload_reals(const VulkanBuffer& buffer, const std::vector<double>& values) {
+  const std::vector<unsigned char> bytes = to_device_reals(values, precision_);
+  if (!bytes.empty()) upload(buffer, bytes.data(), bytes.size());
+}
+
+void VulkanDevice::update_reals(VkCommandBuffer cmd, const VulkanBuffer& buffer, const std::vector<double>& values) {
+  const std::vector<unsigned char> bytes = to_device_reals(values, precision_);
+  update(cmd, buffer, bytes.data(), bytes.size());
 }
 
 }  // namespace sigmafem

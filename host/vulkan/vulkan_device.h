@@ -98,6 +98,8 @@ class VulkanDevice {
   // DeviceError naming `what` when the device has too little memory.
   VulkanBuffer buffer(std::size_t bytes, const char* what);
   void upload(const VulkanBuffer& buffer, const void* data, std::size_t bytes);
+  // `values` in this device's precision (to_device_reals); nothing for none.
+  void upload_reals(const VulkanBuffer& buffer, const std::vector<double>& values);
   void download(const VulkanBuffer& buffer, void* data, std::size_t bytes);
 
   // Whether kernel() takes the shaders compiled with texel reads (the kernels made before the
@@ -130,6 +132,8 @@ class VulkanDevice {
   // Every earlier shader write and transfer is visible to every later shader and transfer.
   void barrier(VkCommandBuffer cmd);
   void update(VkCommandBuffer cmd, const VulkanBuffer& buffer, const void* data, std::size_t bytes);
+  // `values` in this device's precision, recorded as update() does.
+  void update_reals(VkCommandBuffer cmd, const VulkanBuffer& buffer, const std::vector<double>& values);
   // Makes the host-visible read-back area at least `bytes` long (before recording copies).
   void reserve_read_back(std::size_t bytes);
   // Copies `bytes` of `buffer` into the read-back area at `offset` (after a barrier);

@@ -194,8 +194,7 @@ VkDescriptorSet VulkanEnsemble::bind(const VulkanKernel& kernel, const std::vect
 }
 
 void VulkanEnsemble::write_reals(DeviceBuffer id, const std::vector<double>& values) {
-  const std::vector<unsigned char> bytes = to_device_reals(values, device_.precision());
-  device_.upload(buffer(id), bytes.data(), bytes.size());
+  device_.upload_reals(buffer(id), values);
 }
 
 std::vector<double> VulkanEnsemble::read_reals(DeviceBuffer id, std::size_t count) const {
@@ -313,9 +312,9 @@ void VulkanEnsemble::refresh_multigrid(const std::vector<double>& constants) {
   const bool made = multigrid_->set_matrix(representative_system());
   multigrid_refresh_.made(made, multigrid_->setup_in_cycles());
   if (!made) return;   // the last hierarchy stays, or Jacobi until one is made
-  const bool first = !multigrid_solve_->ready();
+  const std::size_t before = multigrid_solve_->bytes();   // its buffers are made at the first upload
   multigrid_solve_->upload(*multigrid_);
-  if (first) device_bytes_ += multigrid_solve_->bytes();
+  device_bytes_ += multigrid_solve_->bytes() - before;
   ++multigrid_makings_;
   multigrid_springs_ = factorised_springs(shift_rows_, constants);
   shift_stale_ = true;

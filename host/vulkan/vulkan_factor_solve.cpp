@@ -5,7 +5,6 @@
 #include <string>
 
 #include "device_layout.h"
-#include "host/ensemble/device_readout.h"
 #include "host/vulkan/vulkan_push_constants.h"
 
 namespace sigmafem {
@@ -41,11 +40,6 @@ void VulkanFactorSolve::upload_ints(const VulkanBuffer& buffer, const std::vecto
   if (!values.empty()) device_.upload(buffer, values.data(), values.size() * sizeof(int));
 }
 
-void VulkanFactorSolve::upload_reals(const VulkanBuffer& buffer, const std::vector<double>& values) {
-  const std::vector<unsigned char> bytes = to_device_reals(values, device_.precision());
-  if (!bytes.empty()) device_.upload(buffer, bytes.data(), bytes.size());
-}
-
 void VulkanFactorSolve::make_layout(const Eigen::SparseMatrix<double>& L, const int* order) {
   auto layout = std::make_unique<Layout>();
   layout->blocks = std::make_unique<FactorBlocks>(L, order);
@@ -78,9 +72,9 @@ void VulkanFactorSolve::make_layout(const Eigen::SparseMatrix<double>& L, const 
 
 void VulkanFactorSolve::upload_values() {
   const FactorBlocks& b = *layout_->blocks;
-  upload_reals(layout_->triangles, b.triangles());
-  upload_reals(layout_->forward_blocks, b.forward_values());
-  upload_reals(layout_->backward_blocks, b.backward_values());
+  device_.upload_reals(layout_->triangles, b.triangles());
+  device_.upload_reals(layout_->forward_blocks, b.forward_values());
+  device_.upload_reals(layout_->backward_blocks, b.backward_values());
 }
 
 void VulkanFactorSolve::upload(const FactorisedPreconditioner& factor) {
@@ -113,7 +107,7 @@ bool VulkanFactorSolve::upload_springs(const SpringCorrection& springs) {
   std::vector<double> values(static_cast<std::size_t>(V.size()));   // by rows
   for (Eigen::Index u = 0; u < V.rows(); ++u)
     for (Eigen::Index j = 0; j < V.cols(); ++j) values[static_cast<std::size_t>(u * V.cols() + j)] = V(u, j);
-  upload_reals(spring_solves_, values);
+  device_.upload_reals(spring_solves_, values);
   upload_spring_rows(springs.size(), springs.reached());
   return true;
 }
@@ -123,8 +117,7 @@ void VulkanFactorSolve::record_couplings(VkCommandBuffer cmd, const std::vector<
   if (couplings.size() != m * m * static_cast<std::size_t>(S_))
     throw DeviceError("the springs' couplings: " + std::to_string(couplings.size()) + " reals for " +
                       std::to_string(m * m * static_cast<std::size_t>(S_)));
-  const std::vector<unsigned char> bytes = to_device_reals(couplings, device_.precision());
-  device_.update(cmd, spring_coupling_, bytes.data(), bytes.size());
+  device_.update_reals(cmd, spring_coupling_, couplings);
 }
 
 void VulkanFactorSolve::upload_spring_rows(int m, const std::vector<int>& reached) {

@@ -82,7 +82,6 @@ class VulkanFactorSolve {
   void plan_dispatches();
   VulkanBuffer make(std::size_t bytes);
   void upload_ints(const VulkanBuffer& buffer, const std::vector<int>& values);
-  void upload_reals(const VulkanBuffer& buffer, const std::vector<double>& values);
 
   VulkanDevice& device_;
   int rows_ = 0, S_ = 0, spring_rows_ = 0;

@@ -3,7 +3,6 @@
 #include <string>
 
 #include "device_layout.h"
-#include "host/ensemble/device_readout.h"
 
 namespace sigmafem {
 
@@ -31,11 +30,6 @@ VulkanMultigrid::Matrix VulkanMultigrid::make_matrix(const RowMajorMatrix& M) {
   return matrix;
 }
 
-void VulkanMultigrid::upload_reals(const VulkanBuffer& to, const std::vector<double>& values) {
-  const std::vector<unsigned char> bytes = to_device_reals(values, device_.precision());
-  device_.upload(to, bytes.data(), bytes.size());
-}
-
 void VulkanMultigrid::upload_matrix(const Matrix& to, const RowMajorMatrix& M) {
   if (static_cast<std::uint32_t>(M.rows()) != to.rows || static_cast<std::size_t>(M.nonZeros()) != to.nonzeros)
     throw DeviceError("a multigrid level of " + std::to_string(M.rows()) + " rows and " +
@@ -43,7 +37,7 @@ void VulkanMultigrid::upload_matrix(const Matrix& to, const RowMajorMatrix& M) {
                       " and " + std::to_string(to.nonzeros));
   device_.upload(to.row_start, M.outerIndexPtr(), 4 * (static_cast<std::size_t>(M.rows()) + 1));
   device_.upload(to.columns, M.innerIndexPtr(), 4 * to.nonzeros);
-  upload_reals(to.values, std::vector<double>(M.valuePtr(), M.valuePtr() + M.nonZeros()));
+  device_.upload_reals(to.values, std::vector<double>(M.valuePtr(), M.valuePtr() + M.nonZeros()));
 }
 
 void VulkanMultigrid::make_levels(const NestedMultigrid& multigrid) {
@@ -86,8 +80,8 @@ void VulkanMultigrid::upload(const NestedMultigrid& multigrid) {
     const Level& level = levels_[static_cast<std::size_t>(l)];
     upload_matrix(level.matrix, multigrid.launch_matrix(l));
     if (!from.smoothing.empty()) {
-      upload_reals(level.diagonal, std::vector<double>(from.diagonal.data(), from.diagonal.data() + from.diagonal.size()));
-      upload_reals(level.steps, multigrid.smoothing_coefficients(l));
+      device_.upload_reals(level.diagonal, std::vector<double>(from.diagonal.data(), from.diagonal.data() + from.diagonal.size()));
+      device_.upload_reals(level.steps, multigrid.smoothing_coefficients(l));
     }
     if (l + 1 < multigrid.level_count()) {
       upload_matrix(level.prolongation, from.prolongation);
@@ -143,8 +137,7 @@ void VulkanMultigrid::plan(const std::vector<MultigridLaunch>& launches) {
 }
 
 void VulkanMultigrid::record_shift(VkCommandBuffer cmd, const std::vector<double>& shift) const {
-  const std::vector<unsigned char> bytes = to_device_reals(shift, device_.precision());
-  device_.update(cmd, shift_, bytes.data(), bytes.size());
+  device_.update_reals(cmd, shift_, shift);
 }
 
 void VulkanMultigrid::record(VkCommandBuffer cmd) const {

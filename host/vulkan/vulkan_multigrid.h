@@ -56,7 +56,6 @@ class VulkanMultigrid {
   VulkanBuffer make(std::size_t bytes);
   Matrix make_matrix(const RowMajorMatrix& M);
   void upload_matrix(const Matrix& to, const RowMajorMatrix& M);
-  void upload_reals(const VulkanBuffer& to, const std::vector<double>& values);
   // The buffers of every level, at the first upload.
   void make_levels(const NestedMultigrid& multigrid);
   // The dispatches of the V-cycle's launches (NestedMultigrid::launches), with their sets.
