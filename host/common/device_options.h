@@ -95,6 +95,9 @@ struct DeviceOptions {
   // they give back (choose_lavapipe_threads, host/vulkan/vulkan_device.h; a user's
   // LP_NUM_THREADS wins); 0: lavapipe's threads always.
   long long lavapipe_serial_work = kLavapipeSerialWork;
+  // Vulkan's CPU form (texel reads) with S a multiple of 4: the element shaders take four sigma
+  // points a lane (kernels/vulkan/sigma_quads.h); false: one (tests compare).
+  bool sigma_quads = true;
   // The CPU back end's worker threads: 0, the machine's cores (over MPI ranks, shared among
   // the ranks on one machine: estimation_job.cpp).
   int cpu_threads = 0;

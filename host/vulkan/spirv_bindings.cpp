@@ -1,5 +1,6 @@
 #include "host/vulkan/spirv_bindings.h"
 
+#include <cstring>
 #include <stdexcept>
 #include <string>
 #include <unordered_map>
@@ -12,7 +13,7 @@ namespace {
 constexpr std::uint32_t kMagic = 0x07230203;
 constexpr std::uint32_t kOpTypeInt = 21, kOpTypeFloat = 22, kOpTypeImage = 25;
 constexpr std::uint32_t kOpTypeSampledImage = 27, kOpTypePointer = 32, kOpVariable = 59;
-constexpr std::uint32_t kOpDecorate = 71;
+constexpr std::uint32_t kOpName = 5, kOpDecorate = 71;
 constexpr std::uint32_t kDecorationBinding = 33, kDecorationDescriptorSet = 34;
 constexpr std::uint32_t kDimBuffer = 5;
 constexpr std::uint32_t kImageFormatRgba32f = 1, kImageFormatR32f = 3;
@@ -29,6 +30,7 @@ std::map<std::uint32_t, SpirvBinding> spirv_bindings(const std::uint32_t* words,
   std::unordered_map<std::uint32_t, std::uint32_t> buffer_image;  // buffer image -> sampled type
   std::unordered_map<std::uint32_t, std::uint32_t> image_format;  // buffer image -> its format
   std::unordered_map<std::uint32_t, SpirvBinding> scalar_kind;    // 32-bit scalar types
+  std::unordered_map<std::uint32_t, std::string> name_of;          // OpName: id -> name
   for (std::size_t at = 5; at < count;) {
     const std::uint32_t length = words[at] >> 16, opcode = words[at] & 0xffffu;
     if (length == 0 || at + length > count)
@@ -36,7 +38,11 @@ std::map<std::uint32_t, SpirvBinding> spirv_bindings(const std::uint32_t* words,
                                   " runs past the module's end");
     const std::uint32_t* operand = words + at + 1;
     const std::uint32_t operands = length - 1;
-    if (opcode == kOpDecorate && operands >= 3 && operand[1] == kDecorationBinding)
+    if (opcode == kOpName && operands >= 2)   // the id, then a nul-terminated string
+      name_of[operand[0]] = std::string(reinterpret_cast<const char*>(operand + 1),
+                                        strnlen(reinterpret_cast<const char*>(operand + 1),
+                                                4 * (operands - 1)));
+    else if (opcode == kOpDecorate && operands >= 3 && operand[1] == kDecorationBinding)
       binding_of[operand[0]] = operand[2];
     else if (opcode == kOpDecorate && operands >= 3 && operand[1] == kDecorationDescriptorSet)
       set_of[operand[0]] = operand[2];
@@ -56,7 +62,7 @@ std::map<std::uint32_t, SpirvBinding> spirv_bindings(const std::uint32_t* words,
       variable_type[operand[1]] = operand[0];
     at += length;
   }
-  // What a variable's pointee is: a sampled buffer image of 32-bit texels, a buffer image
+  // What a variable's pointee is: a sampled buffer image of 32-bit texels (or four floats), a buffer image
   // itself (a storage texel buffer, of r32f or rgba32f only), or else storage.
   auto find = [](const auto& map, std::uint32_t key, std::uint32_t& value) {
     const auto it = map.find(key);
@@ -74,6 +80,11 @@ std::map<std::uint32_t, SpirvBinding> spirv_bindings(const std::uint32_t* words,
         find(sampled_image, type, image) && find(buffer_image, image, texel)) {
       const auto it = scalar_kind.find(texel);
       if (it != scalar_kind.end()) kind = it->second;
+      const auto name = name_of.find(variable);
+      const std::string rgba = "_rgba";
+      if (kind == SpirvBinding::float_texels && name != name_of.end() && name->second.size() > rgba.size() &&
+          name->second.compare(name->second.size() - rgba.size(), rgba.size(), rgba) == 0)
+        kind = SpirvBinding::float4_texels;
     } else if (find(variable_type, variable, pointer) && find(pointee, pointer, type) &&
                find(buffer_image, type, texel)) {
       std::uint32_t format = 0;

@@ -13,6 +13,8 @@ namespace sigmafem {
 enum class SpirvBinding {
   storage_buffer,   // a std430 buffer block (or anything that is not a texel buffer)
   float_texels,     // uniform samplerBuffer: R32_SFLOAT texels
+  float4_texels,    // uniform samplerBuffer named *_rgba: R32G32B32A32_SFLOAT, four floats a
+                    // texel (a sampled buffer's SPIR-V type has no format to say so)
   int_texels,       // uniform isamplerBuffer: R32_SINT
   uint_texels,      // uniform usamplerBuffer: R32_UINT (in a float64 shader, R32G32_UINT:
                     // a double's two halves; kernels/vulkan/ensemble_layout.h)
@@ -26,7 +28,7 @@ inline bool storage_texels(SpirvBinding kind) {
 }
 
 // Binding number -> kind, for the variables of descriptor set 0 that carry a Binding
-// decoration. Throws std::invalid_argument when the words are not a well-formed SPIR-V
+// decoration (a float samplerBuffer is float4_texels when its OpName ends in "_rgba"). Throws std::invalid_argument when the words are not a well-formed SPIR-V
 // module (no magic number, an instruction that runs past the end, a zero word count) or
 // declare a storage texel buffer of a format other than r32f or rgba32f.
 std::map<std::uint32_t, SpirvBinding> spirv_bindings(const std::uint32_t* words, std::size_t count);

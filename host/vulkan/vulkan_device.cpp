@@ -404,13 +404,15 @@ VkBufferView VulkanDevice::texel_view(const VulkanBuffer& buffer, SpirvBinding k
   const bool doubles = kind == SpirvBinding::uint_texels && precision_ == Precision::double_precision;
   const VkFormat format = kind == SpirvBinding::float_texels || kind == SpirvBinding::float_image
                               ? VK_FORMAT_R32_SFLOAT
-                          : kind == SpirvBinding::float4_image ? VK_FORMAT_R32G32B32A32_SFLOAT
+                          : kind == SpirvBinding::float4_image || kind == SpirvBinding::float4_texels
+                              ? VK_FORMAT_R32G32B32A32_SFLOAT
                           : kind == SpirvBinding::int_texels ? VK_FORMAT_R32_SINT
                           : doubles                          ? VK_FORMAT_R32G32_UINT
                                                              : VK_FORMAT_R32_UINT;
   for (const TexelView& v : views_)
     if (v.buffer == buffer.buffer && v.format == format) return v.view;
-  const std::size_t texels = buffer.bytes / (doubles ? 8 : kind == SpirvBinding::float4_image ? 16 : 4);
+  const bool four = kind == SpirvBinding::float4_image || kind == SpirvBinding::float4_texels;
+  const std::size_t texels = buffer.bytes / (doubles ? 8 : four ? 16 : 4);
   if (texels > info_.max_texel_elements)
     throw DeviceError("the Vulkan shader " + kernel + " reads a buffer of " +
                       std::to_string(texels) + " texels; " + info_.name +

@@ -109,9 +109,13 @@ VulkanEnsemble::VulkanEnsemble(const Model& model, EstimatedParameters estimated
   auto kernel = [&](const char* name, DeviceKernel k) {
     return device_.kernel(name, static_cast<int>(kernel_buffers(k).size()));
   };
-  k_element_rhs_ = kernel("element_rhs", DeviceKernel::element_rhs);
+  // The element shaders four sigma points a lane on a CPU device (kernels/vulkan/sigma_quads.h),
+  // where S allows.
+  sigma_quads_ = options.sigma_quads && device_.texel_reads() && S_ % 4 == 0;
+  k_element_rhs_ = kernel(sigma_quads_ ? "element_rhs_quads" : "element_rhs", DeviceKernel::element_rhs);
   k_node_rhs_ = kernel("node_rhs", DeviceKernel::node_rhs);
-  k_element_product_ = kernel("element_product", DeviceKernel::element_product);
+  k_element_product_ =
+      kernel(sigma_quads_ ? "element_product_quads" : "element_product", DeviceKernel::element_product);
   k_node_product_ = kernel("node_product", DeviceKernel::node_product);
   k_state_update_ = kernel("state_update", DeviceKernel::state_update);
   k_observation_gather_ = kernel("observation_gather", DeviceKernel::observation_gather);
@@ -250,9 +254,13 @@ void VulkanEnsemble::dispatch_items(VkCommandBuffer cmd, const VulkanKernel& ker
   device_.barrier(cmd);
 }
 
+std::size_t VulkanEnsemble::element_items() const {
+  return elements_ * static_cast<std::size_t>(sigma_quads_ ? S_ / 4 : S_);
+}
+
 void VulkanEnsemble::record_system_product(VkCommandBuffer cmd, VkDescriptorSet product_set) const {
   const std::size_t S = static_cast<std::size_t>(S_);
-  dispatch_items(cmd, k_element_product_, product_set, elements_ * S, elements_);
+  dispatch_items(cmd, k_element_product_, product_set, element_items(), elements_);
   dispatch_items(cmd, k_node_product_, s_node_product_, nodes_ * S, nodes_);
 }
 
@@ -264,8 +272,7 @@ void VulkanEnsemble::record_cg_iterations(VkCommandBuffer cmd, int count) const 
   const std::uint32_t groups = static_cast<std::uint32_t>(S_ * cg_partitions_);
   for (int i = 0; i < count; ++i) {
     if (node_iteration_) {
-      dispatch_items(cmd, k_element_product_, s_product_cg_, elements_ * static_cast<std::size_t>(S_),
-                     elements_);
+      dispatch_items(cmd, k_element_product_, s_product_cg_, element_items(), elements_);
       device_.dispatch(cmd, k_cg_node_iteration_, s_cg_node_iteration_, &push, groups);
     } else if (cg_partitioned_) {
       record_system_product(cmd, s_product_cg_);
@@ -370,10 +377,10 @@ StepReport VulkanEnsemble::advance(const Eigen::Vector3d& so_position) {
     shift_stale_ = false;
   }
   device_.barrier(cmd);
-  dispatch_items(cmd, k_element_rhs_, s_element_rhs_, elements_ * S, elements_);
+  dispatch_items(cmd, k_element_rhs_, s_element_rhs_, element_items(), elements_);
   dispatch_items(cmd, k_node_rhs_, s_node_rhs_, nodes_ * S, nodes_);
   // The warm start's products K_e dv_e; cg_start gathers them itself.
-  dispatch_items(cmd, k_element_product_, s_product_warm_start_, elements_ * S, elements_);
+  dispatch_items(cmd, k_element_product_, s_product_warm_start_, element_items(), elements_);
   PushConstants push;
   push.S = static_cast<std::uint32_t>(S_);
   push.count = static_cast<std::uint32_t>(nodes_);

@@ -73,6 +73,8 @@ class VulkanEnsemble : public DeviceEnsemble {
   bool texel_reads() const { return device_.texel_reads(); }
   // Whether a CG iteration is two dispatches (cg_node_iteration forms q = A d), not three.
   bool node_iteration() const { return node_iteration_; }
+  // Whether the element shaders take four sigma points a lane (kernels/vulkan/sigma_quads.h).
+  bool sigma_quads() const { return sigma_quads_; }
   // Host waits (command-buffer submissions) of the last advance().
   int last_step_waits() const { return last_step_waits_; }
   // Whether CG is preconditioned by a factor (vulkan_uses_factor), its factorisations so far
@@ -110,6 +112,8 @@ class VulkanEnsemble : public DeviceEnsemble {
   // With the V-cycle: z = M^-1 r over Jacobi's, then cg_preconditioned (r.z; at the start d = z).
   void record_multigrid(VkCommandBuffer cmd, bool start) const;
   void record_system_product(VkCommandBuffer cmd, VkDescriptorSet element_product_set) const;
+  // Lanes of the element shaders: elements x S, or x S / 4 with sigma quads.
+  std::size_t element_items() const;
   // Records what set_parameters() and recenter() left for the next submission; flush_pending()
   // submits it alone, before a read-out.
   bool has_pending() const;
@@ -120,6 +124,7 @@ class VulkanEnsemble : public DeviceEnsemble {
   std::uint32_t cg_group_ = 64;              // work-items per sigma point in the CG shaders
   int cg_partitions_ = 1;                    // work-groups per sigma point in them (constant 1)
   bool node_iteration_ = false;              // CG iterations by element_product and cg_node_iteration
+  bool sigma_quads_ = false;                 // element shaders four sigma points a lane
   bool cg_partitioned_ = false;              // CG in the partitions' shaders (P > 1, or the V-cycle)
   int last_step_waits_ = 0;
   // The observations gathered at the end of the last advance(), until recenter() moves x.

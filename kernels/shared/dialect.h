@@ -27,6 +27,9 @@
 #  define SF_INDEX(x) static_cast<std::size_t>(x)
 #  define SF_UINT(x) static_cast<unsigned int>(x)
 #  define SF_LOAD(a, i) (a)[i]
+#  define SF_SELECT(cond, a, b) ((cond) ? (a) : (b))
+#  define SF_NONZERO(x) ((x) != SF_LIT(0.0))
+#  define SF_POSITIVE(x) ((x) > SF_LIT(0.0))
 typedef unsigned int uint;
 #elif defined(__OPENCL_VERSION__) /* OpenCL C on PoCL or a GPU driver */
 #  ifndef SF_REAL
@@ -48,6 +51,9 @@ typedef unsigned int uint;
 #  define SF_INDEX(x) ((size_t)(x))
 #  define SF_UINT(x) ((uint)(x))
 #  define SF_LOAD(a, i) (a)[i]
+#  define SF_SELECT(cond, a, b) ((cond) ? (a) : (b))
+#  define SF_NONZERO(x) ((x) != SF_LIT(0.0))
+#  define SF_POSITIVE(x) ((x) > SF_LIT(0.0))
 #elif defined(VULKAN) /* GLSL through glslang for Vulkan */
 #  ifndef SF_REAL
 #    define SF_REAL float
@@ -68,6 +74,15 @@ typedef unsigned int uint;
 #    define SF_LOAD(a, i) sf_texel(a, uint(i))
 #  else
 #    define SF_LOAD(a, i) a[i]
+#  endif
+#  if defined(SF_SIGMA_QUADS)
+#    define SF_SELECT(cond, a, b) mix((b), (a), (cond))
+#    define SF_NONZERO(x) notEqual((x), SF_LIT(0.0))
+#    define SF_POSITIVE(x) greaterThan((x), SF_LIT(0.0))
+#  else
+#    define SF_SELECT(cond, a, b) ((cond) ? (a) : (b))
+#    define SF_NONZERO(x) ((x) != SF_LIT(0.0))
+#    define SF_POSITIVE(x) ((x) > SF_LIT(0.0))
 #  endif
 #else
 #  error "dialect.h: expected C++, OpenCL C or Vulkan GLSL"

@@ -131,7 +131,7 @@ SF_FN SF_REAL sf_inverse_transpose3(SF_IN(X, 9), SF_OUT(Y, 9)) {
   C[7] = X[2] * X[3] - X[0] * X[5];
   C[8] = X[0] * X[4] - X[1] * X[3];
   SF_REAL det = X[0] * C[0] + X[1] * C[1] + X[2] * C[2];
-  SF_REAL inverse = det != SF_LIT(0.0) ? SF_LIT(1.0) / det : SF_LIT(0.0);
+  SF_REAL inverse = SF_SELECT(SF_NONZERO(det), SF_LIT(1.0) / det, SF_LIT(0.0));
   SF_UNROLL
   for (int i = 0; i < 9; ++i) Y[i] = C[i] * inverse;
   return det;
@@ -161,7 +161,7 @@ SF_FN void sf_element_polar_frame(SF_IN(grad, 12), SF_IN(p, 12), SF_OUT(frame, 9
   SF_REAL qr[9];
   sf_element_frame(p, qr);
   sf_element_gradient(grad, p, SF_LIT(1.0), X);
-  SF_REAL proper = sf_inverse_transpose3(X, Y) > SF_LIT(0.0) ? SF_LIT(1.0) : SF_LIT(0.0);
+  SF_REAL proper = SF_SELECT(SF_POSITIVE(sf_inverse_transpose3(X, Y)), SF_LIT(1.0), SF_LIT(0.0));
   SF_UNROLL
   for (int i = 0; i < 9; ++i) {
     X[i] *= proper;

@@ -8,6 +8,44 @@
 #include "ensemble_layout.h"
 
 layout(local_size_x = SF_ITEMS_PER_GROUP) in;
+#if defined(SF_SIGMA_QUADS) /* four sigma points a lane: sigma_quads.h */
+#include "sigma_quads.h"
+SF_READ_INTS(SF_ELEMENT_PRODUCT_ELEMENT_NODES, nodes)
+SF_READ_QUADS(SF_ELEMENT_PRODUCT_ELEMENT_REST, rest)
+SF_READ_QUADS(SF_ELEMENT_PRODUCT_FRAMES, frames)
+SF_READ_QUADS(SF_ELEMENT_PRODUCT_D, d)
+SF_READ_UINTS(SF_ELEMENT_PRODUCT_ACTIVE, active_flags)
+SF_WRITE_QUADS(SF_ELEMENT_PRODUCT_ELEMENT_OUT, element_out)
+SF_READ_REALS(SF_ELEMENT_PRODUCT_CONSTANTS, c)
+
+void main() {
+  uint S = sf_push.S;
+  uint Q = S / 4u;
+  uint gid = sf_global_id();
+  if (gid >= sf_push.count * Q) return;
+  uint e = gid / Q;
+  uint q = gid % Q;
+  bvec4 running = notEqual(uvec4(SF_LOAD(active_flags, 4u * q), SF_LOAD(active_flags, 4u * q + 1u),
+                                SF_LOAD(active_flags, 4u * q + 2u), SF_LOAD(active_flags, 4u * q + 3u)),
+                          uvec4(0u));
+  /* None of the four iterating: nothing to do. Else all four are formed and stored: a sigma
+   * point whose CG is done is skipped by every shader that reads them (conjugate_gradient.comp),
+   * and a masked store costs llvmpipe a loop over its lanes for each value. */
+  if (!any(running)) return;
+  SF_REAL grad[12];
+  SF_REAL sigma_lambda;
+  SF_REAL sigma_mu;
+  uint corner_nodes[4];
+  SF_QUAD_ELEMENT(rest, nodes, c, e, q, S, grad, sigma_lambda, sigma_mu, corner_nodes)
+  SF_REAL frame[9];
+  SF_REAL corner[12];
+  SF_REAL product[12];
+  for (uint i = 0u; i < 9u; ++i) frame[i] = SF_QUAD(frames, (9u * e + i) * Q + q);
+  SF_GATHER_CORNER_QUADS(d, corner_nodes, q, Q, corner)
+  sf_element_product(frame, grad, sigma_lambda, sigma_mu, corner, product);
+  for (uint i = 0u; i < 12u; ++i) element_out[(12u * e + i) * Q + q] = product[i];
+}
+#else /* a sigma point a lane */
 SF_READ_INTS(SF_ELEMENT_PRODUCT_ELEMENT_NODES, nodes)
 SF_READ_REALS(SF_ELEMENT_PRODUCT_ELEMENT_REST, rest)
 SF_READ_REALS(SF_ELEMENT_PRODUCT_FRAMES, frames)
@@ -39,3 +77,4 @@ void main() {
   sf_element_product(frame, grad, sigma_lambda, sigma_mu, corner, product);
   SF_STORE_CORNERS(element_out, e, s, S, product)
 }
+#endif

@@ -10,6 +10,45 @@
 #include "ensemble_layout.h"
 
 layout(local_size_x = SF_ITEMS_PER_GROUP) in;
+#if defined(SF_SIGMA_QUADS) /* four sigma points a lane: sigma_quads.h */
+#include "sigma_quads.h"
+SF_READ_INTS(SF_ELEMENT_RHS_ELEMENT_NODES, nodes)
+SF_READ_QUADS(SF_ELEMENT_RHS_ELEMENT_REST, rest)
+SF_WRITE_QUADS(SF_ELEMENT_RHS_FRAMES, frames)
+SF_READ_QUADS(SF_ELEMENT_RHS_X, x)
+SF_READ_QUADS(SF_ELEMENT_RHS_V, v)
+SF_READ_REALS(SF_ELEMENT_RHS_CONSTANTS, c)
+SF_WRITE_QUADS(SF_ELEMENT_RHS_ELEMENT_OUT, element_out)
+SF_WRITE_QUADS(SF_ELEMENT_RHS_ELEMENT_DIAGONAL, element_diagonal)
+
+void main() {
+  uint S = sf_push.S;
+  uint Q = S / 4u;
+  uint gid = sf_global_id();
+  if (gid >= sf_push.count * Q) return;
+  uint e = gid / Q;
+  uint q = gid % Q;
+  SF_REAL grad[12];
+  SF_REAL sigma_lambda;
+  SF_REAL sigma_mu;
+  uint corner_nodes[4];
+  SF_QUAD_ELEMENT(rest, nodes, c, e, q, S, grad, sigma_lambda, sigma_mu, corner_nodes)
+  SF_REAL frame[9];
+  SF_REAL corner[12];
+  SF_REAL force[12];
+  SF_REAL product[12];
+  SF_GATHER_CORNER_QUADS(x, corner_nodes, q, Q, corner)
+  sf_element_rotation(grad, corner, SF_REAL(SF_LOAD(c, SF_POLAR_ROTATION)), frame);
+  for (uint i = 0u; i < 9u; ++i) frames[(9u * e + i) * Q + q] = frame[i];
+  sf_element_force(frame, grad, sigma_lambda, sigma_mu, corner, force);
+  SF_GATHER_CORNER_QUADS(v, corner_nodes, q, Q, corner)
+  sf_element_product(frame, grad, sigma_lambda, sigma_mu, corner, product);
+  SF_REAL velocity_factor = SF_QUAD_CONSTANT(c, SF_VELOCITY_FACTOR, q, S);
+  for (uint i = 0u; i < 12u; ++i) element_out[(12u * e + i) * Q + q] = force[i] - velocity_factor * product[i];
+  sf_element_diagonal(frame, grad, sigma_lambda, sigma_mu, product);
+  for (uint i = 0u; i < 12u; ++i) element_diagonal[(12u * e + i) * Q + q] = product[i];
+}
+#else /* a sigma point a lane */
 SF_READ_INTS(SF_ELEMENT_RHS_ELEMENT_NODES, nodes)
 SF_READ_REALS(SF_ELEMENT_RHS_ELEMENT_REST, rest)
 layout(std430, binding = SF_ELEMENT_RHS_FRAMES) restrict writeonly buffer Frames { real frames[]; };
@@ -48,3 +87,4 @@ void main() {
   sf_element_diagonal(frame, grad, sigma_lambda, sigma_mu, product);
   SF_STORE_CORNERS(element_diagonal, e, s, S, product)
 }
+#endif

@@ -7,8 +7,20 @@
 #ifndef SIGMAFEM_VULKAN_ENSEMBLE_LAYOUT_H
 #define SIGMAFEM_VULKAN_ENSEMBLE_LAYOUT_H
 
+/* SF_SCALAR a buffer's real; SF_REAL the arithmetic's (dialect.h, element.h): the same, or
+ * in the sigma-quad shaders (SF_SIGMA_QUADS: kernels/vulkan/element_rhs.comp) a vector of
+ * four sigma points. */
 #ifdef SF_USE_DOUBLE
-#  define SF_REAL double
+#  define SF_SCALAR double
+#  define SF_SCALAR4 dvec4
+#else
+#  define SF_SCALAR float
+#  define SF_SCALAR4 vec4
+#endif
+#ifdef SF_SIGMA_QUADS
+#  define SF_REAL SF_SCALAR4
+#else
+#  define SF_REAL SF_SCALAR
 #endif
 
 #include "device_layout.h"
@@ -16,7 +28,7 @@
 #include "step_constants.h"
 
 /* GLSL has no typedef. */
-#define real SF_REAL
+#define real SF_SCALAR
 
 /* The arrays a shader only reads, declared with SF_READ_REALS/INTS/UINTS(binding, name) and
  * read with SF_LOAD(name, index) (dialect.h): storage buffers, or, in the shaders compiled

@@ -43,6 +43,24 @@ TEST(SpirvBindings, TheTexelVariantReadsItsReadOnlyArraysAsTexelsOfTheirType) {
   EXPECT_EQ(double_bindings.at(SF_ELEMENT_PRODUCT_ELEMENT_OUT), SpirvBinding::storage_buffer);
 }
 
+// The sigma-quad element shaders (kernels/vulkan/sigma_quads.h) read their per-sigma arrays
+// and the rest state four floats a texel: samplerBuffers named *_rgba; the constants, nodes
+// and flags one a texel. In float64 (no texel of four doubles) the scalar kinds.
+TEST(SpirvBindings, SamplerBuffersNamedRgbaAreTexelsOfFourFloats) {
+  const EmbeddedShader& shader = embedded("element_product_quads", false, true);
+  const auto bindings = spirv_bindings(shader.words, shader.word_count);
+  EXPECT_EQ(bindings.at(SF_ELEMENT_PRODUCT_ELEMENT_REST), SpirvBinding::float4_texels);
+  EXPECT_EQ(bindings.at(SF_ELEMENT_PRODUCT_FRAMES), SpirvBinding::float4_texels);
+  EXPECT_EQ(bindings.at(SF_ELEMENT_PRODUCT_D), SpirvBinding::float4_texels);
+  EXPECT_EQ(bindings.at(SF_ELEMENT_PRODUCT_CONSTANTS), SpirvBinding::float_texels);
+  EXPECT_EQ(bindings.at(SF_ELEMENT_PRODUCT_ELEMENT_NODES), SpirvBinding::int_texels);
+  EXPECT_EQ(bindings.at(SF_ELEMENT_PRODUCT_ACTIVE), SpirvBinding::uint_texels);
+  EXPECT_EQ(bindings.at(SF_ELEMENT_PRODUCT_ELEMENT_OUT), SpirvBinding::storage_buffer);
+  const EmbeddedShader& doubles = embedded("element_product_quads", true, true);
+  EXPECT_EQ(spirv_bindings(doubles.words, doubles.word_count).at(SF_ELEMENT_PRODUCT_FRAMES),
+            SpirvBinding::uint_texels);
+}
+
 TEST(SpirvBindings, TheStorageVariantsReadStorageBuffersOnly) {
   for (const bool double_precision : {false, true}) {
     const EmbeddedShader& shader = embedded("element_product", double_precision, false);

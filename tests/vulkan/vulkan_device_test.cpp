@@ -212,6 +212,52 @@ TEST_F(VulkanDeviceTest, CgInTwoDispatchesGivesTheBitsOfThree) {
   }
 }
 
+// The element shaders four sigma points a lane (kernels/vulkan/sigma_quads.h; S a multiple
+// of 4, the CPU form) do per component what the one-a-lane shaders do: the same bits, with
+// the QR and the polar frames (its selects per component), in float and double, at S = 8 (two
+// quads an element); at S = 6 the ensemble keeps one a lane.
+TEST_F(VulkanDeviceTest, ElementShadersOnSigmaQuadsGiveTheBitsOfOneALane) {
+  Scenario scenario = load_scenario(std::string(SIGMAFEM_SOURCE_DIR) + "/scenarios/liver.json");
+  const std::vector<int>& estimated = scenario.filter->estimate;
+  const int p = static_cast<int>(estimated.size());
+  for (const ElementRotation rotation : {ElementRotation::qr, ElementRotation::polar}) {
+    scenario.material.rotation = rotation;
+    const Model model = make_model(scenario);
+    for (const Precision precision : {Precision::single, Precision::double_precision}) {
+      const std::string what = std::string(rotation == ElementRotation::polar ? "polar" : "qr") +
+                               (precision == Precision::single ? ", float" : ", double");
+      DeviceOptions quads, lanes;
+      quads.precision = lanes.precision = precision;
+      lanes.sigma_quads = false;
+      const int S = 8;
+      VulkanEnsemble by_quads(model, estimated, scenario.observations.nodes, S, quads);
+      VulkanEnsemble by_lanes(model, estimated, scenario.observations.nodes, S, lanes);
+      ASSERT_TRUE(by_quads.sigma_quads()) << what;
+      ASSERT_FALSE(by_lanes.sigma_quads()) << what;
+      Eigen::MatrixXd theta(p, S);
+      for (int j = 0; j < p; ++j)
+        for (int s = 0; s < S; ++s)
+          theta(j, s) = std::log(model.ligaments[estimated[j]].stiffness) + 0.3 * std::cos(s + 2 * j);
+      by_quads.set_parameters(theta);
+      by_lanes.set_parameters(theta);
+      for (int k = 1; k <= 6; ++k) {
+        const Eigen::Vector3d so = scenario.control.trajectory.position(k * scenario.time.dt, scenario.control.start);
+        const StepReport a = by_quads.advance(so);
+        const StepReport b = by_lanes.advance(so);
+        EXPECT_EQ(a.unconverged_count(), 0) << what;
+        EXPECT_EQ(a.cg_iterations, b.cg_iterations) << what << ", step " << k;
+      }
+      for (int s = 0; s < S; ++s) {
+        EXPECT_TRUE(by_quads.positions(s) == by_lanes.positions(s)) << what << ", sigma point " << s;
+        EXPECT_TRUE(by_quads.velocities(s) == by_lanes.velocities(s)) << what << ", sigma point " << s;
+      }
+    }
+  }
+  const Model model = make_model(scenario);
+  VulkanEnsemble six(model, estimated, scenario.observations.nodes, 6, DeviceOptions{});
+  EXPECT_FALSE(six.sigma_quads()) << "S = 6 is not a multiple of 4";
+}
+
 // Lavapipe's threads by the ensemble's work (DeviceOptions::lavapipe_serial_work): the box at
 // S = 4 (5376 element-sigma pairs) runs its shaders on the submitting thread (LP_NUM_THREADS
 // "0" while its device is made), the same box asked to take the threads gets lavapipe's default
