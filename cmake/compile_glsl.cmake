@@ -2,8 +2,10 @@
 # build time in four variants (single and double precision, each with storage reads or with
 # texel reads, -DSF_TEXEL_READS: kernels/vulkan/ensemble_layout.h), and embedded as uint32
 # words in the program (cmake/embed_spirv.cmake), so that it needs no shader files at run time.
-# An entry is NAME:SOURCE[:DEFINE]: kernels/vulkan/SOURCE.comp compiled with -DDEFINE (one
-# file may hold several entry shaders, chosen with -D switches). glslang defines VULKAN
+# An entry is NAME:SOURCE[:DEFINE[:ENV]]: kernels/vulkan/SOURCE.comp compiled with -DDEFINE (one
+# file may hold several entry shaders, chosen with -D switches) for Vulkan ENV (vulkan1.0 by
+# default; vulkan1.1 for SPIR-V 1.3's subgroup operations, which the host uses only on a 1.1
+# device that has them). glslang defines VULKAN
 # itself (kernels/shared/dialect.h's Vulkan branch). Rebuilt when a source or any header of
 # kernels/vulkan/ or kernels/shared/ changes.
 find_program(SIGMAFEM_GLSLANG glslangValidator)
@@ -25,10 +27,14 @@ function(sigmafem_compile_glsl output)
     list(GET _parts 0 _name)
     list(GET _parts 1 _source)
     set(_defines "")
+    set(_env vulkan1.0)
     list(LENGTH _parts _count)
     if(_count GREATER 2)
       list(GET _parts 2 _define)
       set(_defines "-D${_define}")
+    endif()
+    if(_count GREATER 3)
+      list(GET _parts 3 _env)
     endif()
     foreach(_precision single double single_texel double_texel)
       set(_spv ${PROJECT_BINARY_DIR}/generated/spirv/${_name}_${_precision}.spv)
@@ -41,7 +47,7 @@ function(sigmafem_compile_glsl output)
       endif()
       add_custom_command(
         OUTPUT ${_spv}
-        COMMAND ${SIGMAFEM_GLSLANG} -V --target-env vulkan1.0 -S comp --quiet ${_defines}
+        COMMAND ${SIGMAFEM_GLSLANG} -V --target-env ${_env} -S comp --quiet ${_defines}
                 ${_precision_define} -I${_shared} -I${_vulkan} -o ${_spv} ${_vulkan}/${_source}.comp
         DEPENDS ${_vulkan}/${_source}.comp ${_headers}
         COMMENT "glslang: ${_name} (${_precision}) from kernels/vulkan/${_source}.comp"

@@ -37,6 +37,10 @@ struct VulkanDeviceInfo {
   unsigned long long memory = 0;          // bytes of the largest device-local heap
   unsigned long long max_buffer = 0;      // bytes, the largest storage buffer a shader sees
   unsigned long long max_texel_elements = 0;  // texels, the largest texel buffer view
+  // Vulkan 1.1's subgroups (0 and false on a 1.0 device or loader): invocations a subgroup,
+  // and whether compute shaders have subgroupShuffle.
+  unsigned subgroup_size = 0;
+  bool subgroup_shuffle = false;
 };
 
 // Every Vulkan device, in the loader's order. Empty when there is no loader or no driver

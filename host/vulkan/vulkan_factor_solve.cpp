@@ -15,6 +15,9 @@ namespace {
 // does not unroll them) and the step loop: counted, to be safe.
 constexpr long long kStepTurns = 8;
 
+// V's row length on the device: m rounded up to 4 (factor_solve.comp reads 4 at a time).
+std::size_t padded(std::size_t m) { return (m + 3) / 4 * 4; }
+
 }  // namespace
 
 VulkanFactorSolve::VulkanFactorSolve(VulkanDevice& device, int rows, int spring_rows, int sigma_count,
@@ -25,10 +28,19 @@ VulkanFactorSolve::VulkanFactorSolve(VulkanDevice& device, int rows, int spring_
   const std::size_t n = static_cast<std::size_t>(rows), real = device_.real_size();
   const std::size_t m = static_cast<std::size_t>(spring_rows_);
   spring_at_ = make(4 * (2 + n));
-  spring_solves_ = make(real * n * m);
+  spring_solves_ = make(real * n * padded(m));
   spring_coupling_ = make(real * m * m * static_cast<std::size_t>(S_));
-  group_ = static_cast<std::uint32_t>(std::min(S_, kLanes));
-  groups_ = (static_cast<std::uint32_t>(S_) + group_ - 1) / group_;
+  split_ = split_lanes(device_.info(), S_);
+  group_ = static_cast<std::uint32_t>(std::min(S_, kLanes) * split_);
+  groups_ = (static_cast<std::uint32_t>(S_ * split_) + group_ - 1) / group_;
+}
+
+int VulkanFactorSolve::split_lanes(const VulkanDeviceInfo& info, int sigma_count) {
+  if (!info.subgroup_shuffle || sigma_count <= 0) return 1;
+  const int lanes = std::min<int>(kLanes, static_cast<int>(info.subgroup_size));
+  int split = 1;
+  while (2 * split * sigma_count <= lanes) split *= 2;
+  return split;
 }
 
 VulkanBuffer VulkanFactorSolve::make(std::size_t bytes) {
@@ -46,8 +58,9 @@ void VulkanFactorSolve::make_layout(const Eigen::SparseMatrix<double>& L, const 
   const FactorBlocks& b = *layout->blocks;
   const std::size_t P = static_cast<std::size_t>(b.panels()), B = std::max<std::size_t>(b.blocks(), 1);
   const std::size_t vec4 = 4 * device_.real_size();
-  // y's 4 P slots, then V^T y and H V^T y (factor_solve.comp), S times.
-  const std::size_t work_texels = P + (2 * static_cast<std::size_t>(spring_rows_) + 3) / 4;
+  // y's 4 P slots, then V^T y and H V^T y (factor_solve.comp), S times, a copy per lane of a
+  // sigma point.
+  const std::size_t work_texels = P + 2 * padded(static_cast<std::size_t>(spring_rows_)) / 4;
   layout->forward_starts = make(4 * (P + 1));
   layout->forward_panel = make(4 * B);
   layout->backward_starts = make(4 * (P + 1));
@@ -56,13 +69,14 @@ void VulkanFactorSolve::make_layout(const Eigen::SparseMatrix<double>& L, const 
   layout->triangles = make(vec4 * 4 * P);
   layout->forward_blocks = make(vec4 * 4 * B);
   layout->backward_blocks = make(vec4 * 4 * B);
-  layout->work = make(vec4 * work_texels * static_cast<std::size_t>(S_));
+  layout->work = make(vec4 * work_texels * static_cast<std::size_t>(S_ * split_));
   upload_ints(layout->forward_starts, b.forward_starts());
   upload_ints(layout->forward_panel, b.forward_panel());
   upload_ints(layout->backward_starts, b.backward_starts());
   upload_ints(layout->backward_panel, b.backward_panel());
   upload_ints(layout->slot_rows, b.slot_rows());
-  layout->kernel = device_.kernel("factor_solve", SF_FACTOR_SOLVE_WORK + 1, group_, static_cast<std::uint32_t>(P));
+  layout->kernel = device_.kernel(split_ > 1 ? "factor_solve_split" : "factor_solve", SF_FACTOR_SOLVE_WORK + 1,
+                                  group_, static_cast<std::uint32_t>(P));
   const Layout& l = *layout;
   layout->set = device_.bind(l.kernel, {l.forward_starts, l.forward_panel, l.backward_starts, l.backward_panel,
                                         l.slot_rows, r_, z_, active_, spring_at_, spring_solves_, spring_coupling_,
@@ -102,11 +116,12 @@ bool VulkanFactorSolve::upload_springs(const SpringCorrection& springs) {
                       "); the Vulkan buffers hold " + std::to_string(spring_rows_));
   // A step of the correction sums over the reached rows or over m (factor_solve.comp).
   const long long longest = std::max<long long>(springs.size(), static_cast<long long>(springs.reached().size()));
-  if (longest + 2 > loop_turns_) return false;
+  if (longest + 5 > loop_turns_) return false;
   const Eigen::MatrixXd& V = springs.reached_values();
-  std::vector<double> values(static_cast<std::size_t>(V.size()));   // by rows
+  const std::size_t M = padded(static_cast<std::size_t>(V.cols()));
+  std::vector<double> values(static_cast<std::size_t>(V.rows()) * M, 0.0);   // by rows, zeros after m
   for (Eigen::Index u = 0; u < V.rows(); ++u)
-    for (Eigen::Index j = 0; j < V.cols(); ++j) values[static_cast<std::size_t>(u * V.cols() + j)] = V(u, j);
+    for (Eigen::Index j = 0; j < V.cols(); ++j) values[static_cast<std::size_t>(u) * M + static_cast<std::size_t>(j)] = V(u, j);
   device_.upload_reals(spring_solves_, values);
   upload_spring_rows(springs.size(), springs.reached());
   return true;
@@ -149,9 +164,10 @@ void VulkanFactorSolve::plan_dispatches() {
   const auto [m, reached] = spring_steps_;
   std::vector<long long> turns;
   for (int q = 0; q < b.panels(); ++q) turns.push_back(b.forward_starts()[q + 1] - b.forward_starts()[q] + kStepTurns);
-  turns.insert(turns.end(), static_cast<std::size_t>(m), reached + 2);   // (V^T y)_j
-  turns.insert(turns.end(), static_cast<std::size_t>(m), m + 2);         // (H V^T y)_j
-  turns.insert(turns.end(), static_cast<std::size_t>(reached), m + 2);   // y -= V H V^T y, a slot
+  const long long quads = static_cast<long long>(padded(static_cast<std::size_t>(m)) / 4);
+  turns.insert(turns.end(), static_cast<std::size_t>(quads), reached + 2);   // (V^T y)_4i..4i+3
+  turns.insert(turns.end(), static_cast<std::size_t>(m), m + 5);             // (H V^T y)_j, the padding
+  turns.insert(turns.end(), static_cast<std::size_t>(reached), quads + 2);   // y -= V H V^T y, a slot
   for (int p = b.panels() - 1; p >= 0; --p)
     turns.push_back(b.backward_starts()[p + 1] - b.backward_starts()[p] + kStepTurns);
   long long sum = 0;

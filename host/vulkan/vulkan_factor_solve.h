@@ -23,8 +23,14 @@ namespace sigmafem {
 
 class VulkanFactorSolve {
  public:
-  // Sigma points a work-group of factor_solve takes: llvmpipe's 256-bit vector of floats.
+  // Lanes of a work-group of factor_solve: llvmpipe's 256-bit vector of floats.
   static constexpr int kLanes = 8;
+  // Lanes a sigma point of `sigma_count` gets (factor_solve_split, kernels/vulkan/
+  // factor_solve.comp): the most, a power of 2, that leave the group in kLanes and in one
+  // subgroup, on a device with subgroup shuffles; else 1. On lavapipe (subgroups of 8): 8 at
+  // S = 1, 4 at S = 2, 2 at S = 3 or 4, 1 from 5.
+  static int split_lanes(const VulkanDeviceInfo& info, int sigma_count);
+  int split() const { return split_; }
 
   // For a factor of n rows and `sigma_count` sigma points, with a correction for each one's
   // springs at `spring_rows` rows (m; 0: none); r, z and the active flags are CG's buffers,
@@ -94,6 +100,7 @@ class VulkanFactorSolve {
   std::pair<int, int> spring_steps_{0, 0};
   std::vector<std::pair<std::uint32_t, std::uint32_t>> ranges_;
   std::uint32_t group_ = 1, groups_ = 1;
+  int split_ = 1;                           // lanes a sigma point (split_lanes)
 };
 
 }  // namespace sigmafem

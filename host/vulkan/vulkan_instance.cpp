@@ -65,6 +65,8 @@ std::shared_ptr<VulkanApi> open_loader(std::string& why) {
     why = "the Vulkan loader lacks vkCreateInstance";
     return nullptr;
   }
+  api->vkEnumerateInstanceVersion = reinterpret_cast<PFN_vkEnumerateInstanceVersion>(
+      api->vkGetInstanceProcAddr(VK_NULL_HANDLE, "vkEnumerateInstanceVersion"));
   keep_drivers_loaded(*api);
   return api;
 }
@@ -130,7 +132,12 @@ VulkanInstance create_vulkan_instance(std::string& why, bool with_validation) {
   VkApplicationInfo app{};
   app.sType = VK_STRUCTURE_TYPE_APPLICATION_INFO;
   app.pApplicationName = "sigmafem";
-  app.apiVersion = VK_API_VERSION_1_0;
+  // Vulkan 1.1 where the loader has it: SPIR-V 1.3's subgroup operations (factor_solve_split)
+  // on the devices that have 1.1 too; a 1.0 loader would refuse the instance.
+  std::uint32_t loader_version = VK_API_VERSION_1_0;
+  if (api.vkEnumerateInstanceVersion && api.vkEnumerateInstanceVersion(&loader_version) != VK_SUCCESS)
+    loader_version = VK_API_VERSION_1_0;
+  app.apiVersion = loader_version >= VK_API_VERSION_1_1 ? VK_API_VERSION_1_1 : VK_API_VERSION_1_0;
   VkInstanceCreateInfo create{};
   create.sType = VK_STRUCTURE_TYPE_INSTANCE_CREATE_INFO;
   create.pApplicationInfo = &app;
@@ -171,6 +178,7 @@ VulkanInstance create_vulkan_instance(std::string& why, bool with_validation) {
     return result;
   }
   api.load(result.instance);
+  if (app.apiVersion < VK_API_VERSION_1_1) api.vkGetPhysicalDeviceProperties2 = nullptr;   // not ours to call
   if (validation && api.vkCreateDebugUtilsMessengerEXT) {
     messenger.pNext = nullptr;
     if (api.vkCreateDebugUtilsMessengerEXT(result.instance, &messenger, nullptr,
@@ -218,6 +226,17 @@ VulkanDeviceInfo describe_vulkan_device(const VulkanApi& api, VkPhysicalDevice d
       info.memory = std::max<unsigned long long>(info.memory, memory.memoryHeaps[h].size);
   info.max_buffer = properties.limits.maxStorageBufferRange;
   info.max_texel_elements = properties.limits.maxTexelBufferElements;
+  if (api.vkGetPhysicalDeviceProperties2 && properties.apiVersion >= VK_API_VERSION_1_1) {
+    VkPhysicalDeviceSubgroupProperties subgroup{};
+    subgroup.sType = VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_SUBGROUP_PROPERTIES;
+    VkPhysicalDeviceProperties2 properties2{};
+    properties2.sType = VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_PROPERTIES_2;
+    properties2.pNext = &subgroup;
+    api.vkGetPhysicalDeviceProperties2(device, &properties2);
+    info.subgroup_size = subgroup.subgroupSize;
+    info.subgroup_shuffle = (subgroup.supportedStages & VK_SHADER_STAGE_COMPUTE_BIT) != 0 &&
+                            (subgroup.supportedOperations & VK_SUBGROUP_FEATURE_SHUFFLE_BIT) != 0;
+  }
   return info;
 }
 

@@ -83,6 +83,10 @@ struct VulkanApi {
 #undef SF_DECLARE
   PFN_vkCreateDebugUtilsMessengerEXT vkCreateDebugUtilsMessengerEXT = nullptr;
   PFN_vkDestroyDebugUtilsMessengerEXT vkDestroyDebugUtilsMessengerEXT = nullptr;
+  // Vulkan 1.1's, null on a 1.0 loader or instance: the loader's version, and the subgroup
+  // properties (factor_solve's split block rows, host/vulkan/vulkan_factor_solve.h).
+  PFN_vkEnumerateInstanceVersion vkEnumerateInstanceVersion = nullptr;
+  PFN_vkGetPhysicalDeviceProperties2 vkGetPhysicalDeviceProperties2 = nullptr;
 
   // Loads the instance-level functions (device functions too, through the loader's
   // trampolines) for `instance`.
@@ -94,6 +98,8 @@ struct VulkanApi {
         vkGetInstanceProcAddr(instance, "vkCreateDebugUtilsMessengerEXT"));
     vkDestroyDebugUtilsMessengerEXT = reinterpret_cast<PFN_vkDestroyDebugUtilsMessengerEXT>(
         vkGetInstanceProcAddr(instance, "vkDestroyDebugUtilsMessengerEXT"));
+    vkGetPhysicalDeviceProperties2 = reinterpret_cast<PFN_vkGetPhysicalDeviceProperties2>(
+        vkGetInstanceProcAddr(instance, "vkGetPhysicalDeviceProperties2"));
   }
 };
 

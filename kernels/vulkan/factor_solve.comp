@@ -20,12 +20,13 @@
  * 65535 times (gallivm's LP_MAX_TGSI_LOOP_ITERATIONS; bench/RESULTS.md, stop 52). So the
  * solve is a sequence of steps, each a short loop, and one dispatch does a range of them, cut
  * by the host to a bound of loop turns (push constants: count = the first step, p = one past
- * the last; S the sigma points). The steps, with P panels and m spring rows reaching u slots:
- *   [0, P)                    the forward block rows
- *   [P, P + m)                V^T y, a sum over the u slots each
- *   [P + m, P + 2m)           H_s V^T y, a sum over m each
- *   [P + 2m, P + 2m + u)      y -= V H_s V^T y at one reached slot each
- *   [P + 2m + u, 2P + 2m + u) the backward block columns, from the last.
+ * the last; S the sigma points). The steps, with P panels and m spring rows reaching u slots
+ * (V by rows, each padded with zeros to M = m rounded up to 4, and read 4 at a time):
+ *   [0, P)                          the forward block rows
+ *   [P, P + M/4)                    V^T y, 4 of its m at a time, a sum over the u slots each
+ *   [P + M/4, P + M/4 + m)          H_s V^T y, a sum over m each
+ *   [P + M/4 + m, ... + u)          y -= V H_s V^T y at one reached slot each, M/4 turns
+ *   [P + M/4 + m + u, 2P + ... + u) the backward block columns, from the last.
  * An inactive sigma point (CG done) is left alone.
  *
  * In float32, y and the blocks are rgba32f storage texel buffers: llvmpipe loads a storage
@@ -33,6 +34,9 @@
  * RESULTS.md, stop 53); in float64 (no 64-bit texel format) storage buffers. */
 #version 450
 #extension GL_GOOGLE_include_directive : require
+#if defined(SF_SPLIT_BLOCK_ROWS)
+#  extension GL_KHR_shader_subgroup_shuffle : require
+#endif
 #include "ensemble_layout.h"
 
 layout(local_size_x_id = 0) in;
@@ -48,7 +52,6 @@ SF_READ_REALS(SF_FACTOR_SOLVE_R, r)
 layout(std430, binding = SF_FACTOR_SOLVE_Z) restrict writeonly buffer Z { real z[]; };
 SF_READ_UINTS(SF_FACTOR_SOLVE_ACTIVE, active_flags)
 SF_READ_INTS(SF_FACTOR_SOLVE_SPRING_AT, spring_at)
-SF_READ_REALS(SF_FACTOR_SOLVE_SPRING_SOLVES, spring_solves)
 SF_READ_REALS(SF_FACTOR_SOLVE_SPRING_COUPLING, spring_coupling)
 #if defined(SF_USE_DOUBLE)
 #  define real4 dvec4
@@ -56,6 +59,8 @@ layout(std430, binding = SF_FACTOR_SOLVE_TRIANGLES) restrict readonly buffer Tri
 layout(std430, binding = SF_FACTOR_SOLVE_FORWARD_BLOCKS) restrict readonly buffer Forward { dvec4 forward_blocks[]; };
 layout(std430, binding = SF_FACTOR_SOLVE_BACKWARD_BLOCKS) restrict readonly buffer Backward { dvec4 backward_blocks[]; };
 layout(std430, binding = SF_FACTOR_SOLVE_WORK) restrict buffer Work { dvec4 y[]; };
+layout(std430, binding = SF_FACTOR_SOLVE_SPRING_SOLVES) restrict readonly buffer SpringSolves { dvec4 spring_solves[]; };
+#  define SF_V4(i) spring_solves[i]
 #  define SF_COLUMN(blocks, i) blocks[i]
 #  define SF_Y4(t) y[t]
 #  define SF_SET_Y4(t, value) y[t] = (value)
@@ -65,17 +70,44 @@ layout(binding = SF_FACTOR_SOLVE_TRIANGLES, rgba32f) uniform restrict readonly i
 layout(binding = SF_FACTOR_SOLVE_FORWARD_BLOCKS, rgba32f) uniform restrict readonly imageBuffer forward_blocks;
 layout(binding = SF_FACTOR_SOLVE_BACKWARD_BLOCKS, rgba32f) uniform restrict readonly imageBuffer backward_blocks;
 layout(binding = SF_FACTOR_SOLVE_WORK, rgba32f) uniform restrict imageBuffer y;
+/* V, 4 of a row a texel ("_rgba": host/vulkan/spirv_bindings.h). */
+layout(binding = SF_FACTOR_SOLVE_SPRING_SOLVES) uniform samplerBuffer spring_solves_rgba;
+#  define SF_V4(i) texelFetch(spring_solves_rgba, int(i))
 #  define SF_COLUMN(blocks, i) imageLoad(blocks, int(i))
 #  define SF_Y4(t) imageLoad(y, int(t))
 #  define SF_SET_Y4(t, value) imageStore(y, int(t), value)
 #endif
 
 uint S, s;
+/* The split (SF_SPLIT_BLOCK_ROWS, factor_solve_split: with S of at most 4, H = G / S lanes a
+ * sigma point, h this lane's part): a block row's (or column's) blocks are shared out, lane h
+ * taking every H-th from its h-th, so that each lane turns a H-th as often; the H partial sums
+ * are added by subgroup shuffles (the group is one subgroup: the host's condition), in lane
+ * order, the same total in each of the H lanes. Each lane keeps its own copy of y (H copies,
+ * [(t H + h) S + s]), which it alone reads and writes: the lanes share nothing but the
+ * shuffles. Where the sigma points fill the lanes already, one lane a sigma point (H = 1). */
+uint H, h;
+
+/* The quad t (4 slots) of y: this lane's copy for its sigma point. */
+uint y_quad(uint t) { return (t * H + h) * S + s; }
+/* The sum of the H lanes' partial sums of this lane's sigma point, in lane order. */
+real4 add_parts(real4 part) {
+#if defined(SF_SPLIT_BLOCK_ROWS)
+  real4 total = real4(0);
+  for (uint j = 0u; j < 8u; ++j)   /* constant bounds: unrolled, no loop turns */
+    if (j < H) total += subgroupShuffle(part, j * S + s);
+  return total;
+#else
+  return part;
+#endif
+}
+
+real add_parts(real part) { return add_parts(real4(part, 0, 0, 0)).x; }
 
 /* One slot of y, and one set, for this lane's sigma point. */
-real y_at(uint slot) { return SF_Y4((slot >> 2u) * S + s)[slot & 3u]; }
+real y_at(uint slot) { return SF_Y4(y_quad(slot >> 2u))[slot & 3u]; }
 void set_y_at(uint slot, real value) {
-  uint t = (slot >> 2u) * S + s;
+  uint t = y_quad(slot >> 2u);
   real4 four = SF_Y4(t);
   four[slot & 3u] = value;
   SF_SET_Y4(t, four);
@@ -83,25 +115,36 @@ void set_y_at(uint slot, real value) {
 
 void main() {
   S = sf_push.S;
+#if defined(SF_SPLIT_BLOCK_ROWS)   /* one group of H S lanes */
+  H = gl_WorkGroupSize.x / S;
+  s = gl_LocalInvocationID.x % S;
+  h = gl_LocalInvocationID.x / S;
+  if (h >= H || SF_LOAD(active_flags, s) == 0u) return;   /* all H lanes of a sigma point alike */
+#else
+  H = 1u;
+  h = 0u;
   s = gl_WorkGroupID.x * gl_WorkGroupSize.x + gl_LocalInvocationID.x;
   if (s >= S || SF_LOAD(active_flags, s) == 0u) return;
+#endif
   uint P = SF_FACTOR_PANELS;
   uint m = uint(SF_LOAD(spring_at, 0)), reached = uint(SF_LOAD(spring_at, 1));
-  uint projected = P, coupled = P + m, updated = P + 2u * m, backward = P + 2u * m + reached;
-  uint sums = 4u * P;   /* the slot of (V^T y)_0 */
+  uint quads = (m + 3u) / 4u;   /* M / 4 */
+  uint projected = P, coupled = P + quads, updated = P + quads + m, backward = P + quads + m + reached;
+  uint sums = 4u * P;   /* the slot of (V^T y)_0, quad P; (H V^T y)_0 at slot 4 P + M, quad P + M/4 */
   uint first = sf_push.count, last = sf_push.p;
   for (uint q = first; q < min(last, projected); ++q) { /* L y = P r: block row q */
     real4 b;
     for (uint c = 0u; c < 4u; ++c) {   /* constant bounds: unrolled, no loop turns */
       int row = SF_LOAD(slot_rows, 4u * q + c);
-      b[c] = row < 0 ? real(0) : SF_LOAD(r, uint(row) * S + s);
+      b[c] = row < 0 || h > 0u ? real(0) : SF_LOAD(r, uint(row) * S + s);   /* P r once */
     }
-    for (int k = SF_LOAD(forward_starts, q); k < SF_LOAD(forward_starts, q + 1u); ++k) {
-      real4 yp = SF_Y4(uint(SF_LOAD(forward_panel, k)) * S + s);
+    for (int k = SF_LOAD(forward_starts, q) + int(h); k < SF_LOAD(forward_starts, q + 1u); k += int(H)) {
+      real4 yp = SF_Y4(y_quad(uint(SF_LOAD(forward_panel, k))));
       uint at = 4u * uint(k);
       b -= SF_COLUMN(forward_blocks, at) * yp.x + SF_COLUMN(forward_blocks, at + 1u) * yp.y +
            SF_COLUMN(forward_blocks, at + 2u) * yp.z + SF_COLUMN(forward_blocks, at + 3u) * yp.w;
     }
+    b = add_parts(b);
     /* T y_q = b, T's columns t0..t3 lower triangular: y_c, then b -= t_c y_c. */
     real4 t0 = SF_COLUMN(triangles, 4u * q), t1 = SF_COLUMN(triangles, 4u * q + 1u);
     real4 t2 = SF_COLUMN(triangles, 4u * q + 2u), t3 = SF_COLUMN(triangles, 4u * q + 3u);
@@ -112,39 +155,42 @@ void main() {
     b -= t1 * yq.y;
     yq.z = b.z / t2.z;
     yq.w = (b.w - t2.w * yq.z) / t3.w;
-    SF_SET_Y4(q * S + s, yq);
+    SF_SET_Y4(y_quad(q), yq);
   }
-  /* The springs' correction, each sum in a register (no arrays of m per lane). */
-  for (uint step = max(first, projected); step < min(last, coupled); ++step) { /* (V^T y)_j */
-    uint j = step - projected;
-    real sum = real(0);
-    for (uint u = 0u; u < reached; ++u)
-      sum += SF_LOAD(spring_solves, u * m + j) * y_at(uint(SF_LOAD(spring_at, 2u + u)));
-    set_y_at(sums + j, sum);
+  /* The springs' correction, each sum in a register (no arrays of m per lane), shared by the
+   * H lanes as the blocks are. */
+  for (uint step = max(first, projected); step < min(last, coupled); ++step) { /* (V^T y)_4i..4i+3 */
+    uint i = step - projected;
+    real4 sum = real4(0);
+    for (uint u = h; u < reached; u += H) sum += SF_V4(u * quads + i) * y_at(uint(SF_LOAD(spring_at, 2u + u)));
+    SF_SET_Y4(y_quad(P + i), add_parts(sum));   /* padding: V's zeros */
   }
   for (uint step = max(first, coupled); step < min(last, updated); ++step) { /* (H_s V^T y)_j */
     uint j = step - coupled;
     real sum = real(0);
-    for (uint k = 0u; k < m; ++k)
+    for (uint k = h; k < m; k += H)
       sum += SF_LOAD(spring_coupling, (s * m + j) * m + k) * y_at(sums + k);
-    set_y_at(sums + m + j, sum);
+    set_y_at(sums + 4u * quads + j, add_parts(sum));
+    if (j + 1u == m)   /* the padding after it 0, not what the work buffer held */
+      for (uint c = m; c < 4u * quads; ++c) set_y_at(sums + 4u * quads + c, real(0));
   }
   for (uint step = max(first, updated); step < min(last, backward); ++step) { /* y -= V H_s V^T y */
     uint u = step - updated;
     uint at = uint(SF_LOAD(spring_at, 2u + u));
     real sum = real(0);
-    for (uint j = 0u; j < m; ++j) sum += SF_LOAD(spring_solves, u * m + j) * y_at(sums + m + j);
-    set_y_at(at, y_at(at) - sum);
+    for (uint i = h; i < quads; i += H) sum += dot(SF_V4(u * quads + i), SF_Y4(y_quad(P + quads + i)));
+    set_y_at(at, y_at(at) - add_parts(sum));
   }
   for (uint step = max(first, backward); step < last; ++step) { /* L^T w = y: block column p */
     uint p = backward + P - 1u - step;
-    real4 a = SF_Y4(p * S + s);
-    for (int k = SF_LOAD(backward_starts, p); k < SF_LOAD(backward_starts, p + 1u); ++k) {
-      real4 w = SF_Y4(uint(SF_LOAD(backward_panel, k)) * S + s);
+    real4 a = h == 0u ? SF_Y4(y_quad(p)) : real4(0);   /* y_p once */
+    for (int k = SF_LOAD(backward_starts, p) + int(h); k < SF_LOAD(backward_starts, p + 1u); k += int(H)) {
+      real4 w = SF_Y4(y_quad(uint(SF_LOAD(backward_panel, k))));
       uint at = 4u * uint(k);
       a -= real4(dot(SF_COLUMN(backward_blocks, at), w), dot(SF_COLUMN(backward_blocks, at + 1u), w),
                  dot(SF_COLUMN(backward_blocks, at + 2u), w), dot(SF_COLUMN(backward_blocks, at + 3u), w));
     }
+    a = add_parts(a);
     /* T^T w_p = a, from the last: w_c = (a_c - sum_i>c T_ic w_i) / T_cc. */
     real4 t0 = SF_COLUMN(triangles, 4u * p), t1 = SF_COLUMN(triangles, 4u * p + 1u);
     real4 t2 = SF_COLUMN(triangles, 4u * p + 2u), t3 = SF_COLUMN(triangles, 4u * p + 3u);
@@ -153,10 +199,10 @@ void main() {
     wp.z = (a.z - t2.w * wp.w) / t2.z;
     wp.y = (a.y - t1.z * wp.z - t1.w * wp.w) / t1.y;
     wp.x = (a.x - t0.y * wp.y - t0.z * wp.z - t0.w * wp.w) / t0.x;
-    SF_SET_Y4(p * S + s, wp);
+    SF_SET_Y4(y_quad(p), wp);
     for (uint c = 0u; c < 4u; ++c) {
       int row = SF_LOAD(slot_rows, 4u * p + c);
-      if (row >= 0) z[uint(row) * S + s] = wp[c];
+      if (row >= 0 && h == 0u) z[uint(row) * S + s] = wp[c];
     }
   }
 }

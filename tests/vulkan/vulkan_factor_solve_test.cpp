@@ -54,7 +54,7 @@ class VulkanFactorSolveTest : public ::testing::Test {
   // With `springs`, each sigma point's correction for spring_delta(s).
   std::vector<float> device_solve(const std::vector<float>& r, int S, int inactive, bool texel_reads,
                                   long long loop_turns, bool diagonal, int* dispatches = nullptr,
-                                  bool springs = false) {
+                                  bool springs = false, int* split = nullptr) {
     VulkanDevice device(0, Precision::single);
     device.set_texel_reads(texel_reads);
     const std::size_t bytes = r.size() * sizeof(float);
@@ -87,6 +87,7 @@ class VulkanFactorSolveTest : public ::testing::Test {
       couplings_ = couplings;
     }
     if (dispatches) *dispatches = solve.dispatches();
+    if (split) *split = solve.split();
     VkCommandBuffer cmd = device.begin();
     if (springs) {
       solve.record_couplings(cmd, couplings_);
@@ -116,71 +117,103 @@ class VulkanFactorSolveTest : public ::testing::Test {
 };
 
 // Against P^T L^-T L^-1 P r in double from the same L, for S = 11 (a group of 8 and one of
-// 3), in 1000-turn dispatches and in the default's few, texel and storage reads: within
-// float32's rounding, the same bits however the solve is cut, an inactive sigma point untouched.
+// 3) and S = 4, 3 and 1 (on a device with subgroup shuffles, a block row shared by 2, 2 and 8
+// lanes: factor_solve_split), in 1000-turn dispatches and in the default's few, texel and
+// storage reads: within float32's rounding, the same bits however the solve is cut, an
+// inactive sigma point untouched.
 TEST_F(VulkanFactorSolveTest, SolvesAsTheHostFactorInManyDispatchesOrFew) {
-  const int S = 11, inactive = 6;
-  const std::vector<float> r = residuals(S);
   const Eigen::SparseMatrix<double>& L = factor_.lower();
-  for (const bool texel_reads : {true, false}) {
-    int many = 0, few = 0;
-    const std::vector<float> cut = device_solve(r, S, inactive, texel_reads, 1000, false, &many);
-    const std::vector<float> whole = device_solve(r, S, inactive, texel_reads, kFactorLoopTurns, false, &few);
-    EXPECT_GT(many, 20) << "1000 loop turns cut the box's factor into many dispatches";
-    EXPECT_LT(few, many);
-    EXPECT_EQ(0, std::memcmp(cut.data(), whole.data(), cut.size() * sizeof(float)))
-        << "the same sums in the same order, however the solve is cut";
-    for (int s = 0; s < S; ++s) {
-      Eigen::VectorXd y(n_);
-      for (int i = 0; i < n_; ++i) y[factor_.order()[i]] = r[static_cast<std::size_t>(i) * S + s];
-      L.triangularView<Eigen::Lower>().solveInPlace(y);
-      L.transpose().triangularView<Eigen::Upper>().solveInPlace(y);
-      const double scale = y.cwiseAbs().maxCoeff();
-      for (int i = 0; i < n_; ++i) {
-        const float got = cut[static_cast<std::size_t>(i) * S + s];
-        if (s == inactive)
-          ASSERT_EQ(got, untouched) << "row " << i;
-        else
-          ASSERT_NEAR(got, y[factor_.order()[i]], 1e-4 * scale) << "sigma point " << s << ", row " << i;
+  const VulkanDeviceInfo info = list_vulkan_devices().front();
+  for (const int S : {11, 4, 3, 1}) {
+    SCOPED_TRACE("S = " + std::to_string(S));
+    const int inactive = S > 1 ? S / 2 : -1;
+    const std::vector<float> r = residuals(S);
+    for (const bool texel_reads : {true, false}) {
+      int many = 0, few = 0, split = 0;
+      const std::vector<float> cut = device_solve(r, S, inactive, texel_reads, 1000, false, &many, false, &split);
+      const std::vector<float> whole = device_solve(r, S, inactive, texel_reads, kFactorLoopTurns, false, &few);
+      EXPECT_EQ(split, VulkanFactorSolve::split_lanes(info, S));
+      if (info.subgroup_shuffle && info.subgroup_size >= 8) {
+        EXPECT_EQ(split, S == 11 ? 1 : S == 1 ? 8 : 2);
+      }
+      EXPECT_GT(many, 20) << "1000 loop turns cut the box's factor into many dispatches";
+      EXPECT_LT(few, many);
+      EXPECT_EQ(0, std::memcmp(cut.data(), whole.data(), cut.size() * sizeof(float)))
+          << "the same sums in the same order, however the solve is cut";
+      for (int s = 0; s < S; ++s) {
+        Eigen::VectorXd y(n_);
+        for (int i = 0; i < n_; ++i) y[factor_.order()[i]] = r[static_cast<std::size_t>(i) * S + s];
+        L.triangularView<Eigen::Lower>().solveInPlace(y);
+        L.transpose().triangularView<Eigen::Upper>().solveInPlace(y);
+        const double scale = y.cwiseAbs().maxCoeff();
+        for (int i = 0; i < n_; ++i) {
+          const float got = cut[static_cast<std::size_t>(i) * S + s];
+          if (s == inactive)
+            ASSERT_EQ(got, untouched) << "row " << i;
+          else
+            ASSERT_NEAR(got, y[factor_.order()[i]], 1e-4 * scale) << "sigma point " << s << ", row " << i;
+        }
       }
     }
   }
+}
+
+// Lanes a sigma point: a power of 2 within 8 lanes and the subgroup, where shuffles are.
+TEST(VulkanFactorSolveSplit, LanesASigmaPointFillTheGroupAndTheSubgroup) {
+  VulkanDeviceInfo info;
+  info.subgroup_shuffle = true;
+  info.subgroup_size = 8;
+  EXPECT_EQ(VulkanFactorSolve::split_lanes(info, 1), 8);
+  EXPECT_EQ(VulkanFactorSolve::split_lanes(info, 2), 4);
+  EXPECT_EQ(VulkanFactorSolve::split_lanes(info, 3), 2);
+  EXPECT_EQ(VulkanFactorSolve::split_lanes(info, 4), 2);
+  EXPECT_EQ(VulkanFactorSolve::split_lanes(info, 5), 1);
+  EXPECT_EQ(VulkanFactorSolve::split_lanes(info, 16), 1);
+  info.subgroup_size = 4;   // SSE's lavapipe
+  EXPECT_EQ(VulkanFactorSolve::split_lanes(info, 1), 4);
+  EXPECT_EQ(VulkanFactorSolve::split_lanes(info, 3), 1);
+  info.subgroup_size = 32;  // a GPU's: the group stays within kLanes
+  EXPECT_EQ(VulkanFactorSolve::split_lanes(info, 1), 8);
+  info.subgroup_shuffle = false;
+  EXPECT_EQ(VulkanFactorSolve::split_lanes(info, 1), 1);
 }
 
 // With each sigma point's springs corrected between the substitutions (SpringCorrection): the
 // solve with its own system A + E Delta_s E^T, against Eigen's LDL^T of that system in double,
 // in 1000-turn dispatches and in the default's few (the same bits); on the box (about 35
 // spring rows reaching 700 of its 1209: a correction of about 49 000 loop turns) and the
-// liver (27 reaching 258 of 543).
+// liver (27 reaching 258 of 543), at S = 4 and 1 (its sums shared by 2 and 8 lanes where the
+// device has subgroup shuffles) and S = 5 (a lane a sigma point).
 TEST_F(VulkanFactorSolveTest, TheSpringCorrectionSolvesEachSigmaPointsOwnSystem) {
   for (const char* scenario : {"box", "liver"}) {
-    SCOPED_TRACE(scenario);
-    load(scenario);
-    const int S = 4;
-    ASSERT_FALSE(spring_rows_.empty());
-    const std::vector<float> r = residuals(S);
-    int many = 0, few = 0;
-    const std::vector<float> cut = device_solve(r, S, -1, true, 1000, false, &many, true);
-    const std::vector<float> whole = device_solve(r, S, -1, true, kFactorLoopTurns, false, &few, true);
-    EXPECT_GT(many, few);
-    EXPECT_EQ(0, std::memcmp(cut.data(), whole.data(), cut.size() * sizeof(float)));
-    for (int s = 0; s < S; ++s) {
-      Eigen::SparseMatrix<double> own = A_;
-      const Eigen::VectorXd delta = spring_delta(s);
-      for (std::size_t j = 0; j < spring_rows_.size(); ++j)
-        own.coeffRef(spring_rows_[j], spring_rows_[j]) += delta[static_cast<Eigen::Index>(j)];
-      Eigen::SimplicialLDLT<Eigen::SparseMatrix<double>> solver(own);
-      ASSERT_EQ(solver.info(), Eigen::Success);
-      Eigen::VectorXd b(n_), uncorrected(n_);
-      for (int i = 0; i < n_; ++i) b[i] = r[static_cast<std::size_t>(i) * S + s];
-      const Eigen::VectorXd x = solver.solve(b);
-      factor_(b, uncorrected);
-      const double scale = x.cwiseAbs().maxCoeff();
-      EXPECT_GT((uncorrected - x).cwiseAbs().maxCoeff(), 1e-2 * scale)
-          << "the springs change the solve: the correction is tested";
-      for (int i = 0; i < n_; ++i)
-        ASSERT_NEAR(whole[static_cast<std::size_t>(i) * S + s], x[i], 1e-4 * scale)
-            << "sigma point " << s << ", row " << i;
+    for (const int S : {4, 1, 5}) {
+      SCOPED_TRACE(std::string(scenario) + ", S = " + std::to_string(S));
+      load(scenario);
+      ASSERT_FALSE(spring_rows_.empty());
+      const std::vector<float> r = residuals(S);
+      int many = 0, few = 0;
+      const std::vector<float> cut = device_solve(r, S, -1, true, 1000, false, &many, true);
+      const std::vector<float> whole = device_solve(r, S, -1, true, kFactorLoopTurns, false, &few, true);
+      EXPECT_GT(many, few);
+      EXPECT_EQ(0, std::memcmp(cut.data(), whole.data(), cut.size() * sizeof(float)));
+      for (int s = 0; s < S; ++s) {
+        Eigen::SparseMatrix<double> own = A_;
+        const Eigen::VectorXd delta = spring_delta(s);
+        for (std::size_t j = 0; j < spring_rows_.size(); ++j)
+          own.coeffRef(spring_rows_[j], spring_rows_[j]) += delta[static_cast<Eigen::Index>(j)];
+        Eigen::SimplicialLDLT<Eigen::SparseMatrix<double>> solver(own);
+        ASSERT_EQ(solver.info(), Eigen::Success);
+        Eigen::VectorXd b(n_), uncorrected(n_);
+        for (int i = 0; i < n_; ++i) b[i] = r[static_cast<std::size_t>(i) * S + s];
+        const Eigen::VectorXd x = solver.solve(b);
+        factor_(b, uncorrected);
+        const double scale = x.cwiseAbs().maxCoeff();
+        EXPECT_GT((uncorrected - x).cwiseAbs().maxCoeff(), 1e-2 * scale)
+            << "the springs change the solve: the correction is tested";
+        for (int i = 0; i < n_; ++i)
+          ASSERT_NEAR(whole[static_cast<std::size_t>(i) * S + s], x[i], 1e-4 * scale)
+              << "sigma point " << s << ", row " << i;
+      }
     }
   }
 }
