@@ -138,7 +138,8 @@ void main() {
       int row = SF_LOAD(slot_rows, 4u * q + c);
       b[c] = row < 0 || h > 0u ? real(0) : SF_LOAD(r, uint(row) * S + s);   /* P r once */
     }
-    for (int k = SF_LOAD(forward_starts, q) + int(h); k < SF_LOAD(forward_starts, q + 1u); k += int(H)) {
+    int end = SF_LOAD(forward_starts, q + 1u);   /* read once, not at every turn's test */
+    for (int k = SF_LOAD(forward_starts, q) + int(h); k < end; k += int(H)) {
       real4 yp = SF_Y4(y_quad(uint(SF_LOAD(forward_panel, k))));
       uint at = 4u * uint(k);
       b -= SF_COLUMN(forward_blocks, at) * yp.x + SF_COLUMN(forward_blocks, at + 1u) * yp.y +
@@ -184,7 +185,8 @@ void main() {
   for (uint step = max(first, backward); step < last; ++step) { /* L^T w = y: block column p */
     uint p = backward + P - 1u - step;
     real4 a = h == 0u ? SF_Y4(y_quad(p)) : real4(0);   /* y_p once */
-    for (int k = SF_LOAD(backward_starts, p) + int(h); k < SF_LOAD(backward_starts, p + 1u); k += int(H)) {
+    int end = SF_LOAD(backward_starts, p + 1u);
+    for (int k = SF_LOAD(backward_starts, p) + int(h); k < end; k += int(H)) {
       real4 w = SF_Y4(y_quad(uint(SF_LOAD(backward_panel, k))));
       uint at = 4u * uint(k);
       a -= real4(dot(SF_COLUMN(backward_blocks, at), w), dot(SF_COLUMN(backward_blocks, at + 1u), w),
