@@ -62,8 +62,9 @@ std::map<std::uint32_t, SpirvBinding> spirv_bindings(const std::uint32_t* words,
       variable_type[operand[1]] = operand[0];
     at += length;
   }
-  // What a variable's pointee is: a sampled buffer image of 32-bit texels (or four floats), a buffer image
-  // itself (a storage texel buffer, of r32f or rgba32f only), or else storage.
+  // What a variable's pointee is: a sampled buffer image of 32-bit texels (or of four floats,
+  // by its name), a buffer image itself (a storage texel buffer, of r32f or rgba32f only), or
+  // else storage.
   auto find = [](const auto& map, std::uint32_t key, std::uint32_t& value) {
     const auto it = map.find(key);
     if (it == map.end()) return false;

@@ -28,9 +28,10 @@ inline bool storage_texels(SpirvBinding kind) {
 }
 
 // Binding number -> kind, for the variables of descriptor set 0 that carry a Binding
-// decoration (a float samplerBuffer is float4_texels when its OpName ends in "_rgba"). Throws std::invalid_argument when the words are not a well-formed SPIR-V
-// module (no magic number, an instruction that runs past the end, a zero word count) or
-// declare a storage texel buffer of a format other than r32f or rgba32f.
+// decoration (a float samplerBuffer is float4_texels when its OpName ends in "_rgba"). Throws
+// std::invalid_argument when the words are not a well-formed SPIR-V module (no magic number,
+// an instruction that runs past the end, a zero word count) or declare a storage texel buffer
+// of a format other than r32f or rgba32f.
 std::map<std::uint32_t, SpirvBinding> spirv_bindings(const std::uint32_t* words, std::size_t count);
 
 }  // namespace sigmafem

@@ -4,7 +4,7 @@
  * OpenCL's sf_block_factor_solve in conjugate_gradient.cl does the same on PoCL).
  *
  * A lane per sigma point (work-group g holds sigma points g G .. g G + G - 1, G the group
- * size, specialization constant 0): the substitutions are sequential along L's rows, while
+ * size, specialization constant 0), or H lanes (factor_solve_split, below): the substitutions are sequential along L's rows, while
  * the sigma points are independent, and L's entries are read once for the group at the same
  * address in every lane. L comes in dense 4 x 4 blocks (host/reference/factor_blocks.h): the
  * vector y by slots, a vec4 per panel of 4 rows, and a block's 16 entries in 4 vec4 reads,
@@ -14,7 +14,7 @@
  * L^T w = y by block columns (w_p = T_p^-T (y_p - sum_q>p L_qp^T w_q)), each w_p also stored
  * as z at its original rows. Between them, the correction for the sigma point's own springs
  * (SpringCorrection, host/reference/spring_correction.h; OpenCL's SF_SPRING_ROWS): y -= V H_s
- * V^T y at the slots V reaches, with V^T y and H_s V^T y kept in slots 4 P .. 4 P + 2m - 1.
+ * V^T y at the slots V reaches, with V^T y and H_s V^T y kept in slots 4 P .. 4 P + 2M - 1.
  *
  * llvmpipe ends every loop of an invocation, silently, once its loops together have turned
  * 65535 times (gallivm's LP_MAX_TGSI_LOOP_ITERATIONS; bench/RESULTS.md, stop 52). So the
@@ -29,9 +29,10 @@
  *   [P + M/4 + m + u, 2P + ... + u) the backward block columns, from the last.
  * An inactive sigma point (CG done) is left alone.
  *
- * In float32, y and the blocks are rgba32f storage texel buffers: llvmpipe loads a storage
- * buffer at lane-varying addresses one lane at a time, an image in one gather (bench/
- * RESULTS.md, stop 53); in float64 (no 64-bit texel format) storage buffers. */
+ * In float32, y and the blocks are rgba32f storage texel buffers and V an rgba32f uniform
+ * texel buffer: llvmpipe loads a storage buffer at lane-varying addresses one lane at a time,
+ * a texel in one gather (bench/RESULTS.md, stop 53); in float64 (no 64-bit texel format)
+ * storage buffers. */
 #version 450
 #extension GL_GOOGLE_include_directive : require
 #if defined(SF_SPLIT_BLOCK_ROWS)
@@ -80,8 +81,9 @@ layout(binding = SF_FACTOR_SOLVE_SPRING_SOLVES) uniform samplerBuffer spring_sol
 
 uint S, s;
 /* The split (SF_SPLIT_BLOCK_ROWS, factor_solve_split: with S of at most 4, H = G / S lanes a
- * sigma point, h this lane's part): a block row's (or column's) blocks are shared out, lane h
- * taking every H-th from its h-th, so that each lane turns a H-th as often; the H partial sums
+ * sigma point, h this lane's part; bench/RESULTS.md, stop 56): a block row's (or column's)
+ * blocks, and the terms of each of the correction's sums, are shared out, lane h taking every
+ * H-th from its h-th, so that each lane turns a H-th as often; the H partial sums
  * are added by subgroup shuffles (the group is one subgroup: the host's condition), in lane
  * order, the same total in each of the H lanes. Each lane keeps its own copy of y (H copies,
  * [(t H + h) S + s]), which it alone reads and writes: the lanes share nothing but the

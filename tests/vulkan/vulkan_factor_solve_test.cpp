@@ -218,6 +218,61 @@ TEST_F(VulkanFactorSolveTest, TheSpringCorrectionSolvesEachSigmaPointsOwnSystem)
   }
 }
 
+// In float64 (dvec4 storage buffers, and at S = 4 the split's shuffles of doubles), with the
+// springs' correction: each sigma point's own system solved to float64's rounding, against
+// Eigen's LDL^T of it, at S = 4 (2 lanes a sigma point where shuffles are) and 5 (one).
+TEST_F(VulkanFactorSolveTest, InFloat64EachSigmaPointsOwnSystemToItsRounding) {
+  if (!list_vulkan_devices().front().has_fp64) GTEST_SKIP() << "device 0 has no shaderFloat64";
+  load("liver");
+  for (const int S : {4, 5}) {
+    SCOPED_TRACE("S = " + std::to_string(S));
+    VulkanDevice device(0, Precision::double_precision);
+    device.set_texel_reads(true);
+    std::vector<double> r(static_cast<std::size_t>(n_) * S);
+    for (int i = 0; i < n_; ++i)
+      for (int s = 0; s < S; ++s) r[static_cast<std::size_t>(i) * S + s] = std::sin(0.37 * i + s);
+    const std::size_t bytes = r.size() * sizeof(double);
+    const VulkanBuffer r_buffer = device.buffer(bytes, "r"), z_buffer = device.buffer(bytes, "z");
+    const VulkanBuffer active = device.buffer(4 * static_cast<std::size_t>(S), "active");
+    const std::vector<std::uint32_t> flags(static_cast<std::size_t>(S), 1u);
+    device.upload(r_buffer, r.data(), bytes);
+    device.upload(active, flags.data(), 4 * flags.size());
+    SpringCorrection correction(spring_rows_);
+    VulkanFactorSolve solve(device, n_, correction.size(), S, r_buffer, z_buffer, active, kFactorLoopTurns);
+    solve.upload(factor_);
+    correction.prepare(factor_);
+    ASSERT_TRUE(solve.upload_springs(correction));
+    const std::size_t m = spring_rows_.size();
+    std::vector<double> couplings;
+    for (int s = 0; s < S; ++s) {
+      const Eigen::MatrixXd H = correction.coupling(spring_delta(s));
+      for (std::size_t j = 0; j < m; ++j)
+        for (std::size_t k = 0; k < m; ++k)
+          couplings.push_back(H(static_cast<Eigen::Index>(j), static_cast<Eigen::Index>(k)));
+    }
+    VkCommandBuffer cmd = device.begin();
+    solve.record_couplings(cmd, couplings);
+    device.barrier(cmd);
+    solve.record(cmd);
+    device.submit_and_wait(cmd);
+    std::vector<double> z(r.size());
+    device.download(z_buffer, z.data(), bytes);
+    for (int s = 0; s < S; ++s) {
+      Eigen::SparseMatrix<double> own = A_;
+      const Eigen::VectorXd delta = spring_delta(s);
+      for (std::size_t j = 0; j < m; ++j) own.coeffRef(spring_rows_[j], spring_rows_[j]) += delta[static_cast<Eigen::Index>(j)];
+      Eigen::SimplicialLDLT<Eigen::SparseMatrix<double>> solver(own);
+      ASSERT_EQ(solver.info(), Eigen::Success);
+      Eigen::VectorXd b(n_);
+      for (int i = 0; i < n_; ++i) b[i] = r[static_cast<std::size_t>(i) * S + s];
+      const Eigen::VectorXd x = solver.solve(b);
+      const double scale = x.cwiseAbs().maxCoeff();
+      for (int i = 0; i < n_; ++i)
+        ASSERT_NEAR(z[static_cast<std::size_t>(i) * S + s], x[i], 1e-9 * scale) << "sigma point " << s << ", row " << i;
+    }
+  }
+}
+
 // The stand-in, then the first factor (another pattern: new blocks and buffers), then the
 // factor again (the same pattern: its values only): each solve as a fresh solve's, bit for bit.
 TEST_F(VulkanFactorSolveTest, AFactorAfterTheStandInSolvesAsAFreshOne) {
