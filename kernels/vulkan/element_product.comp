@@ -2,7 +2,8 @@
  * CG iteration (as kernels/opencl/element_product.cl, with the sigma point's lambda scale).
  * Each element writes its own 12 outputs; the node kernels sum them in a fixed order: no
  * atomics, the same bits every run.
- * One invocation per (element, sigma); a sigma point whose CG is done is skipped. */
+ * One invocation per (element, sigma), a sigma point whose CG is done skipped; or, compiled
+ * with SF_SIGMA_QUADS (element_product_quads), per element and four sigma points. */
 #version 450
 #extension GL_GOOGLE_include_directive : require
 #include "ensemble_layout.h"

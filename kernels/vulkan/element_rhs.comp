@@ -4,7 +4,8 @@
  *                                           product of the step uses it)
  *   rhs_e  = f_e(x) - (h + a) K_e v_e
  *   diag_e = diag(R K_e R^T)
- * One invocation per (element, sigma). */
+ * One invocation per (element, sigma); or, compiled with SF_SIGMA_QUADS (element_rhs_quads),
+ * per element and four sigma points (sigma_quads.h). */
 #version 450
 #extension GL_GOOGLE_include_directive : require
 #include "ensemble_layout.h"

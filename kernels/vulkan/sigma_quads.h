@@ -4,7 +4,7 @@
  * llvmpipe a lane's loads and stores cost by the count, not the width: the element's own data
  * is read once for four sigma points, and each per-sigma value of four comes in one rgba32f
  * texel fetch and goes in one vec4 store, where the scalar form takes four of each (the
- * element product 37% faster; bench/RESULTS.md, stop 56). The layout is the ensemble's
+ * element product a third faster alone; bench/RESULTS.md, stop 56). The layout is the ensemble's
  * (device_layout.h): [i S + 4 q + j] is quad i Q + q of a per-sigma array, Q = S / 4. */
 #ifndef SIGMAFEM_VULKAN_SIGMA_QUADS_H
 #define SIGMAFEM_VULKAN_SIGMA_QUADS_H
