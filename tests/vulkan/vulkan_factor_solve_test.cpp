@@ -49,6 +49,29 @@ class VulkanFactorSolveTest : public ::testing::Test {
     return delta;
   }
 
+  // Each sigma point's coupling H for spring_delta(s) ([(s m + j) m + k]), of a prepared correction.
+  std::vector<double> couplings(const SpringCorrection& correction, int S) const {
+    const std::size_t m = spring_rows_.size();
+    std::vector<double> values;
+    for (int s = 0; s < S; ++s) {
+      const Eigen::MatrixXd H = correction.coupling(spring_delta(s));
+      for (std::size_t j = 0; j < m; ++j)
+        for (std::size_t k = 0; k < m; ++k) values.push_back(H(static_cast<Eigen::Index>(j), static_cast<Eigen::Index>(k)));
+    }
+    return values;
+  }
+
+  // Sigma point s's own system A + E Delta_s E^T solved for b by Eigen's LDL^T in double.
+  Eigen::VectorXd own_solve(int s, const Eigen::VectorXd& b) const {
+    Eigen::SparseMatrix<double> own = A_;
+    const Eigen::VectorXd delta = spring_delta(s);
+    for (std::size_t j = 0; j < spring_rows_.size(); ++j)
+      own.coeffRef(spring_rows_[j], spring_rows_[j]) += delta[static_cast<Eigen::Index>(j)];
+    Eigen::SimplicialLDLT<Eigen::SparseMatrix<double>> solver(own);
+    EXPECT_EQ(solver.info(), Eigen::Success);
+    return solver.solve(b);
+  }
+
   // z of S sigma points ([row S + s]) for r, on device 0 in float32, with sigma point
   // `inactive` left alone (its z stays at `untouched`).
   // With `springs`, each sigma point's correction for spring_delta(s).
@@ -76,15 +99,7 @@ class VulkanFactorSolveTest : public ::testing::Test {
     if (springs) {
       correction.prepare(factor_);
       if (!solve.upload_springs(correction)) ADD_FAILURE() << "the correction does not fit a dispatch";
-      const std::size_t m = spring_rows_.size();
-      std::vector<double> couplings;
-      for (int s = 0; s < S; ++s) {
-        const Eigen::MatrixXd H = correction.coupling(spring_delta(s));
-        for (std::size_t j = 0; j < m; ++j)
-          for (std::size_t k = 0; k < m; ++k)
-            couplings.push_back(H(static_cast<Eigen::Index>(j), static_cast<Eigen::Index>(k)));
-      }
-      couplings_ = couplings;
+      couplings_ = couplings(correction, S);
     }
     if (dispatches) *dispatches = solve.dispatches();
     if (split) *split = solve.split();
@@ -197,15 +212,9 @@ TEST_F(VulkanFactorSolveTest, TheSpringCorrectionSolvesEachSigmaPointsOwnSystem)
       EXPECT_GT(many, few);
       EXPECT_EQ(0, std::memcmp(cut.data(), whole.data(), cut.size() * sizeof(float)));
       for (int s = 0; s < S; ++s) {
-        Eigen::SparseMatrix<double> own = A_;
-        const Eigen::VectorXd delta = spring_delta(s);
-        for (std::size_t j = 0; j < spring_rows_.size(); ++j)
-          own.coeffRef(spring_rows_[j], spring_rows_[j]) += delta[static_cast<Eigen::Index>(j)];
-        Eigen::SimplicialLDLT<Eigen::SparseMatrix<double>> solver(own);
-        ASSERT_EQ(solver.info(), Eigen::Success);
         Eigen::VectorXd b(n_), uncorrected(n_);
         for (int i = 0; i < n_; ++i) b[i] = r[static_cast<std::size_t>(i) * S + s];
-        const Eigen::VectorXd x = solver.solve(b);
+        const Eigen::VectorXd x = own_solve(s, b);
         factor_(b, uncorrected);
         const double scale = x.cwiseAbs().maxCoeff();
         EXPECT_GT((uncorrected - x).cwiseAbs().maxCoeff(), 1e-2 * scale)
@@ -242,30 +251,17 @@ TEST_F(VulkanFactorSolveTest, InFloat64EachSigmaPointsOwnSystemToItsRounding) {
     solve.upload(factor_);
     correction.prepare(factor_);
     ASSERT_TRUE(solve.upload_springs(correction));
-    const std::size_t m = spring_rows_.size();
-    std::vector<double> couplings;
-    for (int s = 0; s < S; ++s) {
-      const Eigen::MatrixXd H = correction.coupling(spring_delta(s));
-      for (std::size_t j = 0; j < m; ++j)
-        for (std::size_t k = 0; k < m; ++k)
-          couplings.push_back(H(static_cast<Eigen::Index>(j), static_cast<Eigen::Index>(k)));
-    }
     VkCommandBuffer cmd = device.begin();
-    solve.record_couplings(cmd, couplings);
+    solve.record_couplings(cmd, couplings(correction, S));
     device.barrier(cmd);
     solve.record(cmd);
     device.submit_and_wait(cmd);
     std::vector<double> z(r.size());
     device.download(z_buffer, z.data(), bytes);
     for (int s = 0; s < S; ++s) {
-      Eigen::SparseMatrix<double> own = A_;
-      const Eigen::VectorXd delta = spring_delta(s);
-      for (std::size_t j = 0; j < m; ++j) own.coeffRef(spring_rows_[j], spring_rows_[j]) += delta[static_cast<Eigen::Index>(j)];
-      Eigen::SimplicialLDLT<Eigen::SparseMatrix<double>> solver(own);
-      ASSERT_EQ(solver.info(), Eigen::Success);
       Eigen::VectorXd b(n_);
       for (int i = 0; i < n_; ++i) b[i] = r[static_cast<std::size_t>(i) * S + s];
-      const Eigen::VectorXd x = solver.solve(b);
+      const Eigen::VectorXd x = own_solve(s, b);
       const double scale = x.cwiseAbs().maxCoeff();
       for (int i = 0; i < n_; ++i)
         ASSERT_NEAR(z[static_cast<std::size_t>(i) * S + s], x[i], 1e-9 * scale) << "sigma point " << s << ", row " << i;
