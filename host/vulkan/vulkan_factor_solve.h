@@ -2,7 +2,8 @@
 // for every sigma point, M = P^T L L^T P one factor that the sigma points share (of the
 // representative's system: FactorisedPreconditioner, as OpenCL's CPU form has it).
 // kernels/vulkan/factor_solve.comp does the two substitutions on L's 4 x 4 blocks
-// (host/reference/factor_blocks.h), a lane per sigma point, in dispatches cut so that none
+// (host/reference/factor_blocks.h), a lane per sigma point (or, at S <= 4 on a device with
+// subgroup shuffles, several: split_lanes), in dispatches cut so that none
 // turns its loops more often than llvmpipe allows (the shader's comment); VulkanEnsemble
 // records them after CG's start and after each iteration's update.
 #pragma once

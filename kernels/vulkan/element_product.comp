@@ -41,10 +41,10 @@ void main() {
   SF_REAL frame[9];
   SF_REAL corner[12];
   SF_REAL product[12];
-  for (uint i = 0u; i < 9u; ++i) frame[i] = SF_QUAD(frames, (9u * e + i) * Q + q);
+  SF_LOAD_ITEM_QUADS(frames, e, 9u, q, Q, frame)
   SF_GATHER_CORNER_QUADS(d, corner_nodes, q, Q, corner)
   sf_element_product(frame, grad, sigma_lambda, sigma_mu, corner, product);
-  for (uint i = 0u; i < 12u; ++i) element_out[(12u * e + i) * Q + q] = product[i];
+  SF_STORE_ITEM_QUADS(element_out, e, 12u, q, Q, product)
 }
 #else /* a sigma point a lane */
 SF_READ_INTS(SF_ELEMENT_PRODUCT_ELEMENT_NODES, nodes)

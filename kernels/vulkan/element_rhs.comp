@@ -40,14 +40,15 @@ void main() {
   SF_REAL product[12];
   SF_GATHER_CORNER_QUADS(x, corner_nodes, q, Q, corner)
   sf_element_rotation(grad, corner, SF_REAL(SF_LOAD(c, SF_POLAR_ROTATION)), frame);
-  for (uint i = 0u; i < 9u; ++i) frames[(9u * e + i) * Q + q] = frame[i];
+  SF_STORE_ITEM_QUADS(frames, e, 9u, q, Q, frame)
   sf_element_force(frame, grad, sigma_lambda, sigma_mu, corner, force);
   SF_GATHER_CORNER_QUADS(v, corner_nodes, q, Q, corner)
   sf_element_product(frame, grad, sigma_lambda, sigma_mu, corner, product);
   SF_REAL velocity_factor = SF_QUAD_CONSTANT(c, SF_VELOCITY_FACTOR, q, S);
-  for (uint i = 0u; i < 12u; ++i) element_out[(12u * e + i) * Q + q] = force[i] - velocity_factor * product[i];
+  for (uint i = 0u; i < 12u; ++i) force[i] -= velocity_factor * product[i];
+  SF_STORE_ITEM_QUADS(element_out, e, 12u, q, Q, force)
   sf_element_diagonal(frame, grad, sigma_lambda, sigma_mu, product);
-  for (uint i = 0u; i < 12u; ++i) element_diagonal[(12u * e + i) * Q + q] = product[i];
+  SF_STORE_ITEM_QUADS(element_diagonal, e, 12u, q, Q, product)
 }
 #else /* a sigma point a lane */
 SF_READ_INTS(SF_ELEMENT_RHS_ELEMENT_NODES, nodes)

@@ -44,6 +44,12 @@
     sigma_mu = SF_REAL(last_[1]) * region_;                                                \
     SF_UNROLL for (uint c_ = 0u; c_ < 4u; ++c_) corner_nodes[c_] = SF_UINT(SF_LOAD(nodes, 4u * (e) + c_)); \
   }
+/* Item e's N values of quad q, loaded and stored (device_layout.h's SF_LOAD_FRAME and
+ * SF_STORE_CORNERS by quads: [(N e + i) S + s] is quad (N e + i) Q + q). */
+#define SF_LOAD_ITEM_QUADS(in, e, N, q, Q, values) \
+  SF_UNROLL for (uint i_ = 0u; i_ < (N); ++i_) values[i_] = SF_QUAD(in, ((N) * (e) + i_) * (Q) + (q));
+#define SF_STORE_ITEM_QUADS(out, e, N, q, Q, values) \
+  SF_UNROLL for (uint i_ = 0u; i_ < (N); ++i_) out[((N) * (e) + i_) * (Q) + (q)] = values[i_];
 /* A per-dof array's quads at an element's four corners. */
 #define SF_GATHER_CORNER_QUADS(v, corner_nodes, q, Q, out)                            \
   SF_UNROLL for (uint c_ = 0u; c_ < 4u; ++c_)                                         \
