@@ -31,7 +31,8 @@ VulkanFactorSolve::VulkanFactorSolve(VulkanDevice& device, int rows, int spring_
   spring_solves_ = make(real * n * padded(m));
   spring_coupling_ = make(real * m * m * static_cast<std::size_t>(S_));
   split_ = split_lanes(device_.info(), S_);
-  group_ = static_cast<std::uint32_t>(std::min(S_, kLanes) * split_);
+  shared_ = shares_blocks(device_.info(), S_);
+  group_ = static_cast<std::uint32_t>(shared_ ? kLanes : std::min(S_, kLanes) * split_);
   groups_ = (static_cast<std::uint32_t>(S_ * split_) + group_ - 1) / group_;
 }
 
@@ -41,6 +42,11 @@ int VulkanFactorSolve::split_lanes(const VulkanDeviceInfo& info, int sigma_count
   int split = 1;
   while (2 * split * sigma_count <= lanes) split *= 2;
   return split;
+}
+
+bool VulkanFactorSolve::shares_blocks(const VulkanDeviceInfo& info, int sigma_count) {
+  return info.subgroup_shuffle && info.subgroup_size >= static_cast<unsigned>(kLanes) &&
+         split_lanes(info, sigma_count) == 1;
 }
 
 VulkanBuffer VulkanFactorSolve::make(std::size_t bytes) {
@@ -75,12 +81,13 @@ void VulkanFactorSolve::make_layout(const Eigen::SparseMatrix<double>& L, const 
   upload_ints(layout->backward_starts, b.backward_starts());
   upload_ints(layout->backward_panel, b.backward_panel());
   upload_ints(layout->slot_rows, b.slot_rows());
-  layout->kernel = device_.kernel(split_ > 1 ? "factor_solve_split" : "factor_solve", SF_FACTOR_SOLVE_WORK + 1,
+  const char* name = split_ > 1 ? "factor_solve_split" : shared_ ? "factor_solve_shared" : "factor_solve";
+  layout->kernel = device_.kernel(name, SF_FACTOR_SOLVE_WORK_STORES + 1,
                                   group_, static_cast<std::uint32_t>(P));
   const Layout& l = *layout;
   layout->set = device_.bind(l.kernel, {l.forward_starts, l.forward_panel, l.backward_starts, l.backward_panel,
                                         l.slot_rows, r_, z_, active_, spring_at_, spring_solves_, spring_coupling_,
-                                        l.triangles, l.forward_blocks, l.backward_blocks, l.work});
+                                        l.triangles, l.forward_blocks, l.backward_blocks, l.work, l.work});
   layout_ = std::move(layout);
 }
 

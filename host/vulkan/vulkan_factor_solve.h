@@ -2,8 +2,9 @@
 // for every sigma point, M = P^T L L^T P one factor that the sigma points share (of the
 // representative's system: FactorisedPreconditioner, as OpenCL's CPU form has it).
 // kernels/vulkan/factor_solve.comp does the two substitutions on L's 4 x 4 blocks
-// (host/reference/factor_blocks.h), a lane per sigma point (or, at S <= 4 on a device with
-// subgroup shuffles, several: split_lanes), in dispatches cut so that none
+// (host/reference/factor_blocks.h), a lane per sigma point (on a device with subgroup
+// shuffles: at S <= 4 several, split_lanes; from S = 5 in groups of 8 that read the blocks
+// together, shares_blocks), in dispatches cut so that none
 // turns its loops more often than llvmpipe allows (the shader's comment); VulkanEnsemble
 // records them after CG's start and after each iteration's update.
 #pragma once
@@ -32,6 +33,11 @@ class VulkanFactorSolve {
   // S = 1, 4 at S = 2, 2 at S = 3 or 4, 1 from 5.
   static int split_lanes(const VulkanDeviceInfo& info, int sigma_count);
   int split() const { return split_; }
+  // Whether a group of kLanes lanes, a sigma point each, reads each chunk of 8 blocks together
+  // and passes them round by subgroup shuffles (factor_solve_shared): where there are shuffles
+  // and subgroups of at least kLanes, and split_lanes gives 1.
+  static bool shares_blocks(const VulkanDeviceInfo& info, int sigma_count);
+  bool shared() const { return shared_; }
 
   // For a factor of n rows and `sigma_count` sigma points, with a correction for each one's
   // springs at `spring_rows` rows (m; 0: none); r, z and the active flags are CG's buffers,
@@ -102,6 +108,7 @@ class VulkanFactorSolve {
   std::vector<std::pair<std::uint32_t, std::uint32_t>> ranges_;
   std::uint32_t group_ = 1, groups_ = 1;
   int split_ = 1;                           // lanes a sigma point (split_lanes)
+  bool shared_ = false;                     // shares_blocks
 };
 
 }  // namespace sigmafem

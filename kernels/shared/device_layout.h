@@ -168,7 +168,8 @@
  * each slot's original row, CG's r, z and active flags, the factor's correction for each sigma
  * point's springs (host/reference/spring_correction.h): [m, reached slots u, the slots], V
  * there by rows and each sigma point's m x m H; the panels' triangles, the blocks' values by
- * rows and by columns, and the work vector y. */
+ * rows and by columns, and the work vector y (bound twice: read as texels, written as a storage
+ * buffer, where llvmpipe stores a texel several times slower: factor_solve.comp). */
 #define SF_FACTOR_SOLVE_FORWARD_STARTS 0
 #define SF_FACTOR_SOLVE_FORWARD_PANEL 1
 #define SF_FACTOR_SOLVE_BACKWARD_STARTS 2
@@ -184,6 +185,7 @@
 #define SF_FACTOR_SOLVE_FORWARD_BLOCKS 12
 #define SF_FACTOR_SOLVE_BACKWARD_BLOCKS 13
 #define SF_FACTOR_SOLVE_WORK 14
+#define SF_FACTOR_SOLVE_WORK_STORES 15
 /* Vulkan's multigrid shaders (mg_smooth, mg_residual, mg_product: the V-cycle of
  * host/reference/nested_multigrid.h; host/vulkan/vulkan_multigrid.h): a level's matrix in CSR,
  * its diagonal, its Chebyshev steps, the finest level's shifts, the input vector (b, or x of a

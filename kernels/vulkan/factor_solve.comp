@@ -31,11 +31,13 @@
  *
  * In float32, y and the blocks are rgba32f storage texel buffers and V an rgba32f uniform
  * texel buffer: llvmpipe loads a storage buffer at lane-varying addresses one lane at a time,
- * a texel in one gather (bench/RESULTS.md, stop 53); in float64 (no 64-bit texel format)
+ * a texel in one gather (bench/RESULTS.md, stop 53); y is written through a storage buffer
+ * bound to the same memory (SF_FACTOR_SOLVE_WORK_STORES), where llvmpipe stores a vec4 about
+ * 6x faster than a texel (bench/RESULTS.md, stop 57). In float64 (no 64-bit texel format)
  * storage buffers. */
 #version 450
 #extension GL_GOOGLE_include_directive : require
-#if defined(SF_SPLIT_BLOCK_ROWS)
+#if defined(SF_SPLIT_BLOCK_ROWS) || defined(SF_SHARED_BLOCKS)
 #  extension GL_KHR_shader_subgroup_shuffle : require
 #endif
 #include "ensemble_layout.h"
@@ -59,24 +61,26 @@ SF_READ_REALS(SF_FACTOR_SOLVE_SPRING_COUPLING, spring_coupling)
 layout(std430, binding = SF_FACTOR_SOLVE_TRIANGLES) restrict readonly buffer Triangles { dvec4 triangles[]; };
 layout(std430, binding = SF_FACTOR_SOLVE_FORWARD_BLOCKS) restrict readonly buffer Forward { dvec4 forward_blocks[]; };
 layout(std430, binding = SF_FACTOR_SOLVE_BACKWARD_BLOCKS) restrict readonly buffer Backward { dvec4 backward_blocks[]; };
-layout(std430, binding = SF_FACTOR_SOLVE_WORK) restrict buffer Work { dvec4 y[]; };
+layout(std430, binding = SF_FACTOR_SOLVE_WORK) restrict buffer Work { dvec4 y[]; };   /* _STORES unused */
 layout(std430, binding = SF_FACTOR_SOLVE_SPRING_SOLVES) restrict readonly buffer SpringSolves { dvec4 spring_solves[]; };
 #  define SF_V4(i) spring_solves[i]
 #  define SF_COLUMN(blocks, i) blocks[i]
 #  define SF_Y4(t) y[t]
-#  define SF_SET_Y4(t, value) y[t] = (value)
+#  define SF_SET_Y4(t, value) if (writes) y[t] = (value)
 #else
 #  define real4 vec4
 layout(binding = SF_FACTOR_SOLVE_TRIANGLES, rgba32f) uniform restrict readonly imageBuffer triangles;
 layout(binding = SF_FACTOR_SOLVE_FORWARD_BLOCKS, rgba32f) uniform restrict readonly imageBuffer forward_blocks;
 layout(binding = SF_FACTOR_SOLVE_BACKWARD_BLOCKS, rgba32f) uniform restrict readonly imageBuffer backward_blocks;
-layout(binding = SF_FACTOR_SOLVE_WORK, rgba32f) uniform restrict imageBuffer y;
+/* y read as texels and written as vec4s, one memory through two bindings (not restrict: they alias). */
+layout(binding = SF_FACTOR_SOLVE_WORK, rgba32f) uniform readonly imageBuffer y;
+layout(std430, binding = SF_FACTOR_SOLVE_WORK_STORES) writeonly buffer WorkStores { vec4 y_stores[]; };
 /* V, 4 of a row a texel ("_rgba": host/vulkan/spirv_bindings.h). */
 layout(binding = SF_FACTOR_SOLVE_SPRING_SOLVES) uniform samplerBuffer spring_solves_rgba;
 #  define SF_V4(i) texelFetch(spring_solves_rgba, int(i))
 #  define SF_COLUMN(blocks, i) imageLoad(blocks, int(i))
 #  define SF_Y4(t) imageLoad(y, int(t))
-#  define SF_SET_Y4(t, value) imageStore(y, int(t), value)
+#  define SF_SET_Y4(t, value) if (writes) y_stores[t] = (value)
 #endif
 
 uint S, s;
@@ -89,12 +93,21 @@ uint S, s;
  * [(t H + h) S + s]), which it alone reads and writes: the lanes share nothing but the
  * shuffles. Where the sigma points fill the lanes already, one lane a sigma point (H = 1). */
 uint H, h;
+/* The shared block reads (SF_SHARED_BLOCKS, factor_solve_shared: a lane a sigma point, S >= 5,
+ * a group of 8 lanes in one subgroup; bench/RESULTS.md, stop 57): every lane needs the same
+ * blocks, so the 8 lanes read a chunk of 8 blocks' 32 texels together, 4 each, and each block's
+ * 4 columns reach every lane by subgroup shuffles from constant lanes (which llvmpipe does in
+ * registers), where each lane read all 32 alone. All 8 lanes take part, those past S or whose
+ * sigma point is done included (shuffles read only active lanes), and only the others write
+ * (`writes`). */
+uint lane;
+bool writes = true;
 
 /* The quad t (4 slots) of y: this lane's copy for its sigma point. */
 uint y_quad(uint t) { return (t * H + h) * S + s; }
 /* The sum of the H lanes' partial sums of this lane's sigma point, in lane order. */
 real4 add_parts(real4 part) {
-#if defined(SF_SPLIT_BLOCK_ROWS)
+#if defined(SF_SPLIT_BLOCK_ROWS)   /* lanes [j S + s], j < H, hold sigma point s's parts */
   real4 total = real4(0);
   for (uint j = 0u; j < 8u; ++j)   /* constant bounds: unrolled, no loop turns */
     if (j < H) total += subgroupShuffle(part, j * S + s);
@@ -115,6 +128,20 @@ void set_y_at(uint slot, real value) {
   SF_SET_Y4(t, four);
 }
 
+#if defined(SF_SHARED_BLOCKS)
+/* Blocks k0 .. k0 + 7 of a row (those past its `end` repeat its last, unused): lane l reads
+ * the l-th block's panel and texels l, l + 8, l + 16 and l + 24 of the chunk's 32 (f0..f3). */
+#  define SF_READ_CHUNK(panels, blocks)                                                        \
+  int panel = SF_LOAD(panels, uint(min(k0 + int(lane), end - 1)));                             \
+  uint at_ = 4u * uint(k0) + lane, last_ = 4u * uint(end) - 1u;                               \
+  real4 f0 = SF_COLUMN(blocks, min(at_, last_)), f1 = SF_COLUMN(blocks, min(at_ + 8u, last_)); \
+  real4 f2 = SF_COLUMN(blocks, min(at_ + 16u, last_)), f3 = SF_COLUMN(blocks, min(at_ + 24u, last_));
+/* BLOCK(j, f, l) for the chunk's 8 blocks: block j's 4 columns are lanes l .. l + 3 of f. */
+#  define SF_EACH_CHUNK_BLOCK(BLOCK)                                                           \
+  BLOCK(0, f0, 0u) BLOCK(1, f0, 4u) BLOCK(2, f1, 0u) BLOCK(3, f1, 4u)                          \
+  BLOCK(4, f2, 0u) BLOCK(5, f2, 4u) BLOCK(6, f3, 0u) BLOCK(7, f3, 4u)
+#endif
+
 void main() {
   S = sf_push.S;
 #if defined(SF_SPLIT_BLOCK_ROWS)   /* one group of H S lanes */
@@ -122,6 +149,16 @@ void main() {
   s = gl_LocalInvocationID.x % S;
   h = gl_LocalInvocationID.x / S;
   if (h >= H || SF_LOAD(active_flags, s) == 0u) return;   /* all H lanes of a sigma point alike */
+#elif defined(SF_SHARED_BLOCKS)   /* groups of 8, every lane to the end */
+  H = 1u;
+  h = 0u;
+  lane = gl_SubgroupInvocationID;
+  s = gl_WorkGroupID.x * gl_WorkGroupSize.x + gl_LocalInvocationID.x;
+  writes = s < S && SF_LOAD(active_flags, min(s, S - 1u)) != 0u;
+  s = min(s, S - 1u);
+  uint any_writes = 0u;
+  for (uint l = 0u; l < 8u; ++l) any_writes |= subgroupShuffle(writes ? 1u : 0u, l);   /* unrolled */
+  if (any_writes == 0u) return;   /* the whole group: no shuffle is left without its lanes */
 #else
   H = 1u;
   h = 0u;
@@ -141,12 +178,25 @@ void main() {
       b[c] = row < 0 || h > 0u ? real(0) : SF_LOAD(r, uint(row) * S + s);   /* P r once */
     }
     int end = SF_LOAD(forward_starts, q + 1u);   /* read once, not at every turn's test */
+#if defined(SF_SHARED_BLOCKS)
+    for (int k0 = SF_LOAD(forward_starts, q); k0 < end; k0 += 8) {
+      SF_READ_CHUNK(forward_panel, forward_blocks)
+#  define SF_FORWARD_BLOCK(j, f, l)                                                            \
+      if (k0 + j < end) {                                                                      \
+        real4 yp = SF_Y4(y_quad(uint(subgroupShuffle(panel, j))));                             \
+        b -= subgroupShuffle(f, l) * yp.x + subgroupShuffle(f, l + 1u) * yp.y +                \
+             subgroupShuffle(f, l + 2u) * yp.z + subgroupShuffle(f, l + 3u) * yp.w;            \
+      }
+      SF_EACH_CHUNK_BLOCK(SF_FORWARD_BLOCK)
+    }
+#else
     for (int k = SF_LOAD(forward_starts, q) + int(h); k < end; k += int(H)) {
       real4 yp = SF_Y4(y_quad(uint(SF_LOAD(forward_panel, k))));
       uint at = 4u * uint(k);
       b -= SF_COLUMN(forward_blocks, at) * yp.x + SF_COLUMN(forward_blocks, at + 1u) * yp.y +
            SF_COLUMN(forward_blocks, at + 2u) * yp.z + SF_COLUMN(forward_blocks, at + 3u) * yp.w;
     }
+#endif
     b = add_parts(b);
     /* T y_q = b, T's columns t0..t3 lower triangular: y_c, then b -= t_c y_c. */
     real4 t0 = SF_COLUMN(triangles, 4u * q), t1 = SF_COLUMN(triangles, 4u * q + 1u);
@@ -188,12 +238,25 @@ void main() {
     uint p = backward + P - 1u - step;
     real4 a = h == 0u ? SF_Y4(y_quad(p)) : real4(0);   /* y_p once */
     int end = SF_LOAD(backward_starts, p + 1u);
+#if defined(SF_SHARED_BLOCKS)
+    for (int k0 = SF_LOAD(backward_starts, p); k0 < end; k0 += 8) {
+      SF_READ_CHUNK(backward_panel, backward_blocks)
+#  define SF_BACKWARD_BLOCK(j, f, l)                                                           \
+      if (k0 + j < end) {                                                                      \
+        real4 w = SF_Y4(y_quad(uint(subgroupShuffle(panel, j))));                              \
+        a -= real4(dot(subgroupShuffle(f, l), w), dot(subgroupShuffle(f, l + 1u), w),          \
+                   dot(subgroupShuffle(f, l + 2u), w), dot(subgroupShuffle(f, l + 3u), w));    \
+      }
+      SF_EACH_CHUNK_BLOCK(SF_BACKWARD_BLOCK)
+    }
+#else
     for (int k = SF_LOAD(backward_starts, p) + int(h); k < end; k += int(H)) {
       real4 w = SF_Y4(y_quad(uint(SF_LOAD(backward_panel, k))));
       uint at = 4u * uint(k);
       a -= real4(dot(SF_COLUMN(backward_blocks, at), w), dot(SF_COLUMN(backward_blocks, at + 1u), w),
                  dot(SF_COLUMN(backward_blocks, at + 2u), w), dot(SF_COLUMN(backward_blocks, at + 3u), w));
     }
+#endif
     a = add_parts(a);
     /* T^T w_p = a, from the last: w_c = (a_c - sum_i>c T_ic w_i) / T_cc. */
     real4 t0 = SF_COLUMN(triangles, 4u * p), t1 = SF_COLUMN(triangles, 4u * p + 1u);
@@ -206,7 +269,7 @@ void main() {
     SF_SET_Y4(y_quad(p), wp);
     for (uint c = 0u; c < 4u; ++c) {
       int row = SF_LOAD(slot_rows, 4u * p + c);
-      if (row >= 0 && h == 0u) z[uint(row) * S + s] = wp[c];
+      if (row >= 0 && h == 0u && writes) z[uint(row) * S + s] = wp[c];
     }
   }
 }

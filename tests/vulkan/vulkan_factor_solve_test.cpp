@@ -77,7 +77,7 @@ class VulkanFactorSolveTest : public ::testing::Test {
   // With `springs`, each sigma point's correction for spring_delta(s).
   std::vector<float> device_solve(const std::vector<float>& r, int S, int inactive, bool texel_reads,
                                   long long loop_turns, bool diagonal, int* dispatches = nullptr,
-                                  bool springs = false, int* split = nullptr) {
+                                  bool springs = false, int* split = nullptr, bool* shared = nullptr) {
     VulkanDevice device(0, Precision::single);
     device.set_texel_reads(texel_reads);
     const std::size_t bytes = r.size() * sizeof(float);
@@ -103,6 +103,7 @@ class VulkanFactorSolveTest : public ::testing::Test {
     }
     if (dispatches) *dispatches = solve.dispatches();
     if (split) *split = solve.split();
+    if (shared) *shared = solve.shared();
     VkCommandBuffer cmd = device.begin();
     if (springs) {
       solve.record_couplings(cmd, couplings_);
@@ -132,24 +133,30 @@ class VulkanFactorSolveTest : public ::testing::Test {
 };
 
 // Against P^T L^-T L^-1 P r in double from the same L, for S = 11 (a group of 8 and one of
-// 3) and S = 4, 3 and 1 (on a device with subgroup shuffles, a block row shared by 2, 2 and 8
-// lanes: factor_solve_split), in 1000-turn dispatches and in the default's few, texel and
-// storage reads: within float32's rounding, the same bits however the solve is cut, an
-// inactive sigma point untouched.
+// 3) and 9 (one of 8 and one whose only sigma point is done), and S = 4, 3 and 1; on a device
+// with subgroup shuffles, at S = 11 and 9 the groups' lanes read the blocks together
+// (factor_solve_shared: lanes past S and done sigma points take part), at 4, 3 and 1 a block
+// row is shared by 2, 2 and 8 lanes (factor_solve_split); in 1000-turn dispatches and in the
+// default's few, texel and storage reads: within float32's rounding, the same bits however the
+// solve is cut, an inactive sigma point untouched.
 TEST_F(VulkanFactorSolveTest, SolvesAsTheHostFactorInManyDispatchesOrFew) {
   const Eigen::SparseMatrix<double>& L = factor_.lower();
   const VulkanDeviceInfo info = list_vulkan_devices().front();
-  for (const int S : {11, 4, 3, 1}) {
+  for (const int S : {11, 9, 4, 3, 1}) {
     SCOPED_TRACE("S = " + std::to_string(S));
-    const int inactive = S > 1 ? S / 2 : -1;
+    const int inactive = S == 9 ? 8 : S > 1 ? S / 2 : -1;
     const std::vector<float> r = residuals(S);
     for (const bool texel_reads : {true, false}) {
       int many = 0, few = 0, split = 0;
-      const std::vector<float> cut = device_solve(r, S, inactive, texel_reads, 1000, false, &many, false, &split);
+      bool shared = false;
+      const std::vector<float> cut =
+          device_solve(r, S, inactive, texel_reads, 1000, false, &many, false, &split, &shared);
       const std::vector<float> whole = device_solve(r, S, inactive, texel_reads, kFactorLoopTurns, false, &few);
       EXPECT_EQ(split, VulkanFactorSolve::split_lanes(info, S));
+      EXPECT_EQ(shared, VulkanFactorSolve::shares_blocks(info, S));
       if (info.subgroup_shuffle && info.subgroup_size >= 8) {
-        EXPECT_EQ(split, S == 11 ? 1 : S == 1 ? 8 : 2);
+        EXPECT_EQ(split, S >= 9 ? 1 : S == 1 ? 8 : 2);
+        EXPECT_EQ(shared, S >= 9);
       }
       EXPECT_GT(many, 20) << "1000 loop turns cut the box's factor into many dispatches";
       EXPECT_LT(few, many);
@@ -191,6 +198,23 @@ TEST(VulkanFactorSolveSplit, LanesASigmaPointFillTheGroupAndTheSubgroup) {
   EXPECT_EQ(VulkanFactorSolve::split_lanes(info, 1), 8);
   info.subgroup_shuffle = false;
   EXPECT_EQ(VulkanFactorSolve::split_lanes(info, 1), 1);
+}
+
+// The shared block reads: groups of 8 in one subgroup with shuffles, where the split is 1.
+TEST(VulkanFactorSolveShared, GroupsOfEightReadTheBlocksTogetherWhereNoSplitIs) {
+  VulkanDeviceInfo info;
+  info.subgroup_shuffle = true;
+  info.subgroup_size = 8;
+  EXPECT_FALSE(VulkanFactorSolve::shares_blocks(info, 4));   // the split's
+  EXPECT_TRUE(VulkanFactorSolve::shares_blocks(info, 5));
+  EXPECT_TRUE(VulkanFactorSolve::shares_blocks(info, 16));
+  info.subgroup_size = 32;
+  EXPECT_TRUE(VulkanFactorSolve::shares_blocks(info, 64));
+  info.subgroup_size = 4;   // SSE's lavapipe: a group of 8 would be two subgroups
+  EXPECT_FALSE(VulkanFactorSolve::shares_blocks(info, 16));
+  info.subgroup_size = 8;
+  info.subgroup_shuffle = false;
+  EXPECT_FALSE(VulkanFactorSolve::shares_blocks(info, 16));
 }
 
 // With each sigma point's springs corrected between the substitutions (SpringCorrection): the
