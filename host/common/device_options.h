@@ -62,6 +62,11 @@ constexpr long long kFactorLoopTurns = 61440;
 // a filter step) and the box (1344) at S = 4 (9.8 against 11.6), threads on the liver at
 // S = 16 (6.4 against 7.9 ms a step) and the 4768 liver at S = 4 (20 against 23).
 constexpr long long kLavapipeSerialWork = 8192;
+// DeviceOptions::cg_sigma_lanes_from's default, measured on lavapipe on a 2-core machine
+// (bench/RESULTS.md, stop 57): at S = 16 lanes over sigma points (the 4768 liver's step 21.7
+// -> 19.8 ms, the 596 liver's 5.1 -> 3.9); at S = 4 a group a sigma point (one group of lanes
+// would leave lavapipe's other threads idle: the 4768 liver's step 12.3 against 13.3 ms).
+constexpr int kCgSigmaLanesFrom = 16;
 
 struct DeviceOptions {
   int device = 0;                   // index in `sigmafem devices`' list for the back end
@@ -95,6 +100,10 @@ struct DeviceOptions {
   // they give back (choose_lavapipe_threads, host/vulkan/vulkan_device.h; a user's
   // LP_NUM_THREADS wins); 0: lavapipe's threads always.
   long long lavapipe_serial_work = kLavapipeSerialWork;
+  // Vulkan on a CPU device with one CG partition: from this many sigma points the CG shaders
+  // take a sigma point a lane, walking its rows alone, where fewer take a work-group a sigma
+  // point over its nodes (kernels/vulkan/conjugate_gradient.comp); 0: never (tests compare).
+  int cg_sigma_lanes_from = kCgSigmaLanesFrom;
   // Vulkan's CPU form (texel reads) with S a multiple of 4: the element shaders take four sigma
   // points a lane (kernels/vulkan/sigma_quads.h); false: one (tests compare).
   bool sigma_quads = true;

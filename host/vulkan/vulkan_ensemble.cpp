@@ -69,6 +69,10 @@ VulkanEnsemble::VulkanEnsemble(const Model& model, EstimatedParameters estimated
     shift_rows_ = SpringCorrection(estimated_spring_rows(model_, estimated_));
   }
   cg_partitioned_ = cg_partitions_ > 1 || multigrid_;
+  // On a CPU device with enough sigma points the one-partition CG shaders take a sigma point a
+  // lane (conjugate_gradient.comp; DeviceOptions::cg_sigma_lanes_from).
+  cg_sigma_lanes_ = info.type == "cpu" && !cg_partitioned_ && options.cg_sigma_lanes_from > 0 &&
+                    S_ >= options.cg_sigma_lanes_from;
   // CG's preconditioner (vulkan_uses_factor): one factor of the representative's system,
   // analysed here for its size, made at the first step and again when due. With one CG
   // work-group per sigma point only (its finishing shaders); on a CPU device more are made
@@ -127,7 +131,7 @@ VulkanEnsemble::VulkanEnsemble(const Model& model, EstimatedParameters estimated
   const std::vector<DeviceBuffer>& iteration = kernel_buffers(DeviceKernel::vulkan_cg_iteration);
   const std::uint32_t partitions = static_cast<std::uint32_t>(cg_partitions_);
   auto cg_kernel = [&](const char* name, const std::vector<DeviceBuffer>& buffers) {
-    return device_.kernel(name, static_cast<int>(buffers.size()), cg_group_, partitions);
+    return device_.kernel(name, static_cast<int>(buffers.size()), cg_group_, partitions, cg_sigma_lanes_);
   };
   k_cg_start_ = cg_kernel("cg_start", start);
   // One partition on a small mesh: two dispatches an iteration (cg_node_iteration forms q = A d
@@ -258,6 +262,11 @@ std::size_t VulkanEnsemble::element_items() const {
   return elements_ * static_cast<std::size_t>(sigma_quads_ ? S_ / 4 : S_);
 }
 
+std::uint32_t VulkanEnsemble::cg_groups() const {
+  const std::uint32_t S = static_cast<std::uint32_t>(S_);
+  return cg_sigma_lanes_ ? (S + cg_group_ - 1) / cg_group_ : S;
+}
+
 void VulkanEnsemble::record_system_product(VkCommandBuffer cmd, VkDescriptorSet product_set) const {
   const std::size_t S = static_cast<std::size_t>(S_);
   dispatch_items(cmd, k_element_product_, product_set, element_items(), elements_);
@@ -269,7 +278,7 @@ void VulkanEnsemble::record_cg_iterations(VkCommandBuffer cmd, int count) const 
   push.S = static_cast<std::uint32_t>(S_);
   push.count = static_cast<std::uint32_t>(nodes_);
   push.max_iterations = model_.solver.cg_max_iterations;
-  const std::uint32_t groups = static_cast<std::uint32_t>(S_ * cg_partitions_);
+  const std::uint32_t groups = cg_partitioned_ ? static_cast<std::uint32_t>(S_ * cg_partitions_) : cg_groups();
   for (int i = 0; i < count; ++i) {
     if (node_iteration_) {
       dispatch_items(cmd, k_element_product_, s_product_cg_, element_items(), elements_);
@@ -298,7 +307,7 @@ void VulkanEnsemble::record_factor_solve(VkCommandBuffer cmd, const VulkanKernel
   push.S = static_cast<std::uint32_t>(S_);
   push.count = static_cast<std::uint32_t>(nodes_);
   push.max_iterations = model_.solver.cg_max_iterations;
-  device_.dispatch(cmd, finish, set, &push, static_cast<std::uint32_t>(S_));
+  device_.dispatch(cmd, finish, set, &push, cg_groups());
   device_.barrier(cmd);
 }
 
@@ -392,7 +401,7 @@ StepReport VulkanEnsemble::advance(const Eigen::Vector3d& so_position) {
     device_.dispatch(cmd, k_cg_start_scalars_, s_cg_start_scalars_, &push,
                      (static_cast<std::uint32_t>(S_) + cg_group_ - 1) / cg_group_);
   } else {
-    device_.dispatch(cmd, k_cg_start_, s_cg_start_, &push, static_cast<std::uint32_t>(S_));
+    device_.dispatch(cmd, k_cg_start_, s_cg_start_, &push, cg_groups());
   }
   device_.barrier(cmd);
   if (factor_) record_factor_solve(cmd, k_cg_factor_start_, s_cg_factor_start_);

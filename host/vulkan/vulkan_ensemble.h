@@ -75,6 +75,8 @@ class VulkanEnsemble : public DeviceEnsemble {
   bool node_iteration() const { return node_iteration_; }
   // Whether the element shaders take four sigma points a lane (kernels/vulkan/sigma_quads.h).
   bool sigma_quads() const { return sigma_quads_; }
+  // Whether the one-partition CG shaders take a sigma point a lane (conjugate_gradient.comp).
+  bool cg_sigma_lanes() const { return cg_sigma_lanes_; }
   // Host waits (command-buffer submissions) of the last advance().
   int last_step_waits() const { return last_step_waits_; }
   // Whether CG is preconditioned by a factor (vulkan_uses_factor), its factorisations so far
@@ -114,6 +116,8 @@ class VulkanEnsemble : public DeviceEnsemble {
   void record_system_product(VkCommandBuffer cmd, VkDescriptorSet element_product_set) const;
   // Lanes of the element shaders: elements x S, or x S / 4 with sigma quads.
   std::size_t element_items() const;
+  // Work-groups of the one-partition CG shaders: S, or S / cg_group_ with lanes over sigma points.
+  std::uint32_t cg_groups() const;
   // Records what set_parameters() and recenter() left for the next submission; flush_pending()
   // submits it alone, before a read-out.
   bool has_pending() const;
@@ -126,6 +130,7 @@ class VulkanEnsemble : public DeviceEnsemble {
   bool node_iteration_ = false;              // CG iterations by element_product and cg_node_iteration
   bool sigma_quads_ = false;                 // element shaders four sigma points a lane
   bool cg_partitioned_ = false;              // CG in the partitions' shaders (P > 1, or the V-cycle)
+  bool cg_sigma_lanes_ = false;              // the one-partition CG shaders' lanes over sigma points
   int last_step_waits_ = 0;
   // The observations gathered at the end of the last advance(), until recenter() moves x.
   mutable std::vector<double> observations_cache_;

@@ -40,6 +40,14 @@
  * sums, summed in partition order, and each group's own copies of its scalars keep every
  * group's bits the same and no group reading what another writes).
  *
+ * Lanes over sigma points (specialization constant 2, SF_SIGMA_LANES; one partition, on a CPU
+ * device): a group's lanes are sigma points instead, each lane walking all of its sigma point's
+ * rows and summing its dot products itself, in row order (no tree, no barriers; the host
+ * dispatches ceil(S / G) groups). The lanes of a vector then take the same node at once, so
+ * that its loops over element corners and ligaments turn alike in every lane, and read the
+ * node's data at one address, where a group over a sigma point's nodes turns each loop as often
+ * as its busiest node needs (bench/RESULTS.md, stop 57).
+ *
  * Per-sigma scalars (arrays of S): bb = b.b, rr = r.r, rz = r.z, active (1 while iterating),
  * converged (1 converged, 0 hit the cap or broke down), iterations (products done). */
 #version 450
@@ -64,11 +72,29 @@
 
 layout(local_size_x_id = 0) in;
 layout(constant_id = 1) const uint SF_PARTITIONS = 1u;
+layout(constant_id = 2) const bool SF_SIGMA_LANES = false;
+
+/* This invocation's sigma point (one partition), its first row (node) and the step to its next,
+ * and whether it stores the sigma point's scalars: by lanes over sigma points or a group a
+ * sigma point. */
+uint sf_sigma_point() { return SF_SIGMA_LANES ? gl_GlobalInvocationID.x : gl_WorkGroupID.x; }
+uint sf_first_row() { return SF_SIGMA_LANES ? 0u : gl_LocalInvocationID.x; }
+uint sf_row_step() { return SF_SIGMA_LANES ? 1u : gl_WorkGroupSize.x; }
+bool sf_leads() { return SF_SIGMA_LANES || gl_LocalInvocationID.x == 0u; }
+/* Everyone in a group over a sigma point has read its old scalars before they change. */
+void sf_scalars_read() {
+  if (!SF_SIGMA_LANES) {
+    memoryBarrierBuffer();
+    barrier();
+  }
+}
 
 shared real scratch[gl_WorkGroupSize.x];
 
-/* Tree reduction of one value per invocation of the group, returned to every invocation. */
+/* Tree reduction of one value per invocation of the group, returned to every invocation; a
+ * lane's own with lanes over sigma points. */
 real sf_group_sum(real value) {
+  if (SF_SIGMA_LANES) return value;
   uint lid = gl_LocalInvocationID.x;
   barrier(); /* the previous sum's result has been read by everyone */
   scratch[lid] = value;
@@ -128,7 +154,7 @@ void sf_start_rows(uint s, uint S, uint begin, uint end, out real sum_bb, out re
   sum_bb = real(0);
   sum_rr = real(0);
   sum_rz = real(0);
-  for (uint n = begin + gl_LocalInvocationID.x; n < end; n += gl_WorkGroupSize.x) {
+  for (uint n = begin + sf_first_row(); n < end; n += sf_row_step()) {
     real spring;
     SF_SPRING_OF(n, s, S, spring)
     real m = sf_solver_mass(SF_LOAD(mass, n), spring);
@@ -160,10 +186,11 @@ bool sf_start_scalars(uint s, real sum_bb, real sum_rr, real sum_rz) {
 
 #  if defined(SF_ENTRY_CG_START)
 void main() {
-  uint s = gl_WorkGroupID.x;
+  uint s = sf_sigma_point();
+  if (s >= sf_push.S) return;   /* lanes over sigma points: past the last */
   real sum_bb, sum_rr, sum_rz;
   sf_start_rows(s, sf_push.S, 0u, sf_push.count, sum_bb, sum_rr, sum_rz);
-  if (gl_LocalInvocationID.x == 0u) sf_start_scalars(s, sum_bb, sum_rr, sum_rz);
+  if (sf_leads()) sf_start_scalars(s, sum_bb, sum_rr, sum_rz);
 }
 
 #  elif defined(SF_ENTRY_CG_START_PARTIALS)
@@ -242,7 +269,7 @@ layout(std430, binding = SF_CG_ITERATION_OWN_RZ) restrict buffer OwnRz { real ow
 /* The group's d.q over nodes [begin, end) of sigma point s. */
 real sf_dq_rows(uint s, uint S, uint begin, uint end) {
   real sum_dq = real(0);
-  for (uint n = begin + gl_LocalInvocationID.x; n < end; n += gl_WorkGroupSize.x) {
+  for (uint n = begin + sf_first_row(); n < end; n += sf_row_step()) {
 #  if defined(SF_ENTRY_CG_NODE_ITERATION)
     /* q = A d at the node's rows, as node_product forms it, kept for the update. */
     real spring;
@@ -272,7 +299,7 @@ void sf_update_rows(uint s, uint S, uint begin, uint end, real alpha, out real s
                     out real sum_rz) {
   sum_rr = real(0);
   sum_rz = real(0);
-  for (uint n = begin + gl_LocalInvocationID.x; n < end; n += gl_WorkGroupSize.x)
+  for (uint n = begin + sf_first_row(); n < end; n += sf_row_step())
     for (uint k = 0u; k < 3u; ++k) {
       uint row = (3u * n + k) * S + s;
 #  if defined(SF_FACTOR) /* z is factor_solve's */
@@ -287,7 +314,7 @@ void sf_update_rows(uint s, uint S, uint begin, uint end, real alpha, out real s
 
 /* d = z + beta d over the nodes. */
 void sf_direction_rows(uint s, uint S, uint begin, uint end, real beta) {
-  for (uint n = begin + gl_LocalInvocationID.x; n < end; n += gl_WorkGroupSize.x)
+  for (uint n = begin + sf_first_row(); n < end; n += sf_row_step())
     for (uint k = 0u; k < 3u; ++k) {
       uint row = (3u * n + k) * S + s;
       d[row] = z[row] + beta * d[row];
@@ -319,8 +346,8 @@ void sf_store_scalars(uint s, int count, real sum_rr, real sum_rz, bool done, bo
  * d = z + beta d. */
 void main() {
   uint S = sf_push.S;
-  uint s = gl_WorkGroupID.x;
-  if (active_flags[s] == 0u) return; /* the same for the whole group: no barrier is left waiting */
+  uint s = sf_sigma_point();
+  if (s >= S || active_flags[s] == 0u) return; /* the same for the whole group: no barrier is left waiting */
   int count = iterations[s] + 1;
   real rz_old = rz[s];
   real alpha = rz_old / sf_dq_rows(s, S, 0u, sf_push.count);
@@ -328,9 +355,8 @@ void main() {
   sf_update_rows(s, S, 0u, sf_push.count, alpha, sum_rr, sum_rz);
   bool done = sf_done(s, sum_rr);
   bool stop = sf_stop(done, sum_rr, count);
-  memoryBarrierBuffer();
-  barrier(); /* everyone has read the old scalars before they change */
-  if (gl_LocalInvocationID.x == 0u) sf_store_scalars(s, count, sum_rr, sum_rz, done, stop);
+  sf_scalars_read();
+  if (sf_leads()) sf_store_scalars(s, count, sum_rr, sum_rz, done, stop);
 #    if !defined(SF_FACTOR) /* else factor_solve's z, then cg_factor_direction */
   if (stop) return;
   sf_direction_rows(s, S, 0u, sf_push.count, sum_rz / rz_old);
@@ -342,19 +368,18 @@ void main() {
  * beta = r.z / the last r.z. */
 void main() {
   uint S = sf_push.S;
-  uint s = gl_WorkGroupID.x;
-  if (active_flags[s] == 0u) return; /* the same for the whole group */
+  uint s = sf_sigma_point();
+  if (s >= S || active_flags[s] == 0u) return; /* the same for the whole group */
   real sum_rz = real(0);
-  for (uint row = gl_LocalInvocationID.x; row < 3u * sf_push.count; row += gl_WorkGroupSize.x)
+  for (uint row = sf_first_row(); row < 3u * sf_push.count; row += sf_row_step())
     sum_rz += r[row * S + s] * z[row * S + s];
   sum_rz = sf_group_sum(sum_rz);
 #    if defined(SF_ENTRY_CG_FACTOR_DIRECTION)
   real beta = sum_rz / rz[s];
-  memoryBarrierBuffer();
-  barrier(); /* everyone has read the old r.z before it changes */
+  sf_scalars_read();
 #    endif
-  if (gl_LocalInvocationID.x == 0u) rz[s] = sum_rz;
-  for (uint row = gl_LocalInvocationID.x; row < 3u * sf_push.count; row += gl_WorkGroupSize.x) {
+  if (sf_leads()) rz[s] = sum_rz;
+  for (uint row = sf_first_row(); row < 3u * sf_push.count; row += sf_row_step()) {
     uint at = row * S + s;
 #    if defined(SF_ENTRY_CG_FACTOR_START)
     d[at] = z[at];

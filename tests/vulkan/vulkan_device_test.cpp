@@ -258,6 +258,61 @@ TEST_F(VulkanDeviceTest, ElementShadersOnSigmaQuadsGiveTheBitsOfOneALane) {
   EXPECT_FALSE(six.sigma_quads()) << "S = 6 is not a multiple of 4";
 }
 
+// The CG shaders with a sigma point a lane (from DeviceOptions::cg_sigma_lanes_from, on a CPU
+// device: each lane walks its sigma point's rows and sums in row order) against a work-group a
+// sigma point (its tree of sums): the same steps to their rounding, in float and double, at
+// S = 17 (two full groups of 8 and one of one lane, seven past S), in the two dispatches an
+// iteration and the three, over 40 steps. The sums' order differs, so the bits may: CG's
+// iterations within one a step, the positions within 2e-7 m in float (1e-14 m in double) of
+// each other (measured: 3e-8 and 3e-17), where the steps move the nodes by half a millimetre.
+TEST_F(VulkanDeviceTest, CgWithASigmaPointALaneFollowsAGroupASigmaPoint) {
+  Scenario scenario = load_scenario(std::string(SIGMAFEM_SOURCE_DIR) + "/scenarios/liver.json");
+  const std::vector<int>& estimated = scenario.filter->estimate;
+  const int p = static_cast<int>(estimated.size());
+  const Model model = make_model(scenario);
+  for (const Precision precision : {Precision::single, Precision::double_precision}) {
+    for (const int S : {17}) {
+      for (const long long node_iteration_work : {kNodeIterationWork, 0LL}) {
+        const std::string what = std::string(precision == Precision::single ? "float" : "double") +
+                                 ", S = " + std::to_string(S) + (node_iteration_work ? ", two dispatches" : ", three");
+        DeviceOptions lanes, groups;
+        lanes.precision = groups.precision = precision;
+        lanes.node_iteration_work = groups.node_iteration_work = node_iteration_work;
+        groups.cg_sigma_lanes_from = 0;
+        VulkanEnsemble by_lanes(model, estimated, scenario.observations.nodes, S, lanes);
+        VulkanEnsemble by_groups(model, estimated, scenario.observations.nodes, S, groups);
+        ASSERT_TRUE(by_lanes.cg_sigma_lanes()) << what;
+        ASSERT_FALSE(by_groups.cg_sigma_lanes()) << what;
+        Eigen::MatrixXd theta(p, S);
+        for (int j = 0; j < p; ++j)
+          for (int s = 0; s < S; ++s)
+            theta(j, s) = std::log(model.ligaments[estimated[j]].stiffness) + 0.3 * std::cos(s + 2 * j);
+        by_lanes.set_parameters(theta);
+        by_groups.set_parameters(theta);
+        double moved = 0.0, apart = 0.0;
+        const Eigen::VectorXd start = by_groups.positions(0);
+        long long iterations = 0;
+        for (int k = 1; k <= 40; ++k) {
+          const Eigen::Vector3d so = scenario.control.trajectory.position(k * scenario.time.dt, scenario.control.start);
+          const StepReport a = by_lanes.advance(so);
+          const StepReport b = by_groups.advance(so);
+          EXPECT_EQ(a.unconverged_count(), 0) << what;
+          for (const int i : a.cg_iterations) iterations += i;
+          for (int s = 0; s < S; ++s)
+            EXPECT_LE(std::abs(a.cg_iterations[s] - b.cg_iterations[s]), 1) << what << ", step " << k << ", sigma point " << s;
+        }
+        for (int s = 0; s < S; ++s) {
+          moved = std::max(moved, (by_groups.positions(s) - start).cwiseAbs().maxCoeff());
+          apart = std::max(apart, (by_lanes.positions(s) - by_groups.positions(s)).cwiseAbs().maxCoeff());
+        }
+        EXPECT_GT(moved, 1e-4) << what << ": the steps move the nodes";
+        EXPECT_GT(iterations, 40 * S) << what << ": CG iterates";
+        EXPECT_LT(apart, precision == Precision::single ? 2e-7 : 1e-14) << what;
+      }
+    }
+  }
+}
+
 // Lavapipe's threads by the ensemble's work (DeviceOptions::lavapipe_serial_work): the box at
 // S = 4 (5376 element-sigma pairs) runs its shaders on the submitting thread (LP_NUM_THREADS
 // "0" while its device is made), the same box asked to take the threads gets lavapipe's default
