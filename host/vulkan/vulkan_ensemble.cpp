@@ -113,14 +113,14 @@ VulkanEnsemble::VulkanEnsemble(const Model& model, EstimatedParameters estimated
   auto kernel = [&](const char* name, DeviceKernel k) {
     return device_.kernel(name, static_cast<int>(kernel_buffers(k).size()));
   };
-  // The element shaders four sigma points a lane on a CPU device (kernels/vulkan/sigma_quads.h),
-  // where S allows.
+  // The element and node shaders four sigma points a lane on a CPU device
+  // (kernels/vulkan/sigma_quads.h), where S allows.
   sigma_quads_ = options.sigma_quads && device_.texel_reads() && S_ % 4 == 0;
   k_element_rhs_ = kernel(sigma_quads_ ? "element_rhs_quads" : "element_rhs", DeviceKernel::element_rhs);
-  k_node_rhs_ = kernel("node_rhs", DeviceKernel::node_rhs);
+  k_node_rhs_ = kernel(sigma_quads_ ? "node_rhs_quads" : "node_rhs", DeviceKernel::node_rhs);
   k_element_product_ =
       kernel(sigma_quads_ ? "element_product_quads" : "element_product", DeviceKernel::element_product);
-  k_node_product_ = kernel("node_product", DeviceKernel::node_product);
+  k_node_product_ = kernel(sigma_quads_ ? "node_product_quads" : "node_product", DeviceKernel::node_product);
   k_state_update_ = kernel("state_update", DeviceKernel::state_update);
   k_observation_gather_ = kernel("observation_gather", DeviceKernel::observation_gather);
   k_recenter_ = kernel("recenter", DeviceKernel::recenter);
@@ -262,15 +262,18 @@ std::size_t VulkanEnsemble::element_items() const {
   return elements_ * static_cast<std::size_t>(sigma_quads_ ? S_ / 4 : S_);
 }
 
+std::size_t VulkanEnsemble::node_items() const {
+  return nodes_ * static_cast<std::size_t>(sigma_quads_ ? S_ / 4 : S_);
+}
+
 std::uint32_t VulkanEnsemble::cg_groups() const {
   const std::uint32_t S = static_cast<std::uint32_t>(S_);
   return cg_sigma_lanes_ ? (S + cg_group_ - 1) / cg_group_ : S;
 }
 
 void VulkanEnsemble::record_system_product(VkCommandBuffer cmd, VkDescriptorSet product_set) const {
-  const std::size_t S = static_cast<std::size_t>(S_);
   dispatch_items(cmd, k_element_product_, product_set, element_items(), elements_);
-  dispatch_items(cmd, k_node_product_, s_node_product_, nodes_ * S, nodes_);
+  dispatch_items(cmd, k_node_product_, s_node_product_, node_items(), nodes_);
 }
 
 void VulkanEnsemble::record_cg_iterations(VkCommandBuffer cmd, int count) const {
@@ -387,7 +390,7 @@ StepReport VulkanEnsemble::advance(const Eigen::Vector3d& so_position) {
   }
   device_.barrier(cmd);
   dispatch_items(cmd, k_element_rhs_, s_element_rhs_, element_items(), elements_);
-  dispatch_items(cmd, k_node_rhs_, s_node_rhs_, nodes_ * S, nodes_);
+  dispatch_items(cmd, k_node_rhs_, s_node_rhs_, node_items(), nodes_);
   // The warm start's products K_e dv_e; cg_start gathers them itself.
   dispatch_items(cmd, k_element_product_, s_product_warm_start_, element_items(), elements_);
   PushConstants push;

@@ -116,6 +116,8 @@ class VulkanEnsemble : public DeviceEnsemble {
   void record_system_product(VkCommandBuffer cmd, VkDescriptorSet element_product_set) const;
   // Lanes of the element shaders: elements x S, or x S / 4 with sigma quads.
   std::size_t element_items() const;
+  // Lanes of the node shaders: nodes x S, or x S / 4 with sigma quads.
+  std::size_t node_items() const;
   // Work-groups of the one-partition CG shaders: S, or S / cg_group_ with lanes over sigma points.
   std::uint32_t cg_groups() const;
   // Records what set_parameters() and recenter() left for the next submission; flush_pending()
@@ -128,7 +130,7 @@ class VulkanEnsemble : public DeviceEnsemble {
   std::uint32_t cg_group_ = 64;              // work-items per sigma point in the CG shaders
   int cg_partitions_ = 1;                    // work-groups per sigma point in them (constant 1)
   bool node_iteration_ = false;              // CG iterations by element_product and cg_node_iteration
-  bool sigma_quads_ = false;                 // element shaders four sigma points a lane
+  bool sigma_quads_ = false;                 // element and node shaders four sigma points a lane
   bool cg_partitioned_ = false;              // CG in the partitions' shaders (P > 1, or the V-cycle)
   bool cg_sigma_lanes_ = false;              // the one-partition CG shaders' lanes over sigma points
   int last_step_waits_ = 0;

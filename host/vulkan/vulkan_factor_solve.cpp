@@ -10,9 +10,10 @@
 namespace sigmafem {
 namespace {
 
-// A block-row or block-column step of factor_solve.comp turns once per block, its loop once
-// more on leaving, and at most 6 more in the loops over a panel's 4 rows (if the compiler
-// does not unroll them) and the step loop: counted, to be safe.
+// A block-row or block-column step of factor_solve.comp turns once per block (per chunk of 8
+// with the shared reads), its loop once more on leaving, and at most 6 more in the loops over
+// a panel's 4 rows (if the compiler does not unroll them) and the step loop: counted, to be
+// safe.
 constexpr long long kStepTurns = 8;
 
 // V's row length on the device: m rounded up to 4 (factor_solve.comp reads 4 at a time).
@@ -169,14 +170,17 @@ void VulkanFactorSolve::plan_dispatches() {
   ranges_.clear();
   const FactorBlocks& b = *layout_->blocks;
   const auto [m, reached] = spring_steps_;
+  // A block row or column turns once a block, or with the shared reads once a chunk of 8.
+  const int chunk = shared_ ? 8 : 1;
+  auto block_turns = [chunk](int blocks) { return static_cast<long long>((blocks + chunk - 1) / chunk) + kStepTurns; };
   std::vector<long long> turns;
-  for (int q = 0; q < b.panels(); ++q) turns.push_back(b.forward_starts()[q + 1] - b.forward_starts()[q] + kStepTurns);
+  for (int q = 0; q < b.panels(); ++q) turns.push_back(block_turns(b.forward_starts()[q + 1] - b.forward_starts()[q]));
   const long long quads = static_cast<long long>(padded(static_cast<std::size_t>(m)) / 4);
   turns.insert(turns.end(), static_cast<std::size_t>(quads), reached + 2);   // (V^T y)_4i..4i+3
   turns.insert(turns.end(), static_cast<std::size_t>(m), m + 5);             // (H V^T y)_j, the padding
   turns.insert(turns.end(), static_cast<std::size_t>(reached), quads + 2);   // y -= V H V^T y, a slot
   for (int p = b.panels() - 1; p >= 0; --p)
-    turns.push_back(b.backward_starts()[p + 1] - b.backward_starts()[p] + kStepTurns);
+    turns.push_back(block_turns(b.backward_starts()[p + 1] - b.backward_starts()[p]));
   long long sum = 0;
   std::uint32_t first = 0;
   for (std::size_t step = 0; step < turns.size(); ++step) {

@@ -30,6 +30,7 @@
 #  define SF_SELECT(cond, a, b) ((cond) ? (a) : (b))
 #  define SF_NONZERO(x) ((x) != SF_LIT(0.0))
 #  define SF_POSITIVE(x) ((x) > SF_LIT(0.0))
+#  define SF_BOTH_ZERO(a, b) ((a) == SF_LIT(0.0) && (b) == SF_LIT(0.0))
 typedef unsigned int uint;
 #elif defined(__OPENCL_VERSION__) /* OpenCL C on PoCL or a GPU driver */
 #  ifndef SF_REAL
@@ -54,6 +55,7 @@ typedef unsigned int uint;
 #  define SF_SELECT(cond, a, b) ((cond) ? (a) : (b))
 #  define SF_NONZERO(x) ((x) != SF_LIT(0.0))
 #  define SF_POSITIVE(x) ((x) > SF_LIT(0.0))
+#  define SF_BOTH_ZERO(a, b) ((a) == SF_LIT(0.0) && (b) == SF_LIT(0.0))
 #elif defined(VULKAN) /* GLSL through glslang for Vulkan */
 #  ifndef SF_REAL
 #    define SF_REAL float
@@ -75,14 +77,21 @@ typedef unsigned int uint;
 #  else
 #    define SF_LOAD(a, i) a[i]
 #  endif
+/* The shared math's choices (SF_SELECT(cond, a, b) with SF_NONZERO, SF_POSITIVE, SF_BOTH_ZERO
+ * conditions): ternaries, or per component where SF_REAL is a vec4 of sigma points
+ * (kernels/vulkan/sigma_quads.h). */
 #  if defined(SF_SIGMA_QUADS)
 #    define SF_SELECT(cond, a, b) mix((b), (a), (cond))
 #    define SF_NONZERO(x) notEqual((x), SF_LIT(0.0))
 #    define SF_POSITIVE(x) greaterThan((x), SF_LIT(0.0))
+/* Per component: both zero (node_rows.h's placeholder mass). */
+#    define SF_BOTH_ZERO(a, b) \
+      notEqual(uvec4(equal((a), SF_LIT(0.0))) & uvec4(equal((b), SF_LIT(0.0))), uvec4(0u))
 #  else
 #    define SF_SELECT(cond, a, b) ((cond) ? (a) : (b))
 #    define SF_NONZERO(x) ((x) != SF_LIT(0.0))
 #    define SF_POSITIVE(x) ((x) > SF_LIT(0.0))
+#    define SF_BOTH_ZERO(a, b) ((a) == SF_LIT(0.0) && (b) == SF_LIT(0.0))
 #  endif
 #else
 #  error "dialect.h: expected C++, OpenCL C or Vulkan GLSL"

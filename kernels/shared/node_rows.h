@@ -76,7 +76,7 @@ struct SfNodeConstants {
 /* A node that no tetrahedron uses and no spring holds has a unit placeholder mass, so that
  * its rows of A are not zero (as in ImplicitEulerSystem). */
 SF_FN SF_REAL sf_solver_mass(SF_REAL mass, SF_REAL spring) {
-  return (mass == SF_LIT(0) && spring == SF_LIT(0)) ? SF_LIT(1) : mass;
+  return SF_SELECT(SF_BOTH_ZERO(mass, spring), SF_LIT(1), mass);
 }
 
 /* Row of A d, from the gathered element products Kd_elements and the row's d. */

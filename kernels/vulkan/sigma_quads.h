@@ -1,6 +1,7 @@
-/* sigma_quads.h: the element shaders' sigma-quad form (compiled with SF_SIGMA_QUADS), four
- * sigma points a lane: S a multiple of 4, lane (e, q) takes element e's sigma points 4q ..
- * 4q + 3, and SF_REAL, element.h's arithmetic, is a vec4 of them (ensemble_layout.h). On
+/* sigma_quads.h: the element and node shaders' sigma-quad form (compiled with SF_SIGMA_QUADS),
+ * four sigma points a lane: S a multiple of 4, lane (e, q) takes element (or node) e's sigma
+ * points 4q .. 4q + 3, and SF_REAL, element.h's and node_rows.h's arithmetic, is a vec4 of
+ * them (ensemble_layout.h). On
  * llvmpipe a lane's loads and stores cost by the count, not the width: the element's own data
  * is read once for four sigma points, and each per-sigma value of four comes in one rgba32f
  * texel fetch and goes in one vec4 store, where the scalar form takes four of each (the
@@ -55,5 +56,49 @@
   SF_UNROLL for (uint c_ = 0u; c_ < 4u; ++c_)                                         \
     SF_UNROLL for (uint k_ = 0u; k_ < 3u; ++k_)                                       \
       out[3u * c_ + k_] = SF_QUAD(v, (3u * corner_nodes[c_] + k_) * (Q) + (q));
+
+/* node_rows.h's SF_CORNER_SUMS by quads: the three axes' sums of a per-corner output over node
+ * n's incident corners, in the incidence order. */
+#define SF_CORNER_SUM_QUADS(values, incidence_offsets, incidence, n, q, Q, sum)       \
+  {                                                                                  \
+    sum[0] = SF_LIT(0);                                                              \
+    sum[1] = SF_LIT(0);                                                              \
+    sum[2] = SF_LIT(0);                                                              \
+    int end_ = SF_LOAD(incidence_offsets, (n) + 1u);                                 \
+    for (int i_ = SF_LOAD(incidence_offsets, n); i_ < end_; ++i_) {                  \
+      uint base_ = 3u * uint(SF_LOAD(incidence, i_)) * (Q) + (q);                    \
+      sum[0] += SF_QUAD(values, base_);                                              \
+      sum[1] += SF_QUAD(values, base_ + (Q));                                        \
+      sum[2] += SF_QUAD(values, base_ + 2u * (Q));                                   \
+    }                                                                                \
+  }
+/* node_rows.h's SF_NODE_SPRING by quads (ligament_k read by quads: [l S + s]). */
+#define SF_NODE_SPRING_QUADS(ligament_offsets, ligament_of_node, ligament_k, control_k, n, q, Q, spring) \
+  {                                                                                  \
+    spring = SF_REAL(SF_LOAD(control_k, n));                                         \
+    int end_ = SF_LOAD(ligament_offsets, (n) + 1u);                                  \
+    for (int i_ = SF_LOAD(ligament_offsets, n); i_ < end_; ++i_)                     \
+      spring += SF_QUAD(ligament_k, uint(SF_LOAD(ligament_of_node, i_)) * (Q) + (q)); \
+  }
+/* node_rows.h's SF_LOAD_NODE_CONSTANTS for quad q. */
+#define SF_LOAD_NODE_CONSTANT_QUADS(c, q, S, out)                                    \
+  {                                                                                  \
+    out.h = SF_REAL(SF_LOAD(c, SF_H));                                               \
+    out.mass_factor = SF_QUAD_CONSTANT(c, SF_MASS_FACTOR, q, S);                     \
+    out.stiffness_factor = SF_QUAD_CONSTANT(c, SF_STIFFNESS_FACTOR, q, S);           \
+    out.rayleigh_mass = SF_QUAD_CONSTANT(c, SF_RAYLEIGH_MASS, q, S);                 \
+    out.velocity_factor = SF_QUAD_CONSTANT(c, SF_VELOCITY_FACTOR, q, S);             \
+    out.young_scale = SF_QUAD_CONSTANT(c, SF_YOUNG_SCALE, q, S);                     \
+    out.inverse_d0_squared = SF_QUAD_CONSTANT(c, SF_INVERSE_D0_SQUARED, q, S);       \
+    for (uint k_ = 0u; k_ < 3u; ++k_) {                                              \
+      out.gravity[k_] = SF_QUAD_CONSTANT(c, SF_GRAVITY + k_, q, S);                  \
+      out.so_shift[k_] = SF_QUAD_CONSTANT(c, SF_SO_SHIFT + k_, q, S);                \
+    }                                                                                \
+  }
+/* node_rows.h's SF_SYSTEM_ROW for quad q. */
+#define SF_SYSTEM_ROW_QUADS(c, q, S, Kd_elements, spring, m, d_row)                  \
+  sf_system_row(SF_QUAD_CONSTANT(c, SF_STIFFNESS_FACTOR, q, S),                      \
+                SF_QUAD_CONSTANT(c, SF_YOUNG_SCALE, q, S),                           \
+                SF_QUAD_CONSTANT(c, SF_MASS_FACTOR, q, S), Kd_elements, spring, m, d_row)
 
 #endif /* SIGMAFEM_VULKAN_SIGMA_QUADS_H */

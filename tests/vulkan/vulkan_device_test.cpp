@@ -212,10 +212,11 @@ TEST_F(VulkanDeviceTest, CgInTwoDispatchesGivesTheBitsOfThree) {
   }
 }
 
-// The element shaders four sigma points a lane (kernels/vulkan/sigma_quads.h; S a multiple
-// of 4, the CPU form) do per component what the one-a-lane shaders do: the same bits, with
-// the QR and the polar frames (its selects per component), in float and double, at S = 8 (two
-// quads an element); at S = 6 the ensemble keeps one a lane.
+// The element and node shaders four sigma points a lane (kernels/vulkan/sigma_quads.h; S a
+// multiple of 4, the CPU form) do per component what the one-a-lane shaders do: the same bits,
+// with the QR and the polar frames (its selects per component), in float and double, at S = 8
+// (two quads an element), node_product's quads too with the QR frames (three dispatches an
+// iteration); at S = 6 the ensemble keeps one a lane.
 TEST_F(VulkanDeviceTest, ElementShadersOnSigmaQuadsGiveTheBitsOfOneALane) {
   Scenario scenario = load_scenario(std::string(SIGMAFEM_SOURCE_DIR) + "/scenarios/liver.json");
   const std::vector<int>& estimated = scenario.filter->estimate;
@@ -223,11 +224,15 @@ TEST_F(VulkanDeviceTest, ElementShadersOnSigmaQuadsGiveTheBitsOfOneALane) {
   for (const ElementRotation rotation : {ElementRotation::qr, ElementRotation::polar}) {
     scenario.material.rotation = rotation;
     const Model model = make_model(scenario);
-    for (const Precision precision : {Precision::single, Precision::double_precision}) {
+    for (const Precision precision : {Precision::single, Precision::double_precision})
+    for (const long long node_iteration_work : {kNodeIterationWork, 0LL}) {
+      if (node_iteration_work == 0 && rotation == ElementRotation::polar) continue;
       const std::string what = std::string(rotation == ElementRotation::polar ? "polar" : "qr") +
-                               (precision == Precision::single ? ", float" : ", double");
+                               (precision == Precision::single ? ", float" : ", double") +
+                               (node_iteration_work == 0 ? ", node_product" : "");
       DeviceOptions quads, lanes;
       quads.precision = lanes.precision = precision;
+      quads.node_iteration_work = lanes.node_iteration_work = node_iteration_work;
       lanes.sigma_quads = false;
       const int S = 8;
       VulkanEnsemble by_quads(model, estimated, scenario.observations.nodes, S, quads);
