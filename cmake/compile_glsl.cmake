@@ -3,7 +3,7 @@
 # texel reads, -DSF_TEXEL_READS: kernels/vulkan/ensemble_layout.h), and embedded as uint32
 # words in the program (cmake/embed_spirv.cmake), so that it needs no shader files at run time.
 # An entry is NAME:SOURCE[:DEFINE[:ENV]]: kernels/vulkan/SOURCE.comp compiled with -DDEFINE (one
-# file may hold several entry shaders, chosen with -D switches) for Vulkan ENV (vulkan1.0 by
+# file may hold several entry shaders, chosen with -D switches; DEFINE+DEFINE for two) for Vulkan ENV (vulkan1.0 by
 # default; vulkan1.1 for SPIR-V 1.3's subgroup operations, which the host uses only on a 1.1
 # device that has them). glslang defines VULKAN
 # itself (kernels/shared/dialect.h's Vulkan branch). Rebuilt when a source or any header of
@@ -31,7 +31,7 @@ function(sigmafem_compile_glsl output)
     list(LENGTH _parts _count)
     if(_count GREATER 2)
       list(GET _parts 2 _define)
-      set(_defines "-D${_define}")
+      string(REPLACE "+" ";-D" _defines "-D${_define}")
     endif()
     if(_count GREATER 3)
       list(GET _parts 3 _env)

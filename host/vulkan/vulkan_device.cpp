@@ -262,7 +262,7 @@ void VulkanDevice::download(const VulkanBuffer& buffer, void* data, std::size_t 
 }
 
 VulkanKernel VulkanDevice::kernel(const char* name, int bindings, std::uint32_t group_size,
-                                  std::uint32_t partitions, bool sigma_lanes) {
+                                  std::uint32_t partitions, std::uint32_t lane_rows) {
   const bool want_double = precision_ == Precision::double_precision;
   const EmbeddedShader* found = nullptr;
   for (std::size_t i = 0; i < kVulkanShaderCount; ++i) {
@@ -272,7 +272,7 @@ VulkanKernel VulkanDevice::kernel(const char* name, int bindings, std::uint32_t 
   }
   if (found != nullptr)
     return kernel_from_spirv(name, found->words, found->word_count, bindings, group_size,
-                             partitions, sigma_lanes);
+                             partitions, lane_rows);
   throw DeviceError(std::string("no embedded Vulkan shader '") + name + "' (" +
                     (want_double ? "double" : "single") +
                     " precision): the build did not compile it from kernels/vulkan/");
@@ -281,7 +281,7 @@ VulkanKernel VulkanDevice::kernel(const char* name, int bindings, std::uint32_t 
 VulkanKernel VulkanDevice::kernel_from_spirv(const std::string& name, const std::uint32_t* words,
                                              std::size_t word_count, int bindings,
                                              std::uint32_t group_size, std::uint32_t partitions,
-                                             bool sigma_lanes) {
+                                             std::uint32_t lane_rows) {
   // Drivers may crash on a module that is not SPIR-V, so look at its header first.
   constexpr std::uint32_t kSpirvMagic = 0x07230203;
   if (word_count < 5 || words == nullptr || words[0] != kSpirvMagic)
@@ -333,13 +333,13 @@ VulkanKernel VulkanDevice::kernel_from_spirv(const std::string& name, const std:
     code.pCode = words;
     check(api_->vkCreateShaderModule(device_, &code, nullptr, &module),
           "loading the Vulkan shader " + name);
-    // Constant 0 the group size, constant 1 the partitions (when given), constant 2 (a
-    // VkBool32) the lanes over sigma points (when set).
-    const std::uint32_t constants[3] = {group_size, partitions, sigma_lanes ? VK_TRUE : VK_FALSE};
+    // Constant 0 the group size, constant 1 the partitions (when given), constant 2 the rows
+    // at once of lanes over sigma points (when given).
+    const std::uint32_t constants[3] = {group_size, partitions, lane_rows};
     const VkSpecializationMapEntry entries[3] = {{0, 0, sizeof(std::uint32_t)},
                                                  {1, sizeof(std::uint32_t), sizeof(std::uint32_t)},
-                                                 {2, 2 * sizeof(std::uint32_t), sizeof(VkBool32)}};
-    const std::uint32_t used = sigma_lanes && partitions > 0 ? 3u : partitions > 0 ? 2u : 1u;
+                                                 {2, 2 * sizeof(std::uint32_t), sizeof(std::uint32_t)}};
+    const std::uint32_t used = lane_rows > 0 && partitions > 0 ? 3u : partitions > 0 ? 2u : 1u;
     VkSpecializationInfo specialization{used, entries, sizeof(constants), constants};
     VkComputePipelineCreateInfo pipeline{};
     pipeline.sType = VK_STRUCTURE_TYPE_COMPUTE_PIPELINE_CREATE_INFO;

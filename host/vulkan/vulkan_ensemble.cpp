@@ -33,6 +33,15 @@ bool vulkan_uses_multigrid(Preconditioner preconditioner, const std::string& dev
          (preconditioner == Preconditioner::automatic && device_type != "cpu" && nested);
 }
 
+int cg_lane_rows(int lanes_from, int sigma_count, const VulkanDeviceInfo& info, bool one_partition, bool factor) {
+  if (info.type != "cpu" || !one_partition || lanes_from <= 0 || sigma_count <= 0) return 0;
+  if (sigma_count >= lanes_from) return 1;
+  if (!factor || !info.subgroup_shuffle || info.subgroup_size < 8 || sigma_count > 4) return 0;
+  int rows = 1;
+  while (2 * rows * sigma_count <= 8) rows *= 2;
+  return rows;
+}
+
 VulkanEnsemble::VulkanEnsemble(const Model& model, EstimatedParameters estimated,
                                ObservedPoints observed, int sigma_count,
                                const DeviceOptions& options)
@@ -69,10 +78,6 @@ VulkanEnsemble::VulkanEnsemble(const Model& model, EstimatedParameters estimated
     shift_rows_ = SpringCorrection(estimated_spring_rows(model_, estimated_));
   }
   cg_partitioned_ = cg_partitions_ > 1 || multigrid_;
-  // On a CPU device with enough sigma points the one-partition CG shaders take a sigma point a
-  // lane (conjugate_gradient.comp; DeviceOptions::cg_sigma_lanes_from).
-  cg_sigma_lanes_ = info.type == "cpu" && !cg_partitioned_ && options.cg_sigma_lanes_from > 0 &&
-                    S_ >= options.cg_sigma_lanes_from;
   // CG's preconditioner (vulkan_uses_factor): one factor of the representative's system,
   // analysed here for its size, made at the first step and again when due. With one CG
   // work-group per sigma point only (its finishing shaders); on a CPU device more are made
@@ -91,6 +96,7 @@ VulkanEnsemble::VulkanEnsemble(const Model& model, EstimatedParameters estimated
       springs_ = spring_correction(options.spring_correction);   // as OpenCL's
     }
   }
+  cg_lane_rows_ = sigmafem::cg_lane_rows(options.cg_sigma_lanes_from, S_, info, !cg_partitioned_, factor_ != nullptr);
 
   // The partitions' buffers are bound but unused with one partition.
   std::size_t largest = 0;
@@ -131,9 +137,13 @@ VulkanEnsemble::VulkanEnsemble(const Model& model, EstimatedParameters estimated
   const std::vector<DeviceBuffer>& iteration = kernel_buffers(DeviceKernel::vulkan_cg_iteration);
   const std::uint32_t partitions = static_cast<std::uint32_t>(cg_partitions_);
   auto cg_kernel = [&](const char* name, const std::vector<DeviceBuffer>& buffers) {
-    return device_.kernel(name, static_cast<int>(buffers.size()), cg_group_, partitions, cg_sigma_lanes_);
+    return device_.kernel(name, static_cast<int>(buffers.size()), cg_group_, partitions,
+                          static_cast<std::uint32_t>(cg_lane_rows_));
   };
-  k_cg_start_ = cg_kernel("cg_start", start);
+  // Lanes over sigma points two or more a sigma point add their parts by subgroup shuffles: the
+  // factor's CG shaders compiled for them.
+  auto lanes = [&](const char* name) { return cg_lane_rows_ > 1 ? std::string(name) + "_lanes" : std::string(name); };
+  k_cg_start_ = cg_kernel(lanes("cg_start").c_str(), start);
   // One partition on a small mesh: two dispatches an iteration (cg_node_iteration forms q = A d
   // itself), where lavapipe's cost per dispatch outweighs their work; on a larger one the
   // three, where node_product's lanes (a node's sigma points) gather faster than
@@ -143,12 +153,12 @@ VulkanEnsemble::VulkanEnsemble(const Model& model, EstimatedParameters estimated
   // With a factor, the iteration shaders stop at the stop test, and factor_solve and
   // cg_factor_direction follow them.
   if (node_iteration_)
-    k_cg_node_iteration_ = cg_kernel(factor_ ? "cg_node_iteration_factor" : "cg_node_iteration", iteration);
+    k_cg_node_iteration_ = cg_kernel(factor_ ? lanes("cg_node_iteration_factor").c_str() : "cg_node_iteration", iteration);
   else if (!cg_partitioned_)
-    k_cg_iteration_ = cg_kernel(factor_ ? "cg_iteration_factor" : "cg_iteration", iteration);
+    k_cg_iteration_ = cg_kernel(factor_ ? lanes("cg_iteration_factor").c_str() : "cg_iteration", iteration);
   if (factor_) {
-    k_cg_factor_start_ = cg_kernel("cg_factor_start", iteration);
-    k_cg_factor_direction_ = cg_kernel("cg_factor_direction", iteration);
+    k_cg_factor_start_ = cg_kernel(lanes("cg_factor_start").c_str(), iteration);
+    k_cg_factor_direction_ = cg_kernel(lanes("cg_factor_direction").c_str(), iteration);
     factor_solve_ = std::make_unique<VulkanFactorSolve>(device_, 3 * nodes_, springs_.size(), S_, buffer(B::r),
                                                         buffer(B::z), buffer(B::active), options.factor_loop_turns);
     device_bytes_ += factor_solve_->bytes();
@@ -268,7 +278,8 @@ std::size_t VulkanEnsemble::node_items() const {
 
 std::uint32_t VulkanEnsemble::cg_groups() const {
   const std::uint32_t S = static_cast<std::uint32_t>(S_);
-  return cg_sigma_lanes_ ? (S + cg_group_ - 1) / cg_group_ : S;
+  const std::uint32_t J = static_cast<std::uint32_t>(cg_lane_rows_);
+  return J > 0 ? (J * S + cg_group_ - 1) / cg_group_ : S;
 }
 
 void VulkanEnsemble::record_system_product(VkCommandBuffer cmd, VkDescriptorSet product_set) const {

@@ -56,6 +56,12 @@ bool vulkan_uses_factor(Preconditioner preconditioner, const std::string& device
 // has a level), as OpenCL's GPU form. Asked on a mesh that was not refined so, the
 // constructor throws.
 bool vulkan_uses_multigrid(Preconditioner preconditioner, const std::string& device_type, bool nested);
+// The CG shaders' lanes over sigma points with one partition on a CPU device
+// (conjugate_gradient.comp's SF_LANE_ROWS: rows at once a sigma point): 1 from `lanes_from`
+// sigma points (DeviceOptions::cg_sigma_lanes_from; 0: never); with the factor and 8-lane
+// subgroup shuffles at S <= 4, 8 / S rounded down to a power of 2 (2 at S = 3-4, 4 at 2, 8 at 1);
+// else 0, a work-group a sigma point.
+int cg_lane_rows(int lanes_from, int sigma_count, const VulkanDeviceInfo& info, bool one_partition, bool factor);
 
 class VulkanEnsemble : public DeviceEnsemble {
  public:
@@ -76,7 +82,8 @@ class VulkanEnsemble : public DeviceEnsemble {
   // Whether the element shaders take four sigma points a lane (kernels/vulkan/sigma_quads.h).
   bool sigma_quads() const { return sigma_quads_; }
   // Whether the one-partition CG shaders take a sigma point a lane (conjugate_gradient.comp).
-  bool cg_sigma_lanes() const { return cg_sigma_lanes_; }
+  // Rows (nodes) at once of each sigma point's lanes in them; 0: a work-group a sigma point.
+  int cg_lane_rows() const { return cg_lane_rows_; }
   // Host waits (command-buffer submissions) of the last advance().
   int last_step_waits() const { return last_step_waits_; }
   // Whether CG is preconditioned by a factor (vulkan_uses_factor), its factorisations so far
@@ -132,7 +139,7 @@ class VulkanEnsemble : public DeviceEnsemble {
   bool node_iteration_ = false;              // CG iterations by element_product and cg_node_iteration
   bool sigma_quads_ = false;                 // element and node shaders four sigma points a lane
   bool cg_partitioned_ = false;              // CG in the partitions' shaders (P > 1, or the V-cycle)
-  bool cg_sigma_lanes_ = false;              // the one-partition CG shaders' lanes over sigma points
+  int cg_lane_rows_ = 0;                     // the one-partition CG shaders' lanes a sigma point (constant 2)
   int last_step_waits_ = 0;
   // The observations gathered at the end of the last advance(), until recenter() moves x.
   mutable std::vector<double> observations_cache_;

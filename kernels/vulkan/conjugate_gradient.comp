@@ -40,18 +40,23 @@
  * sums, summed in partition order, and each group's own copies of its scalars keep every
  * group's bits the same and no group reading what another writes).
  *
- * Lanes over sigma points (specialization constant 2, SF_SIGMA_LANES; one partition, on a CPU
- * device): a group's lanes are sigma points instead, each lane walking all of its sigma point's
- * rows and summing its dot products itself, in row order (no tree, no barriers; the host
- * dispatches ceil(S / G) groups). The lanes of a vector then take the same node at once, so
- * that its loops over element corners and ligaments turn alike in every lane, and read the
- * node's data at one address, where a group over a sigma point's nodes turns each loop as often
- * as its busiest node needs (bench/RESULTS.md, stop 57).
+ * Lanes over sigma points (specialization constant 2, SF_LANE_ROWS = J > 0; one partition, on
+ * a CPU device): a group's G lanes are G / J sigma points, J lanes each, lane (j, s) walking
+ * every J-th node of its sigma point from the j-th and summing its dot products itself, in
+ * node order, the J parts then added in lane order by subgroup shuffles (J > 1: the entries
+ * compiled with SF_LANE_SHUFFLES, SPIR-V 1.3; no tree, no barriers; the host dispatches
+ * ceil(J S / G) groups). The lanes of a vector then take one node (J = 1) or J at once, so that
+ * its loops over element corners and ligaments turn alike in its lanes, and read the node's
+ * data at one address, where a group over a sigma point's nodes turns each loop as often as the
+ * busiest of 8 nodes needs (bench/RESULTS.md, stop 57).
  *
  * Per-sigma scalars (arrays of S): bb = b.b, rr = r.r, rz = r.z, active (1 while iterating),
  * converged (1 converged, 0 hit the cap or broke down), iterations (products done). */
 #version 450
 #extension GL_GOOGLE_include_directive : require
+#if defined(SF_LANE_SHUFFLES)
+#  extension GL_KHR_shader_subgroup_shuffle : require
+#endif
 
 #if defined(SF_ENTRY_CG_ITERATION_FACTOR)
 #  define SF_ENTRY_CG_ITERATION
@@ -72,15 +77,22 @@
 
 layout(local_size_x_id = 0) in;
 layout(constant_id = 1) const uint SF_PARTITIONS = 1u;
-layout(constant_id = 2) const bool SF_SIGMA_LANES = false;
+layout(constant_id = 2) const uint SF_LANE_ROWS = 0u;
+const bool SF_SIGMA_LANES = SF_LANE_ROWS > 0u;
+/* With lanes over sigma points: the group's sigma points, this lane's among them and its part. */
+const uint SF_LANE_SIGMAS = SF_SIGMA_LANES ? gl_WorkGroupSize.x / SF_LANE_ROWS : 1u;
+uint sf_lane_sigma() { return gl_LocalInvocationID.x % SF_LANE_SIGMAS; }
+uint sf_lane_part() { return gl_LocalInvocationID.x / SF_LANE_SIGMAS; }
 
 /* This invocation's sigma point (one partition), its first row (node) and the step to its next,
  * and whether it stores the sigma point's scalars: by lanes over sigma points or a group a
  * sigma point. */
-uint sf_sigma_point() { return SF_SIGMA_LANES ? gl_GlobalInvocationID.x : gl_WorkGroupID.x; }
-uint sf_first_row() { return SF_SIGMA_LANES ? 0u : gl_LocalInvocationID.x; }
-uint sf_row_step() { return SF_SIGMA_LANES ? 1u : gl_WorkGroupSize.x; }
-bool sf_leads() { return SF_SIGMA_LANES || gl_LocalInvocationID.x == 0u; }
+uint sf_sigma_point() {
+  return SF_SIGMA_LANES ? gl_WorkGroupID.x * SF_LANE_SIGMAS + sf_lane_sigma() : gl_WorkGroupID.x;
+}
+uint sf_first_row() { return SF_SIGMA_LANES ? sf_lane_part() : gl_LocalInvocationID.x; }
+uint sf_row_step() { return SF_SIGMA_LANES ? SF_LANE_ROWS : gl_WorkGroupSize.x; }
+bool sf_leads() { return SF_SIGMA_LANES ? sf_lane_part() == 0u : gl_LocalInvocationID.x == 0u; }
 /* Everyone in a group over a sigma point has read its old scalars before they change. */
 void sf_scalars_read() {
   if (!SF_SIGMA_LANES) {
@@ -91,10 +103,20 @@ void sf_scalars_read() {
 
 shared real scratch[gl_WorkGroupSize.x];
 
-/* Tree reduction of one value per invocation of the group, returned to every invocation; a
- * lane's own with lanes over sigma points. */
+/* Tree reduction of one value per invocation of the group, returned to every invocation; with
+ * lanes over sigma points the J parts of the lane's sigma point, in lane order. */
 real sf_group_sum(real value) {
-  if (SF_SIGMA_LANES) return value;
+  if (SF_SIGMA_LANES) {
+#if defined(SF_LANE_SHUFFLES)
+    if (SF_LANE_ROWS == 1u) return value;
+    real total = real(0);
+    for (uint j = 0u; j < 8u; ++j)   /* constant bounds: unrolled */
+      if (j < SF_LANE_ROWS) total += subgroupShuffle(value, j * SF_LANE_SIGMAS + sf_lane_sigma());
+    return total;
+#else
+    return value;   /* J = 1 without shuffles: the host's condition */
+#endif
+  }
   uint lid = gl_LocalInvocationID.x;
   barrier(); /* the previous sum's result has been read by everyone */
   scratch[lid] = value;
@@ -370,12 +392,15 @@ void main() {
   uint S = sf_push.S;
   uint s = sf_sigma_point();
   if (s >= S || active_flags[s] == 0u) return; /* the same for the whole group */
+#    if defined(SF_ENTRY_CG_FACTOR_DIRECTION)
+  real rz_old = rz[s];   /* before the lead's lane may write it */
+#    endif
   real sum_rz = real(0);
   for (uint row = sf_first_row(); row < 3u * sf_push.count; row += sf_row_step())
     sum_rz += r[row * S + s] * z[row * S + s];
   sum_rz = sf_group_sum(sum_rz);
 #    if defined(SF_ENTRY_CG_FACTOR_DIRECTION)
-  real beta = sum_rz / rz[s];
+  real beta = sum_rz / rz_old;
   sf_scalars_read();
 #    endif
   if (sf_leads()) rz[s] = sum_rz;

@@ -263,20 +263,22 @@ TEST_F(VulkanDeviceTest, ElementShadersOnSigmaQuadsGiveTheBitsOfOneALane) {
   EXPECT_FALSE(six.sigma_quads()) << "S = 6 is not a multiple of 4";
 }
 
-// The CG shaders with a sigma point a lane (from DeviceOptions::cg_sigma_lanes_from, on a CPU
-// device: each lane walks its sigma point's rows and sums in row order) against a work-group a
-// sigma point (its tree of sums): the same steps to their rounding, in float and double, at
-// S = 17 (two full groups of 8 and one of one lane, seven past S), in the two dispatches an
-// iteration and the three, over 40 steps. The sums' order differs, so the bits may: CG's
-// iterations within one a step, the positions within 2e-7 m in float (1e-14 m in double) of
-// each other (measured: 3e-8 and 3e-17), where the steps move the nodes by half a millimetre.
+// The CG shaders with lanes over sigma points (on a CPU device: each lane walks its sigma
+// point's rows, or every J-th node of them, and sums in node order, J parts added by subgroup
+// shuffles) against a work-group a sigma point (its tree of sums): the same steps to their
+// rounding, in float and double, at S = 17 (a lane a sigma point: two full groups of 8 and one
+// of one lane, seven past S) and S = 4 (with 8-lane shuffles, J = 2 lanes a sigma point), in
+// the two dispatches an iteration and the three, over 40 steps. The sums' order differs, so the
+// bits may: CG's iterations within one a step, the positions within 2e-7 m in float (1e-14 m in
+// double) of each other (measured: 3e-8 and 3e-17), where the steps move the nodes by half a
+// millimetre.
 TEST_F(VulkanDeviceTest, CgWithASigmaPointALaneFollowsAGroupASigmaPoint) {
   Scenario scenario = load_scenario(std::string(SIGMAFEM_SOURCE_DIR) + "/scenarios/liver.json");
   const std::vector<int>& estimated = scenario.filter->estimate;
   const int p = static_cast<int>(estimated.size());
   const Model model = make_model(scenario);
   for (const Precision precision : {Precision::single, Precision::double_precision}) {
-    for (const int S : {17}) {
+    for (const int S : {17, 4}) {
       for (const long long node_iteration_work : {kNodeIterationWork, 0LL}) {
         const std::string what = std::string(precision == Precision::single ? "float" : "double") +
                                  ", S = " + std::to_string(S) + (node_iteration_work ? ", two dispatches" : ", three");
@@ -286,8 +288,12 @@ TEST_F(VulkanDeviceTest, CgWithASigmaPointALaneFollowsAGroupASigmaPoint) {
         groups.cg_sigma_lanes_from = 0;
         VulkanEnsemble by_lanes(model, estimated, scenario.observations.nodes, S, lanes);
         VulkanEnsemble by_groups(model, estimated, scenario.observations.nodes, S, groups);
-        ASSERT_TRUE(by_lanes.cg_sigma_lanes()) << what;
-        ASSERT_FALSE(by_groups.cg_sigma_lanes()) << what;
+        const VulkanDeviceInfo& info = by_lanes.device_info();
+        ASSERT_EQ(by_lanes.cg_lane_rows(), cg_lane_rows(kCgSigmaLanesFrom, S, info, true, true)) << what;
+        if (info.subgroup_shuffle && info.subgroup_size >= 8) {
+          ASSERT_EQ(by_lanes.cg_lane_rows(), S == 4 ? 2 : 1) << what;
+        }
+        ASSERT_EQ(by_groups.cg_lane_rows(), 0) << what;
         Eigen::MatrixXd theta(p, S);
         for (int j = 0; j < p; ++j)
           for (int s = 0; s < S; ++s)
@@ -316,6 +322,31 @@ TEST_F(VulkanDeviceTest, CgWithASigmaPointALaneFollowsAGroupASigmaPoint) {
       }
     }
   }
+}
+
+// Which lanes the CG shaders take: a sigma point a lane from cg_sigma_lanes_from, J = 8 / S a
+// sigma point at S <= 4 with the factor and 8-lane shuffles, else a group a sigma point; on a
+// CPU device with one partition only.
+TEST(VulkanCgLanes, LanesOverSigmaPointsWhereTheyFillTheVectors) {
+  VulkanDeviceInfo info;
+  info.type = "cpu";
+  info.subgroup_shuffle = true;
+  info.subgroup_size = 8;
+  EXPECT_EQ(cg_lane_rows(16, 16, info, true, true), 1);
+  EXPECT_EQ(cg_lane_rows(16, 65, info, true, false), 1);   // Jacobi too
+  EXPECT_EQ(cg_lane_rows(16, 8, info, true, true), 0);     // one group would leave threads idle
+  EXPECT_EQ(cg_lane_rows(16, 4, info, true, true), 2);
+  EXPECT_EQ(cg_lane_rows(16, 3, info, true, true), 2);
+  EXPECT_EQ(cg_lane_rows(16, 2, info, true, true), 4);
+  EXPECT_EQ(cg_lane_rows(16, 1, info, true, true), 8);
+  EXPECT_EQ(cg_lane_rows(16, 4, info, true, false), 0);    // the shuffle entries are the factor's
+  EXPECT_EQ(cg_lane_rows(0, 16, info, true, true), 0);     // never
+  EXPECT_EQ(cg_lane_rows(16, 16, info, false, true), 0);   // partitions
+  info.subgroup_size = 4;
+  EXPECT_EQ(cg_lane_rows(16, 4, info, true, true), 0);
+  info.type = "discrete gpu";
+  info.subgroup_size = 32;
+  EXPECT_EQ(cg_lane_rows(16, 64, info, true, true), 0);
 }
 
 // Lavapipe's threads by the ensemble's work (DeviceOptions::lavapipe_serial_work): the box at
