@@ -57,21 +57,24 @@ struct SfNodeConstants {
   SF_REAL so_shift[3];        /* the control target's shift from its start */
 };
 
-/* Loads sigma point s's node constants from the step constants buffer c_. */
-#define SF_LOAD_NODE_CONSTANTS(c_, s, S, out)                                  \
+/* Loads sigma point s's node constants from the step constants buffer c_, each per-sigma
+ * one by SIGMA(c_, k, s, S): SF_SIGMA_CONSTANT, or in Vulkan's sigma-quad shaders
+ * SF_QUAD_CONSTANT, four sigma points' (kernels/vulkan/sigma_quads.h). */
+#define SF_LOAD_NODE_CONSTANTS_BY(SIGMA, c_, s, S, out)                        \
   {                                                                            \
-    out.h = SF_LOAD(c_, SF_H);                                                 \
-    out.mass_factor = SF_SIGMA_CONSTANT(c_, SF_MASS_FACTOR, s, S);             \
-    out.stiffness_factor = SF_SIGMA_CONSTANT(c_, SF_STIFFNESS_FACTOR, s, S);   \
-    out.rayleigh_mass = SF_SIGMA_CONSTANT(c_, SF_RAYLEIGH_MASS, s, S);         \
-    out.velocity_factor = SF_SIGMA_CONSTANT(c_, SF_VELOCITY_FACTOR, s, S);     \
-    out.young_scale = SF_SIGMA_CONSTANT(c_, SF_YOUNG_SCALE, s, S);             \
-    out.inverse_d0_squared = SF_SIGMA_CONSTANT(c_, SF_INVERSE_D0_SQUARED, s, S); \
+    out.h = SF_LIT(SF_LOAD(c_, SF_H));                                         \
+    out.mass_factor = SIGMA(c_, SF_MASS_FACTOR, s, S);                         \
+    out.stiffness_factor = SIGMA(c_, SF_STIFFNESS_FACTOR, s, S);               \
+    out.rayleigh_mass = SIGMA(c_, SF_RAYLEIGH_MASS, s, S);                     \
+    out.velocity_factor = SIGMA(c_, SF_VELOCITY_FACTOR, s, S);                 \
+    out.young_scale = SIGMA(c_, SF_YOUNG_SCALE, s, S);                         \
+    out.inverse_d0_squared = SIGMA(c_, SF_INVERSE_D0_SQUARED, s, S);           \
     for (int k_ = 0; k_ < 3; ++k_) {                                           \
-      out.gravity[k_] = SF_SIGMA_CONSTANT(c_, SF_GRAVITY + k_, s, S);          \
-      out.so_shift[k_] = SF_SIGMA_CONSTANT(c_, SF_SO_SHIFT + k_, s, S);        \
+      out.gravity[k_] = SIGMA(c_, SF_GRAVITY + k_, s, S);                      \
+      out.so_shift[k_] = SIGMA(c_, SF_SO_SHIFT + k_, s, S);                    \
     }                                                                          \
   }
+#define SF_LOAD_NODE_CONSTANTS(c_, s, S, out) SF_LOAD_NODE_CONSTANTS_BY(SF_SIGMA_CONSTANT, c_, s, S, out)
 
 /* A node that no tetrahedron uses and no spring holds has a unit placeholder mass, so that
  * its rows of A are not zero (as in ImplicitEulerSystem). */
@@ -86,11 +89,13 @@ SF_FN SF_REAL sf_system_row(SF_REAL stiffness_factor, SF_REAL young_scale, SF_RE
          mass_factor * m * d_row;
 }
 
-/* The same with sigma point s's factors read from the step constants buffer c_. */
-#define SF_SYSTEM_ROW(c_, s, S, Kd_elements, spring, m, d_row)                                \
-  sf_system_row(SF_SIGMA_CONSTANT(c_, SF_STIFFNESS_FACTOR, s, S),                              \
-                SF_SIGMA_CONSTANT(c_, SF_YOUNG_SCALE, s, S),                                   \
-                SF_SIGMA_CONSTANT(c_, SF_MASS_FACTOR, s, S), Kd_elements, spring, m, d_row)
+/* The same with sigma point s's factors read from the step constants buffer c_ (by SIGMA, as
+ * SF_LOAD_NODE_CONSTANTS_BY). */
+#define SF_SYSTEM_ROW_BY(SIGMA, c_, s, S, Kd_elements, spring, m, d_row)                      \
+  sf_system_row(SIGMA(c_, SF_STIFFNESS_FACTOR, s, S), SIGMA(c_, SF_YOUNG_SCALE, s, S),          \
+                SIGMA(c_, SF_MASS_FACTOR, s, S), Kd_elements, spring, m, d_row)
+#define SF_SYSTEM_ROW(c_, s, S, Kd_elements, spring, m, d_row) \
+  SF_SYSTEM_ROW_BY(SF_SIGMA_CONSTANT, c_, s, S, Kd_elements, spring, m, d_row)
 
 /* The ligament law's explicit factor k |u|^2/d0^2 of node u (its linear part k u is in the
  * spring; the control spring keeps the linear law): 0 for the linear law. */

@@ -42,7 +42,7 @@ void main() {
   SF_REAL mass_n = SF_REAL(SF_LOAD(mass, n));
   SF_REAL m = sf_solver_mass(mass_n, spring);
   SfNodeConstants at;
-  SF_LOAD_NODE_CONSTANT_QUADS(c, q, S, at)
+  SF_LOAD_NODE_CONSTANTS_BY(SF_QUAD_CONSTANT, c, q, S, at)
   SF_REAL f_elements[3];
   SF_REAL diagonal[3];
   SF_CORNER_SUM_QUADS(element_out, incidence_offsets, incidence, n, q, Q, f_elements)
@@ -113,7 +113,7 @@ void main() {
   SF_CORNER_SUM_QUADS(element_out, incidence_offsets, incidence, n, q, Q, sum)
   for (uint k = 0u; k < 3u; ++k) {
     uint row = (3u * n + k) * Q + q;
-    q_out[row] = SF_SYSTEM_ROW_QUADS(c, q, S, sum[k], spring, m, SF_QUAD(d, row));
+    q_out[row] = SF_SYSTEM_ROW_BY(SF_QUAD_CONSTANT, c, q, S, sum[k], spring, m, SF_QUAD(d, row));
   }
 }
 

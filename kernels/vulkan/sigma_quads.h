@@ -80,25 +80,5 @@
     for (int i_ = SF_LOAD(ligament_offsets, n); i_ < end_; ++i_)                     \
       spring += SF_QUAD(ligament_k, uint(SF_LOAD(ligament_of_node, i_)) * (Q) + (q)); \
   }
-/* node_rows.h's SF_LOAD_NODE_CONSTANTS for quad q. */
-#define SF_LOAD_NODE_CONSTANT_QUADS(c, q, S, out)                                    \
-  {                                                                                  \
-    out.h = SF_REAL(SF_LOAD(c, SF_H));                                               \
-    out.mass_factor = SF_QUAD_CONSTANT(c, SF_MASS_FACTOR, q, S);                     \
-    out.stiffness_factor = SF_QUAD_CONSTANT(c, SF_STIFFNESS_FACTOR, q, S);           \
-    out.rayleigh_mass = SF_QUAD_CONSTANT(c, SF_RAYLEIGH_MASS, q, S);                 \
-    out.velocity_factor = SF_QUAD_CONSTANT(c, SF_VELOCITY_FACTOR, q, S);             \
-    out.young_scale = SF_QUAD_CONSTANT(c, SF_YOUNG_SCALE, q, S);                     \
-    out.inverse_d0_squared = SF_QUAD_CONSTANT(c, SF_INVERSE_D0_SQUARED, q, S);       \
-    for (uint k_ = 0u; k_ < 3u; ++k_) {                                              \
-      out.gravity[k_] = SF_QUAD_CONSTANT(c, SF_GRAVITY + k_, q, S);                  \
-      out.so_shift[k_] = SF_QUAD_CONSTANT(c, SF_SO_SHIFT + k_, q, S);                \
-    }                                                                                \
-  }
-/* node_rows.h's SF_SYSTEM_ROW for quad q. */
-#define SF_SYSTEM_ROW_QUADS(c, q, S, Kd_elements, spring, m, d_row)                  \
-  sf_system_row(SF_QUAD_CONSTANT(c, SF_STIFFNESS_FACTOR, q, S),                      \
-                SF_QUAD_CONSTANT(c, SF_YOUNG_SCALE, q, S),                           \
-                SF_QUAD_CONSTANT(c, SF_MASS_FACTOR, q, S), Kd_elements, spring, m, d_row)
 
 #endif /* SIGMAFEM_VULKAN_SIGMA_QUADS_H */
