@@ -63,9 +63,10 @@ constexpr long long kFactorLoopTurns = 61440;
 // S = 16 (6.4 against 7.9 ms a step) and the 4768 liver at S = 4 (20 against 23).
 constexpr long long kLavapipeSerialWork = 8192;
 // DeviceOptions::cg_sigma_lanes_from's default, measured on lavapipe on a 2-core machine
-// (bench/RESULTS.md, stop 57): at S = 16 lanes over sigma points (the 4768 liver's step 21.7
-// -> 19.8 ms, the 596 liver's 5.1 -> 3.9); at S = 4 a group a sigma point (one group of lanes
-// would leave lavapipe's other threads idle: the 4768 liver's step 12.3 against 13.3 ms).
+// (bench/RESULTS.md, stop 57): at S = 16 a sigma point a lane (the 4768 liver's step 21.7 ->
+// 19.8 ms, the 596 liver's 5.1 -> 3.9); at S = 4 one a lane would leave four of a vector's 8
+// idle and lavapipe's second thread too (the 4768 liver's step 13.3 against 12.3 ms), so there
+// J = 8 / S lanes a sigma point instead (vulkan_ensemble.h's cg_lane_rows).
 constexpr int kCgSigmaLanesFrom = 16;
 
 struct DeviceOptions {
@@ -102,10 +103,11 @@ struct DeviceOptions {
   long long lavapipe_serial_work = kLavapipeSerialWork;
   // Vulkan on a CPU device with one CG partition: from this many sigma points the CG shaders
   // take a sigma point a lane, walking its rows alone, where fewer take a work-group a sigma
-  // point over its nodes (kernels/vulkan/conjugate_gradient.comp); 0: never (tests compare).
+  // point over its nodes, or at S <= 4 with the factor 8 / S lanes a sigma point
+  // (kernels/vulkan/conjugate_gradient.comp, cg_lane_rows); 0: never either (tests compare).
   int cg_sigma_lanes_from = kCgSigmaLanesFrom;
-  // Vulkan's CPU form (texel reads) with S a multiple of 4: the element shaders take four sigma
-  // points a lane (kernels/vulkan/sigma_quads.h); false: one (tests compare).
+  // Vulkan's CPU form (texel reads) with S a multiple of 4: the element and node shaders take
+  // four sigma points a lane (kernels/vulkan/sigma_quads.h); false: one (tests compare).
   bool sigma_quads = true;
   // The CPU back end's worker threads: 0, the machine's cores (over MPI ranks, shared among
   // the ranks on one machine: estimation_job.cpp).
