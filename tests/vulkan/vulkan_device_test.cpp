@@ -16,6 +16,7 @@
 #include "host/scenario/scenario.h"
 #include "host/vulkan/vulkan_ensemble.h"
 #include "requirement.h"
+#include "tests/refined_liver.h"
 
 namespace sigmafem {
 namespace {
@@ -220,7 +221,6 @@ TEST_F(VulkanDeviceTest, CgInTwoDispatchesGivesTheBitsOfThree) {
 TEST_F(VulkanDeviceTest, ElementShadersOnSigmaQuadsGiveTheBitsOfOneALane) {
   Scenario scenario = load_scenario(std::string(SIGMAFEM_SOURCE_DIR) + "/scenarios/liver.json");
   const std::vector<int>& estimated = scenario.filter->estimate;
-  const int p = static_cast<int>(estimated.size());
   for (const ElementRotation rotation : {ElementRotation::qr, ElementRotation::polar}) {
     scenario.material.rotation = rotation;
     const Model model = make_model(scenario);
@@ -239,10 +239,7 @@ TEST_F(VulkanDeviceTest, ElementShadersOnSigmaQuadsGiveTheBitsOfOneALane) {
       VulkanEnsemble by_lanes(model, estimated, scenario.observations.nodes, S, lanes);
       ASSERT_TRUE(by_quads.sigma_quads()) << what;
       ASSERT_FALSE(by_lanes.sigma_quads()) << what;
-      Eigen::MatrixXd theta(p, S);
-      for (int j = 0; j < p; ++j)
-        for (int s = 0; s < S; ++s)
-          theta(j, s) = std::log(model.ligaments[estimated[j]].stiffness) + 0.3 * std::cos(s + 2 * j);
+      const Eigen::MatrixXd theta = test::spread_log_stiffness(scenario, model, S, 0.3);
       by_quads.set_parameters(theta);
       by_lanes.set_parameters(theta);
       for (int k = 1; k <= 6; ++k) {
@@ -275,7 +272,6 @@ TEST_F(VulkanDeviceTest, ElementShadersOnSigmaQuadsGiveTheBitsOfOneALane) {
 TEST_F(VulkanDeviceTest, CgWithASigmaPointALaneFollowsAGroupASigmaPoint) {
   Scenario scenario = load_scenario(std::string(SIGMAFEM_SOURCE_DIR) + "/scenarios/liver.json");
   const std::vector<int>& estimated = scenario.filter->estimate;
-  const int p = static_cast<int>(estimated.size());
   const Model model = make_model(scenario);
   for (const Precision precision : {Precision::single, Precision::double_precision}) {
     for (const int S : {17, 4}) {
@@ -294,10 +290,7 @@ TEST_F(VulkanDeviceTest, CgWithASigmaPointALaneFollowsAGroupASigmaPoint) {
           ASSERT_EQ(by_lanes.cg_lane_rows(), S == 4 ? 2 : 1) << what;
         }
         ASSERT_EQ(by_groups.cg_lane_rows(), 0) << what;
-        Eigen::MatrixXd theta(p, S);
-        for (int j = 0; j < p; ++j)
-          for (int s = 0; s < S; ++s)
-            theta(j, s) = std::log(model.ligaments[estimated[j]].stiffness) + 0.3 * std::cos(s + 2 * j);
+        const Eigen::MatrixXd theta = test::spread_log_stiffness(scenario, model, S, 0.3);
         by_lanes.set_parameters(theta);
         by_groups.set_parameters(theta);
         double moved = 0.0, apart = 0.0;

@@ -22,6 +22,33 @@
 namespace sigmafem {
 namespace {
 
+// A device with CG's buffers for a solve of S sigma points in Real (float or double): r
+// uploaded, z, and the active flags (every sigma point iterating but `inactive`).
+template <typename Real>
+struct SolveBuffers {
+  SolveBuffers(const std::vector<Real>& r, int S, int inactive, bool texel_reads)
+      : device(0, sizeof(Real) == sizeof(double) ? Precision::double_precision : Precision::single),
+        bytes(r.size() * sizeof(Real)),
+        r_buffer(device.buffer(bytes, "r")),
+        z_buffer(device.buffer(bytes, "z")),
+        active(device.buffer(4 * static_cast<std::size_t>(S), "active")) {
+    device.set_texel_reads(texel_reads);
+    std::vector<std::uint32_t> flags(static_cast<std::size_t>(S), 1u);
+    if (inactive >= 0) flags[static_cast<std::size_t>(inactive)] = 0u;
+    device.upload(r_buffer, r.data(), bytes);
+    device.upload(active, flags.data(), 4 * flags.size());
+  }
+  // z after the solve recorded.
+  std::vector<Real> z() {
+    std::vector<Real> values(bytes / sizeof(Real));
+    device.download(z_buffer, values.data(), bytes);
+    return values;
+  }
+  VulkanDevice device;
+  std::size_t bytes;
+  VulkanBuffer r_buffer, z_buffer, active;
+};
+
 class VulkanFactorSolveTest : public ::testing::Test {
  protected:
   void SetUp() override {
@@ -78,20 +105,13 @@ class VulkanFactorSolveTest : public ::testing::Test {
   std::vector<float> device_solve(const std::vector<float>& r, int S, int inactive, bool texel_reads,
                                   long long loop_turns, bool diagonal, int* dispatches = nullptr,
                                   bool springs = false, int* split = nullptr, bool* shared = nullptr) {
-    VulkanDevice device(0, Precision::single);
-    device.set_texel_reads(texel_reads);
-    const std::size_t bytes = r.size() * sizeof(float);
-    const VulkanBuffer r_buffer = device.buffer(bytes, "r"), z_buffer = device.buffer(bytes, "z");
-    const VulkanBuffer active = device.buffer(4 * static_cast<std::size_t>(S), "active");
-    std::vector<std::uint32_t> flags(static_cast<std::size_t>(S), 1u);
-    if (inactive >= 0) flags[static_cast<std::size_t>(inactive)] = 0u;
-    device.upload(r_buffer, r.data(), bytes);
-    device.upload(active, flags.data(), 4 * flags.size());
+    SolveBuffers<float> buffers(r, S, inactive, texel_reads);
+    VulkanDevice& device = buffers.device;
     const std::vector<float> sentinel(r.size(), untouched);
-    device.upload(z_buffer, sentinel.data(), bytes);
+    device.upload(buffers.z_buffer, sentinel.data(), buffers.bytes);
     SpringCorrection correction(springs ? spring_rows_ : std::vector<int>{});
-    VulkanFactorSolve solve(device, n_, correction.size(), S, r_buffer, z_buffer,
-                            active, loop_turns);
+    VulkanFactorSolve solve(device, n_, correction.size(), S, buffers.r_buffer, buffers.z_buffer,
+                            buffers.active, loop_turns);
     if (diagonal)
       solve.upload_diagonal(A_);
     else
@@ -111,9 +131,7 @@ class VulkanFactorSolveTest : public ::testing::Test {
     }
     solve.record(cmd);
     device.submit_and_wait(cmd);
-    std::vector<float> z(r.size());
-    device.download(z_buffer, z.data(), bytes);
-    return z;
+    return buffers.z();
   }
 
   // Sigma point s's r, a smooth field with a different phase each.
@@ -262,19 +280,14 @@ TEST_F(VulkanFactorSolveTest, InFloat64EachSigmaPointsOwnSystemToItsRounding) {
   load("liver");
   for (const int S : {4, 5}) {
     SCOPED_TRACE("S = " + std::to_string(S));
-    VulkanDevice device(0, Precision::double_precision);
-    device.set_texel_reads(true);
     std::vector<double> r(static_cast<std::size_t>(n_) * S);
     for (int i = 0; i < n_; ++i)
       for (int s = 0; s < S; ++s) r[static_cast<std::size_t>(i) * S + s] = std::sin(0.37 * i + s);
-    const std::size_t bytes = r.size() * sizeof(double);
-    const VulkanBuffer r_buffer = device.buffer(bytes, "r"), z_buffer = device.buffer(bytes, "z");
-    const VulkanBuffer active = device.buffer(4 * static_cast<std::size_t>(S), "active");
-    const std::vector<std::uint32_t> flags(static_cast<std::size_t>(S), 1u);
-    device.upload(r_buffer, r.data(), bytes);
-    device.upload(active, flags.data(), 4 * flags.size());
+    SolveBuffers<double> buffers(r, S, -1, true);
+    VulkanDevice& device = buffers.device;
     SpringCorrection correction(spring_rows_);
-    VulkanFactorSolve solve(device, n_, correction.size(), S, r_buffer, z_buffer, active, kFactorLoopTurns);
+    VulkanFactorSolve solve(device, n_, correction.size(), S, buffers.r_buffer, buffers.z_buffer,
+                            buffers.active, kFactorLoopTurns);
     solve.upload(factor_);
     correction.prepare(factor_);
     ASSERT_TRUE(solve.upload_springs(correction));
@@ -283,8 +296,7 @@ TEST_F(VulkanFactorSolveTest, InFloat64EachSigmaPointsOwnSystemToItsRounding) {
     device.barrier(cmd);
     solve.record(cmd);
     device.submit_and_wait(cmd);
-    std::vector<double> z(r.size());
-    device.download(z_buffer, z.data(), bytes);
+    const std::vector<double> z = buffers.z();
     for (int s = 0; s < S; ++s) {
       Eigen::VectorXd b(n_);
       for (int i = 0; i < n_; ++i) b[i] = r[static_cast<std::size_t>(i) * S + s];
@@ -302,15 +314,9 @@ TEST_F(VulkanFactorSolveTest, AFactorAfterTheStandInSolvesAsAFreshOne) {
   const int S = 4;
   const std::vector<float> r = residuals(S);
   const std::vector<float> fresh = device_solve(r, S, -1, true, kFactorLoopTurns, false);
-  VulkanDevice device(0, Precision::single);
-  device.set_texel_reads(true);
-  const std::size_t bytes = r.size() * sizeof(float);
-  const VulkanBuffer r_buffer = device.buffer(bytes, "r"), z_buffer = device.buffer(bytes, "z");
-  const VulkanBuffer active = device.buffer(4 * static_cast<std::size_t>(S), "active");
-  const std::vector<std::uint32_t> flags(static_cast<std::size_t>(S), 1u);
-  device.upload(r_buffer, r.data(), bytes);
-  device.upload(active, flags.data(), 4 * flags.size());
-  VulkanFactorSolve solve(device, n_, 0, S, r_buffer, z_buffer, active, kFactorLoopTurns);
+  SolveBuffers<float> buffers(r, S, -1, true);
+  VulkanDevice& device = buffers.device;
+  VulkanFactorSolve solve(device, n_, 0, S, buffers.r_buffer, buffers.z_buffer, buffers.active, kFactorLoopTurns);
   solve.upload_diagonal(A_);
   const std::size_t stand_in_bytes = solve.bytes();
   std::size_t factor_bytes = 0;
@@ -321,9 +327,8 @@ TEST_F(VulkanFactorSolveTest, AFactorAfterTheStandInSolvesAsAFreshOne) {
     VkCommandBuffer cmd = device.begin();
     solve.record(cmd);
     device.submit_and_wait(cmd);
-    std::vector<float> z(r.size());
-    device.download(z_buffer, z.data(), bytes);
-    EXPECT_EQ(0, std::memcmp(z.data(), fresh.data(), bytes)) << "upload " << upload;
+    const std::vector<float> z = buffers.z();
+    EXPECT_EQ(0, std::memcmp(z.data(), fresh.data(), buffers.bytes)) << "upload " << upload;
   }
   EXPECT_GT(factor_bytes, stand_in_bytes) << "the factor's pattern got its own buffers";
 }
