@@ -41,6 +41,9 @@ struct VulkanDeviceInfo {
   // and whether compute shaders have subgroupShuffle.
   unsigned subgroup_size = 0;
   bool subgroup_shuffle = false;
+  // Whether a work-group of `lanes` invocations is one subgroup that shuffles (the shaders'
+  // shuffles between a group's lanes: factor_solve_shared, the CG shaders' *_lanes).
+  bool shuffles_groups_of(unsigned lanes) const { return subgroup_shuffle && subgroup_size >= lanes; }
 };
 
 // Every Vulkan device, in the loader's order. Empty when there is no loader or no driver

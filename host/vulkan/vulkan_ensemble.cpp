@@ -36,7 +36,7 @@ bool vulkan_uses_multigrid(Preconditioner preconditioner, const std::string& dev
 int cg_lane_rows(int lanes_from, int sigma_count, const VulkanDeviceInfo& info, bool one_partition, bool factor) {
   if (info.type != "cpu" || !one_partition || lanes_from <= 0 || sigma_count <= 0) return 0;
   if (sigma_count >= lanes_from) return 1;
-  if (!factor || !info.subgroup_shuffle || info.subgroup_size < 8 || sigma_count > 4) return 0;
+  if (!factor || !info.shuffles_groups_of(8) || sigma_count > 4) return 0;
   int rows = 1;
   while (2 * rows * sigma_count <= 8) rows *= 2;
   return rows;
@@ -279,7 +279,7 @@ std::size_t VulkanEnsemble::node_items() const {
 std::uint32_t VulkanEnsemble::cg_groups() const {
   const std::uint32_t S = static_cast<std::uint32_t>(S_);
   const std::uint32_t J = static_cast<std::uint32_t>(cg_lane_rows_);
-  return J > 0 ? (J * S + cg_group_ - 1) / cg_group_ : S;
+  return J > 0 ? (J * S + cg_group_ - 1) / cg_group_ : S * static_cast<std::uint32_t>(cg_partitions_);
 }
 
 void VulkanEnsemble::record_system_product(VkCommandBuffer cmd, VkDescriptorSet product_set) const {
@@ -292,7 +292,7 @@ void VulkanEnsemble::record_cg_iterations(VkCommandBuffer cmd, int count) const 
   push.S = static_cast<std::uint32_t>(S_);
   push.count = static_cast<std::uint32_t>(nodes_);
   push.max_iterations = model_.solver.cg_max_iterations;
-  const std::uint32_t groups = cg_partitioned_ ? static_cast<std::uint32_t>(S_ * cg_partitions_) : cg_groups();
+  const std::uint32_t groups = cg_groups();
   for (int i = 0; i < count; ++i) {
     if (node_iteration_) {
       dispatch_items(cmd, k_element_product_, s_product_cg_, element_items(), elements_);
@@ -334,7 +334,7 @@ void VulkanEnsemble::record_multigrid(VkCommandBuffer cmd, bool start) const {
   push.count = static_cast<std::uint32_t>(nodes_);
   push.max_iterations = model_.solver.cg_max_iterations;
   push.p = start ? 1u : 0u;
-  device_.dispatch(cmd, k_cg_preconditioned_, s_cg_preconditioned_, &push, static_cast<std::uint32_t>(S_ * cg_partitions_));
+  device_.dispatch(cmd, k_cg_preconditioned_, s_cg_preconditioned_, &push, cg_groups());
   device_.barrier(cmd);
 }
 
@@ -408,8 +408,7 @@ StepReport VulkanEnsemble::advance(const Eigen::Vector3d& so_position) {
   push.S = static_cast<std::uint32_t>(S_);
   push.count = static_cast<std::uint32_t>(nodes_);
   if (cg_partitioned_) {
-    device_.dispatch(cmd, k_cg_start_partials_, s_cg_start_partials_, &push,
-                     static_cast<std::uint32_t>(S_ * cg_partitions_));
+    device_.dispatch(cmd, k_cg_start_partials_, s_cg_start_partials_, &push, cg_groups());
     device_.barrier(cmd);
     record_multigrid(cmd, true);
     device_.dispatch(cmd, k_cg_start_scalars_, s_cg_start_scalars_, &push,

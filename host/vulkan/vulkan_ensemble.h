@@ -125,7 +125,8 @@ class VulkanEnsemble : public DeviceEnsemble {
   std::size_t element_items() const;
   // Lanes of the node shaders: nodes x S, or x S / 4 with sigma quads.
   std::size_t node_items() const;
-  // Work-groups of the one-partition CG shaders: S, or S / cg_group_ with lanes over sigma points.
+  // Work-groups of the CG shaders: S x partitions, or with lanes over sigma points J S / cg_group_
+  // (rounded up).
   std::uint32_t cg_groups() const;
   // Records what set_parameters() and recenter() left for the next submission; flush_pending()
   // submits it alone, before a read-out.

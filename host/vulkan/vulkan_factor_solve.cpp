@@ -46,8 +46,7 @@ int VulkanFactorSolve::split_lanes(const VulkanDeviceInfo& info, int sigma_count
 }
 
 bool VulkanFactorSolve::shares_blocks(const VulkanDeviceInfo& info, int sigma_count) {
-  return info.subgroup_shuffle && info.subgroup_size >= static_cast<unsigned>(kLanes) &&
-         split_lanes(info, sigma_count) == 1;
+  return info.shuffles_groups_of(kLanes) && split_lanes(info, sigma_count) == 1;
 }
 
 VulkanBuffer VulkanFactorSolve::make(std::size_t bytes) {

@@ -100,8 +100,12 @@ uint H, h;
  * registers), where each lane read all 32 alone. All 8 lanes take part, those past S or whose
  * sigma point is done included (shuffles read only active lanes), and only the others write
  * (`writes`). */
+#if defined(SF_SHARED_BLOCKS)
 uint lane;
-bool writes = true;
+bool writes;
+#else
+const bool writes = true;   /* every lane that runs writes: no test at the stores */
+#endif
 
 /* The quad t (4 slots) of y: this lane's copy for its sigma point. */
 uint y_quad(uint t) { return (t * H + h) * S + s; }
