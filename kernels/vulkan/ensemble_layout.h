@@ -8,7 +8,7 @@
 #define SIGMAFEM_VULKAN_ENSEMBLE_LAYOUT_H
 
 /* SF_SCALAR a buffer's real; SF_REAL the arithmetic's (dialect.h, element.h): the same, or
- * in the sigma-quad shaders (SF_SIGMA_QUADS: kernels/vulkan/element_rhs.comp) a vector of
+ * in the sigma-quad shaders (SF_SIGMA_QUADS: kernels/vulkan/sigma_quads.h) a vector of
  * four sigma points. */
 #ifdef SF_USE_DOUBLE
 #  define SF_SCALAR double
