@@ -93,8 +93,8 @@ Eigen::SparseMatrix<double> DeviceEnsemble::sigma_system(int s, const Eigen::Vec
   return system_at(theta, effects_.empty() ? PhysicsEffects{} : effects_.at(static_cast<std::size_t>(s)), x, v);
 }
 
-std::unique_ptr<FactorisedPreconditioner> DeviceEnsemble::analysed_factor() const {
-  auto factor = std::make_unique<FactorisedPreconditioner>();
+std::unique_ptr<FactorisedPreconditioner> DeviceEnsemble::analysed_factor(const SpringCorrection& springs) const {
+  auto factor = std::make_unique<FactorisedPreconditioner>(springs.rows());
   const ReferenceSimulation rest(model_);
   factor->analyse(representative_system(rest.positions(), rest.velocities()));
   return factor;

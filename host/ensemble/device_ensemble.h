@@ -103,7 +103,8 @@ class DeviceEnsemble : public SimulationEnsemble {
   std::vector<double> representative_ligament_k() const;
   // A factor shared by the sigma points (OpenCL's CPU form, Vulkan on a CPU device), analysed
   // on the representative's system at rest: its size is known before the first step makes it.
-  std::unique_ptr<FactorisedPreconditioner> analysed_factor() const;
+  // With `springs`' rows ordered last, where it is corrected for them (FactorisedPreconditioner).
+  std::unique_ptr<FactorisedPreconditioner> analysed_factor(const SpringCorrection& springs = SpringCorrection()) const;
   // Its correction for the sigma points' springs (SpringCorrection) at the estimated
   // ligaments' rows, where `asked` and m x S stays small (spring_correction_fits); else none.
   SpringCorrection spring_correction(bool asked) const;

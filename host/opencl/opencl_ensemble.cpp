@@ -95,11 +95,6 @@ OpenClEnsemble::OpenClEnsemble(const Model& model, EstimatedParameters estimated
     if (!cpu_form)
       throw DeviceError("--preconditioner factorised: OpenCL has it on a CPU device only (its "
                         "GPU kernels precondition CG with the multigrid V-cycle or Jacobi); device " + info.name);
-    factor_ = analysed_factor();
-    // Again with the factor's buffers (L alone is 125 MB on the 38k liver; the copies of its
-    // values below add at most own_factors_bytes).
-    check_device_memory(device_.real_size(), info.name, info.global_memory, info.max_allocation,
-                        factor_->nonzeros());
     // The shared factor is corrected for each sigma point's own springs at the estimated
     // ligaments' rows (SpringCorrection) where the kernels' arrays of m x S stay small.
     SpringCorrection correction = spring_correction(options.spring_correction);
@@ -114,10 +109,18 @@ OpenClEnsemble::OpenClEnsemble(const Model& model, EstimatedParameters estimated
     // 2.0-2.9 ms; stop 51). Beyond the cache a solve's time is reading L, which the shared
     // factor reads once for a block.
     const bool springs_alone = corrected && estimated_.regions.empty();
+    factor_ = springs_alone ? analysed_factor(correction) : analysed_factor();
     if (!springs_alone && S_ >= kOwnFactorsFromSigmaPoints &&
         static_cast<std::size_t>(S_) * factor_->nonzeros() * device_.real_size() <= options.own_factors_bytes)
       factor_copies_ = S_;
-    if (factor_copies_ == 1 && corrected) springs_ = std::move(correction);
+    if (factor_copies_ == 1 && corrected) {
+      springs_ = std::move(correction);
+      if (!springs_alone) factor_ = analysed_factor(springs_);   // again, the springs' rows last
+    }
+    // Again with the factor's buffers (L alone is 125 MB on the 38k liver; the copies of its
+    // values add at most own_factors_bytes).
+    check_device_memory(device_.real_size(), info.name, info.global_memory, info.max_allocation,
+                        factor_->nonzeros());
     // The copies in the layout of the blocks that solve with them (conjugate_gradient.cl): cg_solve's
     // blocks of their own vectors one after the other, else all S interleaved.
     factor_block_ = whole_solve_ && solve_block_ < S_ ? solve_block_ : S_;

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <stdexcept>
 #include <iostream>   // Eigen's MetisSupport uses std::cerr without including it
 #include <Eigen/MetisSupport>
 
@@ -37,14 +38,68 @@ Eigen::SparseMatrix<double> FactorisedPreconditioner::ordered(const Eigen::Spars
   return permuted;
 }
 
+FactorisedPreconditioner::FactorisedPreconditioner(std::vector<int> rows_last) : rows_last_(std::move(rows_last)) {
+  std::sort(rows_last_.begin(), rows_last_.end());
+  rows_last_.erase(std::unique(rows_last_.begin(), rows_last_.end()), rows_last_.end());
+}
+
+std::vector<int> FactorisedPreconditioner::rows_first(Eigen::Index n) const {
+  std::vector<bool> last(static_cast<std::size_t>(n), false);
+  for (int row : rows_last_) {
+    if (row < 0 || row >= n) throw std::invalid_argument("FactorisedPreconditioner: a row to order last is outside A");
+    last[static_cast<std::size_t>(row)] = true;
+  }
+  std::vector<int> first;
+  for (int i = 0; i < static_cast<int>(n); ++i)
+    if (!last[static_cast<std::size_t>(i)]) first.push_back(i);
+  return first;
+}
+
+Eigen::SparseMatrix<double> FactorisedPreconditioner::without_rows_last(const Eigen::SparseMatrix<double>& whole) const {
+  const std::vector<int> first = rows_first(whole.rows());
+  std::vector<int> position(static_cast<std::size_t>(whole.rows()), -1);
+  for (std::size_t k = 0; k < first.size(); ++k) position[static_cast<std::size_t>(first[k])] = static_cast<int>(k);
+  std::vector<Eigen::Triplet<double>> entries;
+  for (Eigen::Index j = 0; j < whole.outerSize(); ++j)
+    for (Eigen::SparseMatrix<double>::InnerIterator it(whole, j); it; ++it) {
+      const int row = position[static_cast<std::size_t>(it.row())], column = position[static_cast<std::size_t>(j)];
+      if (row >= 0 && column >= 0) entries.emplace_back(row, column, it.value());
+    }
+  const Eigen::Index n = static_cast<Eigen::Index>(first.size());
+  Eigen::SparseMatrix<double> rest(n, n);
+  rest.setFromTriplets(entries.begin(), entries.end());
+  return rest;
+}
+
+FactorisedPreconditioner::Ordering FactorisedPreconditioner::with_rows_last(const Ordering& rest_inverse) const {
+  const std::vector<int> first = rows_first(rest_inverse.size() + static_cast<Eigen::Index>(rows_last_.size()));
+  Ordering inverse(static_cast<Eigen::Index>(first.size() + rows_last_.size()));
+  Eigen::Index k = 0;
+  for (Eigen::Index i = 0; i < rest_inverse.size(); ++i)
+    inverse.indices()[k++] = first[static_cast<std::size_t>(rest_inverse.indices()[i])];
+  for (int row : rows_last_) inverse.indices()[k++] = row;
+  return inverse;
+}
+
 void FactorisedPreconditioner::analyse(const Eigen::SparseMatrix<double>& A) {
   // Both orderings, analysed (a symbolic factorisation: the factor's column counts), and the
   // one with fewer entries kept. The orderings give the inverse permutation (Eigen's
   // SimplicialCholesky does the same), and want the whole symmetric pattern.
   const Eigen::SparseMatrix<double> whole = A.selfadjointView<Eigen::Lower>();
   Ordering amd_inverse, metis_inverse;
-  Eigen::AMDOrdering<int>()(whole, amd_inverse);
-  Eigen::MetisOrdering<int>()(whole, metis_inverse);
+  if (rows_last_.empty()) {
+    Eigen::AMDOrdering<int>()(whole, amd_inverse);
+    Eigen::MetisOrdering<int>()(whole, metis_inverse);
+  } else {
+    const Eigen::SparseMatrix<double> rest = without_rows_last(whole);
+    Ordering amd_rest, metis_rest;   // empty where every row is to be last
+    if (rest.rows() > 0) {
+      Eigen::AMDOrdering<int>()(rest, amd_rest);
+      Eigen::MetisOrdering<int>()(rest, metis_rest);
+    }
+    amd_inverse = with_rows_last(amd_rest);
+    metis_inverse = with_rows_last(metis_rest);
+  }
   order_ = metis_inverse.inverse();
   llt_.analyzePattern(ordered(A));
   const Eigen::Index metis_nonzeros = llt_.matrixL().nestedExpression().nonZeros();

@@ -3,7 +3,8 @@
 // with those springs as its own factor would (one CG iteration and the float's rounding); with
 // other rotations too it still takes fewer iterations than the factor alone; made between the
 // two substitutions on the rows V reaches (the kernels' form) it is the same correction; no
-// difference leaves the factor's solve as it was.
+// difference leaves the factor's solve as it was; with the rows ordered last in the factor V
+// reaches only them, and the correction is as good.
 #include "host/reference/spring_correction.h"
 
 #include <gtest/gtest.h>
@@ -142,6 +143,27 @@ TEST_F(SpringCorrectionTest, NoDifferenceLeavesTheFactorsSolve) {
   corrected = z;
   correction_.apply(factor_, coupling, corrected);
   EXPECT_EQ((corrected - z).norm(), 0.0);
+}
+
+TEST_F(SpringCorrectionTest, WithItsRowsLastInTheFactorItReachesOnlyThem) {
+  // The devices' factor (DeviceEnsemble::analysed_factor): the rows after all the others, so
+  // that V = L^-1 P E is zero above them. The free ordering's V reaches more rows (123).
+  FactorisedPreconditioner last(rows_);
+  ASSERT_TRUE(last.factorise(simulation_->system_matrix()));
+  const int n = static_cast<int>(simulation_->system_matrix().rows()), m = static_cast<int>(rows_.size());
+  for (int row : rows_) EXPECT_GE(last.order()[row], n - m) << "row " << row << " not among the last";
+  SpringCorrection correction(rows_);
+  correction.prepare(last);
+  EXPECT_EQ(correction.reached().size(), rows_.size());
+  EXPECT_GT(correction_.reached().size(), 2 * rows_.size()) << "the free ordering's V, for comparison";
+  // The same system solved as by the free ordering's correction (the first test's bounds).
+  const System system = next_system(*simulation_, 0.05, 31);
+  const Eigen::MatrixXd coupling = correction.coupling(delta(system));
+  Eigen::VectorXd z, Az;
+  last(system.b, z);
+  correction.apply(last, coupling, z);
+  system.A->apply(z, Az);
+  EXPECT_LE((Az - system.b).norm(), 1e-4 * system.b.norm());
 }
 
 }  // namespace
