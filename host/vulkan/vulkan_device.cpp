@@ -261,8 +261,7 @@ void VulkanDevice::download(const VulkanBuffer& buffer, void* data, std::size_t 
   std::memcpy(data, staging_.map, bytes);
 }
 
-VulkanKernel VulkanDevice::kernel(const char* name, int bindings, std::uint32_t group_size,
-                                  std::uint32_t partitions, std::uint32_t lane_rows) {
+VulkanKernel VulkanDevice::kernel(const char* name, int bindings, const std::vector<std::uint32_t>& constants) {
   const bool want_double = precision_ == Precision::double_precision;
   const EmbeddedShader* found = nullptr;
   for (std::size_t i = 0; i < kVulkanShaderCount; ++i) {
@@ -271,8 +270,7 @@ VulkanKernel VulkanDevice::kernel(const char* name, int bindings, std::uint32_t 
     if (found == nullptr || shader.texel_reads == texel_reads_) found = &shader;
   }
   if (found != nullptr)
-    return kernel_from_spirv(name, found->words, found->word_count, bindings, group_size,
-                             partitions, lane_rows);
+    return kernel_from_spirv(name, found->words, found->word_count, bindings, constants);
   throw DeviceError(std::string("no embedded Vulkan shader '") + name + "' (" +
                     (want_double ? "double" : "single") +
                     " precision): the build did not compile it from kernels/vulkan/");
@@ -280,8 +278,7 @@ VulkanKernel VulkanDevice::kernel(const char* name, int bindings, std::uint32_t 
 
 VulkanKernel VulkanDevice::kernel_from_spirv(const std::string& name, const std::uint32_t* words,
                                              std::size_t word_count, int bindings,
-                                             std::uint32_t group_size, std::uint32_t partitions,
-                                             std::uint32_t lane_rows) {
+                                             const std::vector<std::uint32_t>& constants) {
   // Drivers may crash on a module that is not SPIR-V, so look at its header first.
   constexpr std::uint32_t kSpirvMagic = 0x07230203;
   if (word_count < 5 || words == nullptr || words[0] != kSpirvMagic)
@@ -333,21 +330,18 @@ VulkanKernel VulkanDevice::kernel_from_spirv(const std::string& name, const std:
     code.pCode = words;
     check(api_->vkCreateShaderModule(device_, &code, nullptr, &module),
           "loading the Vulkan shader " + name);
-    // Constant 0 the group size, constant 1 the partitions (when given), constant 2 the rows
-    // at once of lanes over sigma points (when given).
-    const std::uint32_t constants[3] = {group_size, partitions, lane_rows};
-    const VkSpecializationMapEntry entries[3] = {{0, 0, sizeof(std::uint32_t)},
-                                                 {1, sizeof(std::uint32_t), sizeof(std::uint32_t)},
-                                                 {2, 2 * sizeof(std::uint32_t), sizeof(std::uint32_t)}};
-    const std::uint32_t used = lane_rows > 0 && partitions > 0 ? 3u : partitions > 0 ? 2u : 1u;
-    VkSpecializationInfo specialization{used, entries, sizeof(constants), constants};
+    std::vector<VkSpecializationMapEntry> entries;
+    for (std::uint32_t i = 0; i < constants.size(); ++i)
+      entries.push_back({i, i * static_cast<std::uint32_t>(sizeof(std::uint32_t)), sizeof(std::uint32_t)});
+    const VkSpecializationInfo specialization{static_cast<std::uint32_t>(entries.size()), entries.data(),
+                                              constants.size() * sizeof(std::uint32_t), constants.data()};
     VkComputePipelineCreateInfo pipeline{};
     pipeline.sType = VK_STRUCTURE_TYPE_COMPUTE_PIPELINE_CREATE_INFO;
     pipeline.stage.sType = VK_STRUCTURE_TYPE_PIPELINE_SHADER_STAGE_CREATE_INFO;
     pipeline.stage.stage = VK_SHADER_STAGE_COMPUTE_BIT;
     pipeline.stage.module = module;
     pipeline.stage.pName = "main";
-    pipeline.stage.pSpecializationInfo = group_size > 0 ? &specialization : nullptr;
+    pipeline.stage.pSpecializationInfo = constants.empty() ? nullptr : &specialization;
     pipeline.layout = k.layout;
     check(api_->vkCreateComputePipelines(device_, VK_NULL_HANDLE, 1, &pipeline, nullptr, &k.pipeline),
           "building the Vulkan shader " + name + " (vkCreateComputePipelines)");

@@ -115,18 +115,17 @@ class VulkanDevice {
   bool texel_reads() const { return texel_reads_; }
 
   // The pipeline of embedded shader `name` in this device's precision (and with texel reads
-  // when set and the shader has that variant). `group_size` > 0 sets
-  // specialization constant 0 (the work-group size of the CG and factor shaders), `partitions`
-  // > 0 (with it) constant 1 (the CG shaders' partitions per sigma point, factor_solve's rows
-  // of L), `lane_rows` > 0 (with both) constant 2 (the CG shaders' rows at once of lanes over
-  // sigma points). Throws DeviceError when the shader is not embedded, is not SPIR-V or the
+  // when set and the shader has that variant), with specialization constant i set to
+  // constants[i] (none given: the shader's defaults). The CG and factor shaders take their
+  // work-group size as constant 0, the CG shaders their partitions per sigma point as 1
+  // (factor_solve its panels of L) and their rows at once of lanes over sigma points as 2;
+  // recenter S and p. Throws DeviceError when the shader is not embedded, is not SPIR-V or the
   // driver rejects it.
-  VulkanKernel kernel(const char* name, int bindings, std::uint32_t group_size = 0,
-                      std::uint32_t partitions = 0, std::uint32_t lane_rows = 0);
+  VulkanKernel kernel(const char* name, int bindings, const std::vector<std::uint32_t>& constants = {});
   // Same, from given SPIR-V words (tests: a module that fails to load).
   VulkanKernel kernel_from_spirv(const std::string& name, const std::uint32_t* words,
-                                 std::size_t word_count, int bindings, std::uint32_t group_size,
-                                 std::uint32_t partitions = 0, std::uint32_t lane_rows = 0);
+                                 std::size_t word_count, int bindings,
+                                 const std::vector<std::uint32_t>& constants = {});
   // A descriptor set with `buffers` at bindings 0..n-1 for `kernel`; a texel binding gets a
   // view of its buffer (made once per buffer and format). Throws DeviceError when a buffer
   // bound as texels holds more than the device's maxTexelBufferElements.

@@ -91,9 +91,9 @@ VulkanEnsemble::VulkanEnsemble(const Model& model, EstimatedParameters estimated
       throw DeviceError("--preconditioner factorised: Vulkan has it with one CG work-group per "
                         "sigma point only (" + std::to_string(cg_partitions_) + " asked)");
     if (cg_partitions_ == 1) {
-      factor_ = analysed_factor();
-      check_device_memory(device_.real_size(), info.name, info.memory, info.max_buffer, factor_->nonzeros());
       springs_ = spring_correction(options.spring_correction);   // as OpenCL's
+      factor_ = analysed_factor(springs_);
+      check_device_memory(device_.real_size(), info.name, info.memory, info.max_buffer, factor_->nonzeros());
     }
   }
   cg_lane_rows_ = sigmafem::cg_lane_rows(options.cg_sigma_lanes_from, S_, info, !cg_partitioned_, factor_ != nullptr);
@@ -122,14 +122,15 @@ VulkanEnsemble::VulkanEnsemble(const Model& model, EstimatedParameters estimated
   // The element and node shaders four sigma points a lane on a CPU device
   // (kernels/vulkan/sigma_quads.h), where S allows.
   sigma_quads_ = options.sigma_quads && device_.texel_reads() && S_ % 4 == 0;
-  k_element_rhs_ = kernel(sigma_quads_ ? "element_rhs_quads" : "element_rhs", DeviceKernel::element_rhs);
-  k_node_rhs_ = kernel(sigma_quads_ ? "node_rhs_quads" : "node_rhs", DeviceKernel::node_rhs);
+  // With a factor, the right-hand side's shaders leave out the Jacobi diagonal (*_factor).
+  const std::string rhs_form = std::string(sigma_quads_ ? "_quads" : "") + (factor_ ? "_factor" : "");
+  k_element_rhs_ = kernel(("element_rhs" + rhs_form).c_str(), DeviceKernel::element_rhs);
+  k_node_rhs_ = kernel(("node_rhs" + rhs_form).c_str(), DeviceKernel::node_rhs);
   k_element_product_ =
       kernel(sigma_quads_ ? "element_product_quads" : "element_product", DeviceKernel::element_product);
   k_node_product_ = kernel(sigma_quads_ ? "node_product_quads" : "node_product", DeviceKernel::node_product);
-  k_state_update_ = kernel("state_update", DeviceKernel::state_update);
+  k_state_update_ = kernel(sigma_quads_ ? "state_update_quads" : "state_update", DeviceKernel::state_update);
   k_observation_gather_ = kernel("observation_gather", DeviceKernel::observation_gather);
-  k_recenter_ = kernel("recenter", DeviceKernel::recenter);
   // The CG shaders (conjugate_gradient.comp): the start's three share one set of bindings
   // (the node rows' buffers first: cg_start does the warm start's gather), the iteration's
   // four another.
@@ -137,13 +138,13 @@ VulkanEnsemble::VulkanEnsemble(const Model& model, EstimatedParameters estimated
   const std::vector<DeviceBuffer>& iteration = kernel_buffers(DeviceKernel::vulkan_cg_iteration);
   const std::uint32_t partitions = static_cast<std::uint32_t>(cg_partitions_);
   auto cg_kernel = [&](const char* name, const std::vector<DeviceBuffer>& buffers) {
-    return device_.kernel(name, static_cast<int>(buffers.size()), cg_group_, partitions,
-                          static_cast<std::uint32_t>(cg_lane_rows_));
+    return device_.kernel(name, static_cast<int>(buffers.size()),
+                          {cg_group_, partitions, static_cast<std::uint32_t>(cg_lane_rows_)});
   };
   // Lanes over sigma points two or more a sigma point add their parts by subgroup shuffles: the
   // factor's CG shaders compiled for them.
   auto lanes = [&](const char* name) { return cg_lane_rows_ > 1 ? std::string(name) + "_lanes" : std::string(name); };
-  k_cg_start_ = cg_kernel(lanes("cg_start").c_str(), start);
+  k_cg_start_ = cg_kernel(lanes(factor_ ? "cg_start_factor" : "cg_start").c_str(), start);
   // One partition on a small mesh: two dispatches an iteration (cg_node_iteration forms q = A d
   // itself), where lavapipe's cost per dispatch outweighs their work; on a larger one the
   // three, where node_product's lanes (a node's sigma points) gather faster than
@@ -202,7 +203,14 @@ VulkanEnsemble::VulkanEnsemble(const Model& model, EstimatedParameters estimated
   }
   s_state_update_ = bind(k_state_update_, kernel_buffers(DeviceKernel::state_update));
   s_observation_gather_ = bind(k_observation_gather_, kernel_buffers(DeviceKernel::observation_gather));
-  s_recenter_ = bind(k_recenter_, kernel_buffers(DeviceKernel::recenter));
+  make_recenter(static_cast<std::uint32_t>(parameter_count()));
+}
+
+void VulkanEnsemble::make_recenter(std::uint32_t p) {
+  const std::vector<DeviceBuffer>& buffers = kernel_buffers(DeviceKernel::recenter);
+  k_recenter_ = device_.kernel("recenter", static_cast<int>(buffers.size()), {static_cast<std::uint32_t>(S_), p});
+  s_recenter_ = bind(k_recenter_, buffers);
+  recenter_parameters_ = p;
 }
 
 VkDescriptorSet VulkanEnsemble::bind(const VulkanKernel& kernel, const std::vector<DeviceBuffer>& buffers) {
@@ -434,7 +442,7 @@ StepReport VulkanEnsemble::advance(const Eigen::Vector3d& so_position) {
   });
 
   // The state update, the solver report and the observations, in one more submission.
-  dispatch_items(cmd, k_state_update_, s_state_update_, 3 * nodes_ * S,
+  dispatch_items(cmd, k_state_update_, s_state_update_, 3 * node_items(),
                  static_cast<std::uint32_t>(3 * nodes_));
   const std::size_t rows = 3 * observed_.size();
   if (rows > 0) {
@@ -488,7 +496,7 @@ void VulkanEnsemble::predicted_observations(Eigen::MatrixXd& y) const {
 
 void VulkanEnsemble::recenter(const Recentering& r) {
   const RecenteringInputs in = pack_recentering(r, S_, "VulkanEnsemble");
-  recenter_parameters_ = in.p;
+  if (in.p != recenter_parameters_) make_recenter(in.p);   // a wrapper's parameters (EffectEnsemble)
   const Precision precision = device_.precision();
   pending_scalars_ = to_device_reals(in.scalars, precision);
   pending_directions_ = to_device_reals(in.directions, precision);

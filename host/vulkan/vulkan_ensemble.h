@@ -145,7 +145,10 @@ class VulkanEnsemble : public DeviceEnsemble {
   // The observations gathered at the end of the last advance(), until recenter() moves x.
   mutable std::vector<double> observations_cache_;
   mutable bool observations_current_ = false;
-  std::uint32_t recenter_parameters_ = 0;   // p of the last recenter(): the recenter shader's loop
+  // The recenter shader made for S and p (its specialization constants; made again when a
+  // re-centring comes with another p, as from an EffectEnsemble's added parameters).
+  void make_recenter(std::uint32_t p);
+  std::uint32_t recenter_parameters_ = 0;
   // Device reals waiting for the next command buffer (record_pending): the stiffnesses, and
   // the re-centring's inputs with its dispatch.
   mutable std::vector<unsigned char> pending_ligament_k_;

@@ -82,8 +82,7 @@ void VulkanFactorSolve::make_layout(const Eigen::SparseMatrix<double>& L, const 
   upload_ints(layout->backward_panel, b.backward_panel());
   upload_ints(layout->slot_rows, b.slot_rows());
   const char* name = split_ > 1 ? "factor_solve_split" : shared_ ? "factor_solve_shared" : "factor_solve";
-  layout->kernel = device_.kernel(name, SF_FACTOR_SOLVE_WORK_STORES + 1,
-                                  group_, static_cast<std::uint32_t>(P));
+  layout->kernel = device_.kernel(name, SF_FACTOR_SOLVE_WORK_STORES + 1, {group_, static_cast<std::uint32_t>(P)});
   const Layout& l = *layout;
   layout->set = device_.bind(l.kernel, {l.forward_starts, l.forward_panel, l.backward_starts, l.backward_panel,
                                         l.slot_rows, r_, z_, active_, spring_at_, spring_solves_, spring_coupling_,

@@ -517,11 +517,7 @@ static inline __attribute__((always_inline)) int sf_block_cg_start(
   for (uint row = 0; row < rows; ++row) {
     for (uint i = 0; i < count; ++i) {
       size_t at = (size_t)row * S + first + i;
-      real bi = b[at];
-      real ri = bi - q[at];
-      r[at] = ri;
-      sum_bb[i] += bi * bi;
-      sum_rr[i] += ri * ri;
+      SF_CG_START_R_ROW(at, q[at], b, r, sum_bb[i], sum_rr[i])
     }
   }
   sf_block_factor_solve(first, count, S, rows, r, z, sum_rz SF_FACTOR_PASS);

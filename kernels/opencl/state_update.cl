@@ -6,5 +6,5 @@ __kernel void state_update(uint S, uint rows, __global const real* c, __global c
                            __global real* dv, __global real* x, __global real* v) {
   size_t gid = get_global_id(0);
   if (gid >= (size_t)rows * S) return;
-  SF_STATE_UPDATE_ROW(gid, gid % S, c[SF_H], bb, dv, x, v)
+  SF_STATE_UPDATE_ROW(gid, bb[gid % S], c[SF_H], dv, x, v)
 }

@@ -24,6 +24,17 @@
     sum_rz += ri_ * zi_;                                                                       \
   }
 
+/* The same without z and d, where a factor forms them after the start (OpenCL's SF_FACTOR,
+ * Vulkan's factor_solve and cg_factor_start): r = b - q; b.b, r.r. */
+#define SF_CG_START_R_ROW(at, q_value, b_, r_, sum_bb, sum_rr) \
+  {                                                            \
+    SF_REAL bi_ = SF_LOAD(b_, at);                             \
+    SF_REAL ri_ = bi_ - (q_value);                             \
+    r_[at] = ri_;                                              \
+    sum_bb += bi_ * bi_;                                       \
+    sum_rr += ri_ * ri_;                                       \
+  }
+
 /* An iteration's row, with q = A d there (q_value: its value at the row): x += alpha d,
  * r -= alpha q, z = M^-1 r; r.r, r.z. */
 #define SF_CG_UPDATE_ROW(at, alpha, q_value, x_, r_, z_, d_, inverse_diagonal_, sum_rr, sum_rz) \

@@ -17,6 +17,7 @@
  * these finish what Jacobi's z lets the shaders above do at once:
  *   -DSF_ENTRY_CG_ITERATION_FACTOR, -DSF_ENTRY_CG_NODE_ITERATION_FACTOR  cg_iteration and
  *                            cg_node_iteration up to the stop test: no r.z, no new direction
+ *   -DSF_ENTRY_CG_START_FACTOR      cg_start_factor: cg_start's r = b - A x and sums, no z or d
  *   -DSF_ENTRY_CG_FACTOR_START      cg_factor_start: r.z and d = z after the warm start's solve
  *   -DSF_ENTRY_CG_FACTOR_DIRECTION  cg_factor_direction: r.z, beta and d = z + beta d
  *
@@ -58,7 +59,10 @@
 #  extension GL_KHR_shader_subgroup_shuffle : require
 #endif
 
-#if defined(SF_ENTRY_CG_ITERATION_FACTOR)
+#if defined(SF_ENTRY_CG_START_FACTOR)
+#  define SF_ENTRY_CG_START
+#  define SF_FACTOR
+#elif defined(SF_ENTRY_CG_ITERATION_FACTOR)
 #  define SF_ENTRY_CG_ITERATION
 #  define SF_FACTOR
 #elif defined(SF_ENTRY_CG_NODE_ITERATION_FACTOR)
@@ -185,7 +189,11 @@ void sf_start_rows(uint s, uint S, uint begin, uint end, out real sum_bb, out re
     for (uint k = 0u; k < 3u; ++k) {
       uint row = (3u * n + k) * S + s;
       real q = SF_SYSTEM_ROW(c, s, S, Kd[k], spring, m, SF_LOAD(x, row));
+#  if defined(SF_FACTOR) /* z, d and r.z are factor_solve's and cg_factor_start's */
+      SF_CG_START_R_ROW(row, q, b, r, sum_bb, sum_rr)
+#  else
       SF_CG_START_ROW(row, q, b, inverse_diagonal, r, z, d, sum_bb, sum_rr, sum_rz)
+#  endif
     }
   }
   sum_bb = sf_group_sum(sum_bb);

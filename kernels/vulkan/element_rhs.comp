@@ -5,7 +5,8 @@
  *   rhs_e  = f_e(x) - (h + a) K_e v_e
  *   diag_e = diag(R K_e R^T)
  * One invocation per (element, sigma); or, compiled with SF_SIGMA_QUADS (element_rhs_quads),
- * per element and four sigma points (sigma_quads.h). */
+ * per element and four sigma points (sigma_quads.h). Compiled with SF_FACTOR (*_factor: CG
+ * preconditioned by factor_solve), no Jacobi diagonal, as OpenCL's with SF_FACTOR. */
 #version 450
 #extension GL_GOOGLE_include_directive : require
 #include "ensemble_layout.h"
@@ -47,8 +48,10 @@ void main() {
   SF_REAL velocity_factor = SF_QUAD_CONSTANT(c, SF_VELOCITY_FACTOR, q, S);
   for (uint i = 0u; i < 12u; ++i) force[i] -= velocity_factor * product[i];
   SF_STORE_ITEM_QUADS(element_out, e, 12u, q, Q, force)
+#if !defined(SF_FACTOR)
   sf_element_diagonal(frame, grad, sigma_lambda, sigma_mu, product);
   SF_STORE_ITEM_QUADS(element_diagonal, e, 12u, q, Q, product)
+#endif
 }
 #else /* a sigma point a lane */
 SF_READ_INTS(SF_ELEMENT_RHS_ELEMENT_NODES, nodes)
@@ -86,7 +89,9 @@ void main() {
   sf_element_product(frame, grad, sigma_lambda, sigma_mu, corner, product);
   for (uint i = 0u; i < 12u; ++i) force[i] -= SF_SIGMA_CONSTANT(c, SF_VELOCITY_FACTOR, s, S) * product[i];
   SF_STORE_CORNERS(element_out, e, s, S, force)
+#if !defined(SF_FACTOR)
   sf_element_diagonal(frame, grad, sigma_lambda, sigma_mu, product);
   SF_STORE_CORNERS(element_diagonal, e, s, S, product)
+#endif
 }
 #endif

@@ -7,7 +7,8 @@
  * One invocation per (node, sigma); or, with -DSF_ENTRY_NODE_RHS_QUADS and
  * -DSF_ENTRY_NODE_PRODUCT_QUADS (node_rhs_quads, node_product_quads: SF_SIGMA_QUADS, the CPU
  * form with S a multiple of 4), per node and four sigma points, read by rgba texels and
- * written as vec4s (sigma_quads.h; the same bits). */
+ * written as vec4s (sigma_quads.h; the same bits). node_rhs compiled with SF_FACTOR (*_factor:
+ * CG preconditioned by factor_solve) leaves out the Jacobi diagonal, as OpenCL's does. */
 #version 450
 #extension GL_GOOGLE_include_directive : require
 #if defined(SF_ENTRY_NODE_RHS_QUADS)
@@ -44,9 +45,11 @@ void main() {
   SfNodeConstants at;
   SF_LOAD_NODE_CONSTANTS_BY(SF_QUAD_CONSTANT, c, q, S, at)
   SF_REAL f_elements[3];
-  SF_REAL diagonal[3];
   SF_CORNER_SUM_QUADS(element_out, incidence_offsets, incidence, n, q, Q, f_elements)
+#if !defined(SF_FACTOR)
+  SF_REAL diagonal[3];
   SF_CORNER_SUM_QUADS(element_diagonal, incidence_offsets, incidence, n, q, Q, diagonal)
+#endif
   SF_REAL u[3];
   for (uint k = 0u; k < 3u; ++k) u[k] = SF_QUAD(x, (3u * n + k) * Q + q) - SF_REAL(SF_LOAD(rest_positions, 3u * n + k));
   SF_REAL control = SF_REAL(SF_LOAD(control_k, n));
@@ -54,7 +57,9 @@ void main() {
   for (uint k = 0u; k < 3u; ++k) {
     uint row = (3u * n + k) * Q + q;
     rhs[row] = sf_node_rhs_row(at, int(k), f_elements[k], u[k], SF_QUAD(v, row), spring, control, law, mass_n, m);
+#if !defined(SF_FACTOR)
     inverse_diagonal[row] = sf_node_inverse_diagonal(at, diagonal[k], spring, m);
+#endif
   }
 }
 
@@ -79,9 +84,11 @@ void main() {
   SfNodeConstants at;
   SF_LOAD_NODE_CONSTANTS(c, s, S, at)
   real f_elements[3];
-  real diagonal[3];
   SF_CORNER_SUMS(element_out, incidence_offsets, incidence, n, s, S, f_elements)
+#if !defined(SF_FACTOR)
+  real diagonal[3];
   SF_CORNER_SUMS(element_diagonal, incidence_offsets, incidence, n, s, S, diagonal)
+#endif
   real u[3];
   for (uint k = 0u; k < 3u; ++k) u[k] = SF_LOAD(x, (3u * n + k) * S + s) - SF_LOAD(rest_positions, 3u * n + k);
   real control = SF_LOAD(control_k, n);
@@ -90,7 +97,9 @@ void main() {
     uint row = (3u * n + k) * S + s;
     rhs[row] = sf_node_rhs_row(at, int(k), f_elements[k], u[k], SF_LOAD(v, row), spring, control,
                                law, SF_LOAD(mass, n), m);
+#if !defined(SF_FACTOR)
     inverse_diagonal[row] = sf_node_inverse_diagonal(at, diagonal[k], spring, m);
+#endif
   }
 }
 

@@ -67,7 +67,7 @@ TEST_F(VulkanDeviceTest, AShaderThatFailsToLoadIsADeviceError) {
   // Not SPIR-V: the driver never sees it (some crash on such input).
   const std::vector<std::uint32_t> garbage = {0xdeadbeef, 1, 2, 3, 4, 5};
   try {
-    device.kernel_from_spirv("garbage", garbage.data(), garbage.size(), 1, 0);
+    device.kernel_from_spirv("garbage", garbage.data(), garbage.size(), 1);
     FAIL() << "expected a load failure";
   } catch (const DeviceError& e) {
     const std::string message = e.what();
