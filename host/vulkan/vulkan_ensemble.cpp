@@ -94,8 +94,8 @@ VulkanEnsemble::VulkanEnsemble(const Model& model, EstimatedParameters estimated
       springs_ = spring_correction(options.spring_correction);   // as OpenCL's
       // In the free ordering, not with the springs' rows last as OpenCL's: with them last the
       // 38k liver's CG took 170 iterations at its second filter step instead of 2 and the
-      // estimate went non-finite at step 23 (stop 58; not yet understood: the solve alone agreed
-      // with the free ordering's to 1e-6). On the 596 liver the rows last were 5% faster.
+      // estimate went non-finite at step 23, in float32 only, with or without the correction
+      // (stop 58; not yet understood). On the 596 liver the rows last were 5% faster.
       factor_ = analysed_factor();
       check_device_memory(device_.real_size(), info.name, info.memory, info.max_buffer, factor_->nonzeros());
     }
