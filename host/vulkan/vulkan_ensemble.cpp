@@ -92,10 +92,10 @@ VulkanEnsemble::VulkanEnsemble(const Model& model, EstimatedParameters estimated
                         "sigma point only (" + std::to_string(cg_partitions_) + " asked)");
     if (cg_partitions_ == 1) {
       springs_ = spring_correction(options.spring_correction);   // as OpenCL's
-      // In the free ordering, not with the springs' rows last as OpenCL's: with them last the
-      // 38k liver's CG took 170 iterations at its second filter step instead of 2 and the
-      // estimate went non-finite at step 23, in float32 only, with or without the correction
-      // (stop 58; not yet understood). On the 596 liver the rows last were 5% faster.
+      // In the free ordering, not with the springs' rows last as OpenCL's: the 38k liver's
+      // filter here goes wrong in some runs (CG from 2 to ~170 iterations a step, then
+      // non-finite), and with the rows last in most (stop 58; not yet found: the solve alone
+      // checks out). On the 596 liver the rows last were 5% faster.
       factor_ = analysed_factor();
       check_device_memory(device_.real_size(), info.name, info.memory, info.max_buffer, factor_->nonzeros());
     }
