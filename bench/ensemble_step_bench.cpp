@@ -450,37 +450,39 @@ BENCHMARK_CAPTURE(BM_ensemble_step, vulkan_multigrid_box_large_117240, kVulkanMu
 // A whole filter step on the liver, over the same 1000 steps of its scenario on every back end
 // (from stop 58; before, as many as half a second took, so that a faster back end averaged
 // over more and later steps, whose CG iterations differ).
-constexpr int kLiverFilterSteps = 1000;
+void liver_filter_steps(benchmark::internal::Benchmark* b) {
+  b->Iterations(1000)->Unit(benchmark::kMillisecond)->UseRealTime();
+}
 BENCHMARK_CAPTURE(BM_filter_step, opencl, kOpenCl, std::string("liver"))
-    ->Iterations(kLiverFilterSteps)->Unit(benchmark::kMillisecond)->UseRealTime();
+    ->Apply(liver_filter_steps);
 BENCHMARK_CAPTURE(BM_filter_step, opencl_factorised, kOpenClFactorised, std::string("liver"))
-    ->Iterations(kLiverFilterSteps)->Unit(benchmark::kMillisecond)->UseRealTime();
+    ->Apply(liver_filter_steps);
 BENCHMARK_CAPTURE(BM_filter_step, opencl_shared_factor, kOpenClSharedFactor, std::string("liver"))
-    ->Iterations(kLiverFilterSteps)->Unit(benchmark::kMillisecond)->UseRealTime();
+    ->Apply(liver_filter_steps);
 BENCHMARK_CAPTURE(BM_filter_step, opencl_uncorrected_factor, kOpenClUncorrectedFactor, std::string("liver"))
-    ->Iterations(kLiverFilterSteps)->Unit(benchmark::kMillisecond)->UseRealTime();
+    ->Apply(liver_filter_steps);
 BENCHMARK_CAPTURE(BM_filter_step, opencl_per_iteration, kOpenClPerIteration, std::string("liver"))
-    ->Iterations(kLiverFilterSteps)->Unit(benchmark::kMillisecond)->UseRealTime();
+    ->Apply(liver_filter_steps);
 BENCHMARK_CAPTURE(BM_filter_step, opencl_whole_solve, kOpenClWholeSolve, std::string("liver"))
-    ->Iterations(kLiverFilterSteps)->Unit(benchmark::kMillisecond)->UseRealTime();
+    ->Apply(liver_filter_steps);
 BENCHMARK_CAPTURE(BM_filter_step, vulkan_three_dispatches, kVulkanThreeDispatches, std::string("liver"))
-    ->Iterations(kLiverFilterSteps)->Unit(benchmark::kMillisecond)->UseRealTime();
+    ->Apply(liver_filter_steps);
 BENCHMARK_CAPTURE(BM_filter_step, vulkan, kVulkan, std::string("liver"))
-    ->Iterations(kLiverFilterSteps)->Unit(benchmark::kMillisecond)->UseRealTime();
+    ->Apply(liver_filter_steps);
 BENCHMARK_CAPTURE(BM_filter_step, vulkan_factorised, kVulkanFactorised, std::string("liver"))
-    ->Iterations(kLiverFilterSteps)->Unit(benchmark::kMillisecond)->UseRealTime();
+    ->Apply(liver_filter_steps);
 BENCHMARK_CAPTURE(BM_filter_step, vulkan_uncorrected_factor, kVulkanUncorrectedFactor, std::string("liver"))
-    ->Iterations(kLiverFilterSteps)->Unit(benchmark::kMillisecond)->UseRealTime();
+    ->Apply(liver_filter_steps);
 BENCHMARK_CAPTURE(BM_filter_step, vulkan_texel_reads, kVulkanTexelReads, std::string("liver"))
-    ->Iterations(kLiverFilterSteps)->Unit(benchmark::kMillisecond)->UseRealTime();
+    ->Apply(liver_filter_steps);
 BENCHMARK_CAPTURE(BM_filter_step, vulkan_storage_reads, kVulkanStorageReads, std::string("liver"))
-    ->Iterations(kLiverFilterSteps)->Unit(benchmark::kMillisecond)->UseRealTime();
+    ->Apply(liver_filter_steps);
 BENCHMARK_CAPTURE(BM_filter_step, cpu, kCpu, std::string("liver"))
-    ->Iterations(kLiverFilterSteps)->Unit(benchmark::kMillisecond)->UseRealTime();
+    ->Apply(liver_filter_steps);
 BENCHMARK_CAPTURE(BM_filter_step, cpu_shared, kCpuShared, std::string("liver"))
-    ->Iterations(kLiverFilterSteps)->Unit(benchmark::kMillisecond)->UseRealTime();
+    ->Apply(liver_filter_steps);
 BENCHMARK_CAPTURE(BM_filter_step, cpu_jacobi, kCpuJacobi, std::string("liver"))
-    ->Iterations(kLiverFilterSteps)->Unit(benchmark::kMillisecond)->UseRealTime();
+    ->Apply(liver_filter_steps);
 // Against the parameter count (issue 19): S = 4 to 65.
 BENCHMARK_CAPTURE(BM_filter_step_parameters, opencl_factorised, kOpenClFactorised)
     ->Arg(3)->Arg(8)->Arg(16)->Arg(32)->Arg(64)->Unit(benchmark::kMillisecond)->UseRealTime();

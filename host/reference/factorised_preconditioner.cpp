@@ -55,8 +55,8 @@ std::vector<int> FactorisedPreconditioner::rows_first(Eigen::Index n) const {
   return first;
 }
 
-Eigen::SparseMatrix<double> FactorisedPreconditioner::without_rows_last(const Eigen::SparseMatrix<double>& whole) const {
-  const std::vector<int> first = rows_first(whole.rows());
+Eigen::SparseMatrix<double> FactorisedPreconditioner::without_rows_last(const Eigen::SparseMatrix<double>& whole,
+                                                                         const std::vector<int>& first) const {
   std::vector<int> position(static_cast<std::size_t>(whole.rows()), -1);
   for (std::size_t k = 0; k < first.size(); ++k) position[static_cast<std::size_t>(first[k])] = static_cast<int>(k);
   std::vector<Eigen::Triplet<double>> entries;
@@ -71,8 +71,8 @@ Eigen::SparseMatrix<double> FactorisedPreconditioner::without_rows_last(const Ei
   return rest;
 }
 
-FactorisedPreconditioner::Ordering FactorisedPreconditioner::with_rows_last(const Ordering& rest_inverse) const {
-  const std::vector<int> first = rows_first(rest_inverse.size() + static_cast<Eigen::Index>(rows_last_.size()));
+FactorisedPreconditioner::Ordering FactorisedPreconditioner::with_rows_last(const Ordering& rest_inverse,
+                                                                            const std::vector<int>& first) const {
   Ordering inverse(static_cast<Eigen::Index>(first.size() + rows_last_.size()));
   Eigen::Index k = 0;
   for (Eigen::Index i = 0; i < rest_inverse.size(); ++i)
@@ -91,14 +91,15 @@ void FactorisedPreconditioner::analyse(const Eigen::SparseMatrix<double>& A) {
     Eigen::AMDOrdering<int>()(whole, amd_inverse);
     Eigen::MetisOrdering<int>()(whole, metis_inverse);
   } else {
-    const Eigen::SparseMatrix<double> rest = without_rows_last(whole);
+    const std::vector<int> first = rows_first(A.rows());
+    const Eigen::SparseMatrix<double> rest = without_rows_last(whole, first);
     Ordering amd_rest, metis_rest;   // empty where every row is to be last
     if (rest.rows() > 0) {
       Eigen::AMDOrdering<int>()(rest, amd_rest);
       Eigen::MetisOrdering<int>()(rest, metis_rest);
     }
-    amd_inverse = with_rows_last(amd_rest);
-    metis_inverse = with_rows_last(metis_rest);
+    amd_inverse = with_rows_last(amd_rest, first);
+    metis_inverse = with_rows_last(metis_rest, first);
   }
   order_ = metis_inverse.inverse();
   llt_.analyzePattern(ordered(A));

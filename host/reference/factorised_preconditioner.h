@@ -78,12 +78,13 @@ class FactorisedPreconditioner {
   bool same_pattern(const Eigen::SparseMatrix<double>& A) const;
   // A's symmetric permutation by order_, the matrix llt_ factorises (in its natural order).
   Eigen::SparseMatrix<double> ordered(const Eigen::SparseMatrix<double>& A) const;
-  // For rows_last_: the other rows in increasing order (A of n rows); A's pattern without
-  // rows_last_, numbered so; an ordering of that (inverse, as the orderings give it) with
-  // rows_last_ appended, of all n rows.
+  // For rows_last_: the other rows in increasing order (`first`, of A's n rows); A's pattern
+  // on those rows alone, numbered so; an ordering of that (inverse, as the orderings give it)
+  // with rows_last_ appended, of all n rows.
   std::vector<int> rows_first(Eigen::Index n) const;
-  Eigen::SparseMatrix<double> without_rows_last(const Eigen::SparseMatrix<double>& whole) const;
-  Ordering with_rows_last(const Ordering& rest_inverse) const;
+  Eigen::SparseMatrix<double> without_rows_last(const Eigen::SparseMatrix<double>& whole,
+                                                const std::vector<int>& first) const;
+  Ordering with_rows_last(const Ordering& rest_inverse, const std::vector<int>& first) const;
   Ordering order_;
   Eigen::SimplicialLLT<Eigen::SparseMatrix<double>, Eigen::Lower, Eigen::NaturalOrdering<int>> llt_;
   SupernodalFactor supernodes_;
