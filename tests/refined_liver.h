@@ -34,7 +34,7 @@ inline Eigen::MatrixXd spread_log_stiffness(const Scenario& scenario, const Mode
 
 // `steps` steps of the scenario's motion with parameters `theta`, every sigma point converging;
 // each step's CG iterations added to `iterations`. Returns the positions, 3N x S.
-inline Eigen::MatrixXd run_steps(DeviceEnsemble& ensemble, const Scenario& scenario, const Eigen::MatrixXd& theta,
+inline Eigen::MatrixXd run_steps(SimulationEnsemble& ensemble, const Scenario& scenario, const Eigen::MatrixXd& theta,
                                  int steps, long& iterations) {
   ensemble.set_parameters(theta);
   const int S = ensemble.sigma_count();
@@ -46,8 +46,8 @@ inline Eigen::MatrixXd run_steps(DeviceEnsemble& ensemble, const Scenario& scena
       iterations += report.cg_iterations[s];
     }
   }
-  Eigen::MatrixXd x(ensemble.positions(0).size(), S);
-  for (int s = 0; s < S; ++s) x.col(s) = ensemble.positions(s);
+  Eigen::MatrixXd x, v;
+  ensemble.read_states(x, v);
   return x;
 }
 

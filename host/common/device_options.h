@@ -54,9 +54,12 @@ inline bool spring_correction_fits(std::size_t spring_rows, int sigma_count) {
 
 // DeviceOptions::node_iteration_work's default, measured on lavapipe (bench/RESULTS.md, stop 52).
 constexpr long long kNodeIterationWork = 32768;
-// DeviceOptions::factor_loop_turns' default: under llvmpipe's 65535 loop turns an invocation
-// (kernels/vulkan/factor_solve.comp).
-constexpr long long kFactorLoopTurns = 61440;
+// llvmpipe (lavapipe's compiler) ends the loops of a shader invocation, silently, once they have
+// turned 65535 times in all (gallivm's LP_MAX_TGSI_LOOP_ITERATIONS; bench/RESULTS.md, stop 52):
+// the most our Vulkan shaders' loops are planned to turn, with room for those not counted.
+constexpr long long kShaderLoopTurns = 61440;
+// DeviceOptions::factor_loop_turns' default (kernels/vulkan/factor_solve.comp).
+constexpr long long kFactorLoopTurns = kShaderLoopTurns;
 // DeviceOptions::lavapipe_serial_work's default, measured on lavapipe on a 2-core machine
 // (bench/RESULTS.md, stop 55): serial on the liver (596 tetrahedra) at S = 4 (3.3 against 4.3 ms
 // a filter step) and the box (1344) at S = 4 (9.8 against 11.6), threads on the liver at
@@ -96,6 +99,11 @@ struct DeviceOptions {
   // blocks is one; host/reference/factor_blocks.h), below llvmpipe's limit; tests make it small
   // to cut a solve into many.
   long long factor_loop_turns = kFactorLoopTurns;
+  // Vulkan with one CG partition: the most loop turns of one invocation of the CG shaders, whose
+  // lanes walk their sigma point's nodes (cg_loop_turns, host/vulkan/vulkan_ensemble.h): where
+  // the lanes over sigma points would turn more, a work-group a sigma point, grown until its
+  // lanes turn less; tests make it small.
+  long long cg_loop_turns = kShaderLoopTurns;
   // Vulkan on lavapipe: below this many element-sigma pairs (elements x S) its shaders run on
   // the thread that submits them, where handing each dispatch to its threads costs more than
   // they give back (choose_lavapipe_threads, host/vulkan/vulkan_device.h; a user's

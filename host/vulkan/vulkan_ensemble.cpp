@@ -42,6 +42,20 @@ int cg_lane_rows(int lanes_from, int sigma_count, const VulkanDeviceInfo& info, 
   return rows;
 }
 
+long long cg_loop_turns(const Model& model, int row_step) {
+  const int nodes = model.node_count();
+  std::vector<long long> turns(static_cast<std::size_t>(nodes), kCgNodeTurns);
+  for (const ElementRest& element : model.elements)
+    for (const int n : element.nodes) ++turns[static_cast<std::size_t>(n)];
+  for (const SpringSet& ligament : model.ligaments)
+    for (const int n : ligament.nodes) ++turns[static_cast<std::size_t>(n)];
+  const int step = std::max(1, row_step);
+  long long total = 0;
+  for (int first = 0; first < nodes; first += step)
+    total += *std::max_element(turns.begin() + first, turns.begin() + std::min(nodes, first + step));
+  return total;
+}
+
 VulkanEnsemble::VulkanEnsemble(const Model& model, EstimatedParameters estimated,
                                ObservedPoints observed, int sigma_count,
                                const DeviceOptions& options)
@@ -92,15 +106,25 @@ VulkanEnsemble::VulkanEnsemble(const Model& model, EstimatedParameters estimated
                         "sigma point only (" + std::to_string(cg_partitions_) + " asked)");
     if (cg_partitions_ == 1) {
       springs_ = spring_correction(options.spring_correction);   // as OpenCL's
-      // In the free ordering, not with the springs' rows last as OpenCL's: the 38k liver's
-      // filter here goes wrong in some runs (CG from 2 to ~170 iterations a step, then
-      // non-finite), and with the rows last in most (stop 58; not yet found: the solve alone
-      // checks out). On the 596 liver the rows last were 5% faster.
-      factor_ = analysed_factor();
+      factor_ = analysed_factor(springs_);   // their rows last, as OpenCL's
       check_device_memory(device_.real_size(), info.name, info.memory, info.max_buffer, factor_->nonzeros());
     }
   }
   cg_lane_rows_ = sigmafem::cg_lane_rows(options.cg_sigma_lanes_from, S_, info, !cg_partitioned_, factor_ != nullptr);
+  // Within llvmpipe's loop turns (cg_loop_turns): lanes over sigma points give way to a group a
+  // sigma point, which grows until its lanes' share of the nodes fits (128 invocations a group,
+  // Vulkan's least maximum, at most).
+  if (!cg_partitioned_) {
+    if (cg_lane_rows_ > 0 && cg_loop_turns(model_, cg_lane_rows_) > options.cg_loop_turns) cg_lane_rows_ = 0;
+    while (cg_lane_rows_ == 0 && cg_loop_turns(model_, static_cast<int>(cg_group_)) > options.cg_loop_turns) {
+      if (cg_group_ >= 128)
+        throw DeviceError("the mesh's " + std::to_string(nodes_) + " nodes are too many for Vulkan's CG with one "
+                          "work-group of 128 a sigma point on " + info.name + " (its loops would turn " +
+                          std::to_string(cg_loop_turns(model_, static_cast<int>(cg_group_))) + " times; at most " +
+                          std::to_string(options.cg_loop_turns) + ")");
+      cg_group_ *= 2;
+    }
+  }
 
   // The partitions' buffers are bound but unused with one partition.
   std::size_t largest = 0;

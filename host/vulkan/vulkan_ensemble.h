@@ -62,6 +62,16 @@ bool vulkan_uses_multigrid(Preconditioner preconditioner, const std::string& dev
 // subgroup shuffles at S <= 4, 8 / S rounded down to a power of 2 (2 at S = 3-4, 4 at 2, 8 at 1);
 // else 0, a work-group a sigma point.
 int cg_lane_rows(int lanes_from, int sigma_count, const VulkanDeviceInfo& info, bool one_partition, bool factor);
+// The loop turns of the one-partition CG shaders' busiest invocation when their lanes walk every
+// `row_step`-th node of a sigma point (J with lanes over sigma points, else the group size): at
+// each node cg_start and cg_node_iteration turn once per element corner and ligament there, and
+// kCgNodeTurns more, and lanes that run in one vector turn together, as often as their busiest
+// node needs (an upper bound: the busiest of the row_step nodes taken at once). llvmpipe ends
+// every loop of an invocation past 65535 turns (kShaderLoopTurns), silently: before this bound
+// the 38k liver's CG at S = 4 (2 lanes a sigma point, ~100 000 turns) started from a residual
+// with its last rows never written.
+constexpr long long kCgNodeTurns = 4;
+long long cg_loop_turns(const Model& model, int row_step);
 
 class VulkanEnsemble : public DeviceEnsemble {
  public:
@@ -84,6 +94,9 @@ class VulkanEnsemble : public DeviceEnsemble {
   // Whether the one-partition CG shaders take a sigma point a lane (conjugate_gradient.comp).
   // Rows (nodes) at once of each sigma point's lanes in them; 0: a work-group a sigma point.
   int cg_lane_rows() const { return cg_lane_rows_; }
+  // Work-items per sigma point in the CG shaders without lanes over sigma points (specialization
+  // constant 0): 8 on a CPU device, more where a mesh's nodes would turn their loops too often.
+  std::uint32_t cg_group_size() const { return cg_group_; }
   // Host waits (command-buffer submissions) of the last advance().
   int last_step_waits() const { return last_step_waits_; }
   // Whether CG is preconditioned by a factor (vulkan_uses_factor), its factorisations so far
