@@ -64,13 +64,13 @@ bool vulkan_uses_multigrid(Preconditioner preconditioner, const std::string& dev
 int cg_lane_rows(int lanes_from, int sigma_count, const VulkanDeviceInfo& info, bool one_partition, bool factor);
 // The loop turns of the one-partition CG shaders' busiest invocation when their lanes walk every
 // `row_step`-th node of a sigma point (J with lanes over sigma points, else the group size): at
-// each node cg_start and cg_node_iteration turn once per element corner and ligament there, and
-// kCgNodeTurns more, and lanes that run in one vector turn together, as often as their busiest
-// node needs (an upper bound: the busiest of the row_step nodes taken at once). llvmpipe ends
-// every loop of an invocation past 65535 turns (kShaderLoopTurns), silently: before this bound
-// the 38k liver's CG at S = 4 (2 lanes a sigma point, ~100 000 turns) started from a residual
-// with its last rows never written.
-constexpr long long kCgNodeTurns = 4;
+// each node cg_node_iteration, the busiest, turns once per element corner and ligament there
+// and kCgNodeTurns more (the node loops of its d.q and its update, 3 rows each), and lanes that
+// run in one vector turn together, as often as their busiest node needs (an upper bound: the
+// busiest of the row_step nodes taken at once). llvmpipe ends every loop of an invocation past
+// 65535 turns (kShaderLoopTurns), silently: before this bound the 38k liver's CG at S = 4 (2
+// lanes a sigma point, ~115 000 turns) started from a residual with its last rows never written.
+constexpr long long kCgNodeTurns = 8;
 long long cg_loop_turns(const Model& model, int row_step);
 
 class VulkanEnsemble : public DeviceEnsemble {

@@ -403,7 +403,7 @@ TEST_F(VulkanDeviceTest, CgGroupsGrowToKeepWithinTheLoopTurns) {
 }
 
 // The 38k liver's filter (S = 4, the factor): its 2 lanes a sigma point would turn the CG
-// shaders' loops ~100 000 times, past lavapipe's 65535, which then ended them silently and CG
+// shaders' loops ~115 000 times, past lavapipe's 65535, which then ended them silently and CG
 // started from a residual whose last rows were never written (the filter's estimate went
 // non-finite in some runs: stop 58). It takes a group of 8 a sigma point instead, and its steps
 // follow the CPU reference's. Not VulkanDeviceTest: not under the validation layer; long (14 s).
