@@ -109,13 +109,15 @@ OpenClEnsemble::OpenClEnsemble(const Model& model, EstimatedParameters estimated
     // 2.0-2.9 ms; stop 51). Beyond the cache a solve's time is reading L, which the shared
     // factor reads once for a block.
     const bool springs_alone = corrected && estimated_.regions.empty();
-    factor_ = springs_alone ? analysed_factor(correction) : analysed_factor();
-    if (!springs_alone && S_ >= kOwnFactorsFromSigmaPoints &&
-        static_cast<std::size_t>(S_) * factor_->nonzeros() * device_.real_size() <= options.own_factors_bytes)
+    // Own factors (in the free ordering) are sized by an analysis first; else the shared factor
+    // is analysed once, with the springs' rows last where it is corrected (~1 s on the 38k liver).
+    const bool may_own = !springs_alone && S_ >= kOwnFactorsFromSigmaPoints;
+    factor_ = corrected && !may_own ? analysed_factor(correction) : analysed_factor();
+    if (may_own && static_cast<std::size_t>(S_) * factor_->nonzeros() * device_.real_size() <= options.own_factors_bytes)
       factor_copies_ = S_;
     if (factor_copies_ == 1 && corrected) {
       springs_ = std::move(correction);
-      if (!springs_alone) factor_ = analysed_factor(springs_);   // again, the springs' rows last
+      if (may_own) factor_ = analysed_factor(springs_);   // again, the springs' rows last
     }
     // Again with the factor's buffers (L alone is 125 MB on the 38k liver; the copies of its
     // values add at most own_factors_bytes).
