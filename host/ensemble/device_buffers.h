@@ -74,6 +74,9 @@ struct DeviceBufferSizes {
   std::size_t factor_nonzeros = 0;   // of CG's factor, if it has one (0: Jacobi)
   int factor_copies = 1;             // of L's values: 1 shared, S when each sigma point has its own
   int spring_rows = 0;               // m of the factor's SpringCorrection (0: none)
+  // Jacobi's diagonals (element_diagonal, inverse_diagonal: 12 E S + 3 N S reals); false with a
+  // factor, whose kernels leave them out (*_factor, SF_FACTOR): one element each.
+  bool jacobi_diagonals = true;
 };
 
 // Every buffer of an ensemble of `model` with S sigma points, in DeviceBuffer order. The

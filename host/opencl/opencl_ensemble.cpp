@@ -167,10 +167,11 @@ OpenClEnsemble::OpenClEnsemble(const Model& model, EstimatedParameters estimated
     const std::size_t dof = 3 * static_cast<std::size_t>(nodes_) * S_;
     // cg_solve's blocks keep their own vectors there too (conjugate_gradient.cl).
     const std::size_t cg_solve_vectors = whole_solve_ && solve_block_ < S_ ? kCgSolveBlockVectors : 0;
-    const DeviceBufferSizes sizes{std::max<std::size_t>(element_chunks_, cg_solve_vectors) * dof,
-                                  cg_partitions_,
-                                  factor_ ? factor_->nonzeros() : 0, factor_copies_,
-                                  springs_.size()};
+    DeviceBufferSizes sizes{std::max<std::size_t>(element_chunks_, cg_solve_vectors) * dof,
+                            cg_partitions_,
+                            factor_ ? factor_->nonzeros() : 0, factor_copies_,
+                            springs_.size()};
+    sizes.jacobi_diagonals = factor_ == nullptr;   // SF_FACTOR's kernels leave them out
     written_.resize(kDeviceBufferCount);
     write_done_.resize(written_.size());
     for (const DeviceBufferSpec& spec : buffer_specs(sizes)) {

@@ -126,9 +126,12 @@ VulkanEnsemble::VulkanEnsemble(const Model& model, EstimatedParameters estimated
     }
   }
 
-  // The partitions' buffers are bound but unused with one partition.
+  // The partitions' buffers are bound but unused with one partition; Jacobi's diagonals with
+  // the factor (its *_factor shaders leave them out).
+  DeviceBufferSizes sizes{0, cg_partitions_};
+  sizes.jacobi_diagonals = factor_ == nullptr;
   std::size_t largest = 0;
-  for (const DeviceBufferSpec& spec : buffer_specs({0, cg_partitions_})) {
+  for (const DeviceBufferSpec& spec : buffer_specs(sizes)) {
     const std::size_t bytes = take_device_bytes(spec, device_.real_size());
     largest = std::max(largest, bytes);
     buffers_.push_back(device_.buffer(bytes, spec.what));

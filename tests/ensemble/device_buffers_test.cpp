@@ -61,6 +61,16 @@ TEST_F(DeviceBuffersTest, EveryBufferOnceInOrderWithTheLayoutsSizes) {
   EXPECT_EQ(std::count(all_active.begin(), all_active.end(), 1), S);
   // The node incidence lists every element corner once.
   EXPECT_EQ(spec(specs, DeviceBuffer::incidence).count, 4 * static_cast<std::size_t>(E));
+  // Jacobi's diagonals, which a factor's kernels leave out, are one element with a factor.
+  EXPECT_EQ(spec(specs, DeviceBuffer::element_diagonal).count, 12 * static_cast<std::size_t>(E) * S);
+  EXPECT_EQ(spec(specs, DeviceBuffer::inverse_diagonal).count, dof);
+  DeviceBufferSizes factor{0, 1, 1000};
+  factor.jacobi_diagonals = false;
+  const std::vector<DeviceBufferSpec> with_factor =
+      device_buffer_specs(model_, scenario_.observations.observed, S, 42, factor);
+  EXPECT_EQ(spec(with_factor, DeviceBuffer::element_diagonal).count, 1u);
+  EXPECT_EQ(spec(with_factor, DeviceBuffer::inverse_diagonal).count, 1u);
+  EXPECT_EQ(spec(with_factor, DeviceBuffer::element_out).count, 12 * static_cast<std::size_t>(E) * S);
   // A larger element_out asked for (the chunks' copies on a CPU) is given.
   EXPECT_EQ(spec(device_buffer_specs(model_, scenario_.observations.observed, S, 42, {5 * dof, 1}),
                  DeviceBuffer::element_out)
