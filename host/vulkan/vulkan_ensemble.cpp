@@ -182,17 +182,16 @@ VulkanEnsemble::VulkanEnsemble(const Model& model, EstimatedParameters estimated
   // cg_node_iteration's (a sigma point's nodes) (bench/RESULTS.md, stop 52).
   node_iteration_ = !cg_partitioned_ &&
                     static_cast<long long>(elements_) * S_ <= options.node_iteration_work;
-  // With a factor, the iteration shaders stop at the stop test, and factor_solve and
-  // cg_factor_direction follow them.
+  // With a factor, the iteration shaders stop at the stop test, and factor_solve follows them,
+  // finishing the iteration (r.z and the direction) itself.
   if (node_iteration_)
     k_cg_node_iteration_ = cg_kernel(factor_ ? lanes("cg_node_iteration_factor").c_str() : "cg_node_iteration", iteration);
   else if (!cg_partitioned_)
     k_cg_iteration_ = cg_kernel(factor_ ? lanes("cg_iteration_factor").c_str() : "cg_iteration", iteration);
   if (factor_) {
-    k_cg_factor_start_ = cg_kernel(lanes("cg_factor_start").c_str(), iteration);
-    k_cg_factor_direction_ = cg_kernel(lanes("cg_factor_direction").c_str(), iteration);
-    factor_solve_ = std::make_unique<VulkanFactorSolve>(device_, 3 * nodes_, springs_.size(), S_, buffer(B::r),
-                                                        buffer(B::z), buffer(B::active), options.factor_loop_turns);
+    const VulkanFactorSolve::CgBuffers cg{buffer(B::r), buffer(B::z), buffer(B::d), buffer(B::active), buffer(B::rz)};
+    factor_solve_ = std::make_unique<VulkanFactorSolve>(device_, 3 * nodes_, springs_.size(), S_, cg,
+                                                        options.factor_loop_turns);
     device_bytes_ += factor_solve_->bytes();
   }
   if (multigrid_) {
@@ -227,10 +226,6 @@ VulkanEnsemble::VulkanEnsemble(const Model& model, EstimatedParameters estimated
     s_cg_dot_ = bind(k_cg_dot_, iteration);
     s_cg_update_ = bind(k_cg_update_, iteration);
     s_cg_direction_ = bind(k_cg_direction_, iteration);
-  }
-  if (factor_) {
-    s_cg_factor_start_ = bind(k_cg_factor_start_, iteration);
-    s_cg_factor_direction_ = bind(k_cg_factor_direction_, iteration);
   }
   s_state_update_ = bind(k_state_update_, kernel_buffers(DeviceKernel::state_update));
   s_observation_gather_ = bind(k_observation_gather_, kernel_buffers(DeviceKernel::observation_gather));
@@ -349,19 +344,8 @@ void VulkanEnsemble::record_cg_iterations(VkCommandBuffer cmd, int count) const 
       device_.dispatch(cmd, k_cg_iteration_, s_cg_iteration_, &push, groups);
     }
     device_.barrier(cmd);
-    if (factor_) record_factor_solve(cmd, k_cg_factor_direction_, s_cg_factor_direction_);
+    if (factor_) factor_solve_->record(cmd, SF_FACTOR_FINISH_DIRECTION);
   }
-}
-
-void VulkanEnsemble::record_factor_solve(VkCommandBuffer cmd, const VulkanKernel& finish,
-                                         VkDescriptorSet set) const {
-  factor_solve_->record(cmd);
-  PushConstants push;
-  push.S = static_cast<std::uint32_t>(S_);
-  push.count = static_cast<std::uint32_t>(nodes_);
-  push.max_iterations = model_.solver.cg_max_iterations;
-  device_.dispatch(cmd, finish, set, &push, cg_groups());
-  device_.barrier(cmd);
 }
 
 void VulkanEnsemble::record_multigrid(VkCommandBuffer cmd, bool start) const {
@@ -456,7 +440,7 @@ StepReport VulkanEnsemble::advance(const Eigen::Vector3d& so_position) {
     device_.dispatch(cmd, k_cg_start_, s_cg_start_, &push, cg_groups());
   }
   device_.barrier(cmd);
-  if (factor_) record_factor_solve(cmd, k_cg_factor_start_, s_cg_factor_start_);
+  if (factor_) factor_solve_->record(cmd, SF_FACTOR_FINISH_START);
 
   // Then batches until every sigma point is done or the cap is reached, each submitted and
   // waited for, with the S active flags read back.

@@ -122,8 +122,6 @@ class VulkanEnsemble : public DeviceEnsemble {
   void dispatch_items(VkCommandBuffer cmd, const VulkanKernel& kernel, VkDescriptorSet set,
                       std::size_t items, std::uint32_t count) const;
   void record_cg_iterations(VkCommandBuffer cmd, int count) const;
-  // With a factor: z = M^-1 r, then `finish` (cg_factor_start or cg_factor_direction).
-  void record_factor_solve(VkCommandBuffer cmd, const VulkanKernel& finish, VkDescriptorSet set) const;
   // Makes the factor again from the representative (the mean sigma point) when it is due and
   // uploads it with its spring correction; with no factor yet and a failed factorisation,
   // A's diagonal (Jacobi) instead.
@@ -172,7 +170,7 @@ class VulkanEnsemble : public DeviceEnsemble {
   VulkanKernel k_element_rhs_, k_node_rhs_, k_element_product_, k_node_product_;
   VulkanKernel k_cg_start_, k_cg_iteration_, k_state_update_, k_observation_gather_, k_recenter_;
   VulkanKernel k_cg_start_partials_, k_cg_start_scalars_, k_cg_dot_, k_cg_update_, k_cg_direction_;
-  VulkanKernel k_cg_node_iteration_, k_cg_factor_start_, k_cg_factor_direction_, k_cg_preconditioned_;
+  VulkanKernel k_cg_node_iteration_, k_cg_preconditioned_;
   // CG's shared factor (vulkan_uses_factor), with its refresh rule, and its solve on the device.
   std::unique_ptr<FactorisedPreconditioner> factor_;
   std::unique_ptr<VulkanFactorSolve> factor_solve_;
@@ -202,7 +200,6 @@ class VulkanEnsemble : public DeviceEnsemble {
   VkDescriptorSet s_cg_start_partials_ = VK_NULL_HANDLE, s_cg_start_scalars_ = VK_NULL_HANDLE;
   VkDescriptorSet s_cg_dot_ = VK_NULL_HANDLE, s_cg_update_ = VK_NULL_HANDLE;
   VkDescriptorSet s_cg_direction_ = VK_NULL_HANDLE, s_cg_node_iteration_ = VK_NULL_HANDLE;
-  VkDescriptorSet s_cg_factor_start_ = VK_NULL_HANDLE, s_cg_factor_direction_ = VK_NULL_HANDLE;
   VkDescriptorSet s_cg_preconditioned_ = VK_NULL_HANDLE;
 };
 

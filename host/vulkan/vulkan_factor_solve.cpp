@@ -22,10 +22,9 @@ std::size_t padded(std::size_t m) { return (m + 3) / 4 * 4; }
 }  // namespace
 
 VulkanFactorSolve::VulkanFactorSolve(VulkanDevice& device, int rows, int spring_rows, int sigma_count,
-                                     const VulkanBuffer& r, const VulkanBuffer& z, const VulkanBuffer& active,
-                                     long long loop_turns)
+                                     const CgBuffers& cg, long long loop_turns)
     : device_(device), rows_(rows), S_(sigma_count), spring_rows_(spring_rows), loop_turns_(loop_turns),
-      r_(r), z_(z), active_(active) {
+      cg_(cg) {
   const std::size_t n = static_cast<std::size_t>(rows), real = device_.real_size();
   const std::size_t m = static_cast<std::size_t>(spring_rows_);
   spring_at_ = make(4 * (2 + n));
@@ -64,9 +63,9 @@ void VulkanFactorSolve::make_layout(const Eigen::SparseMatrix<double>& L, const 
   const FactorBlocks& b = *layout->blocks;
   const std::size_t P = static_cast<std::size_t>(b.panels()), B = std::max<std::size_t>(b.blocks(), 1);
   const std::size_t vec4 = 4 * device_.real_size();
-  // y's 4 P slots, then V^T y and H V^T y (factor_solve.comp), S times, a copy per lane of a
-  // sigma point.
-  const std::size_t work_texels = P + 2 * padded(static_cast<std::size_t>(spring_rows_)) / 4;
+  // y's 4 P slots, then V^T y and H V^T y, then r.z between dispatches (factor_solve.comp), S
+  // times, a copy per lane of a sigma point.
+  const std::size_t work_texels = P + 2 * padded(static_cast<std::size_t>(spring_rows_)) / 4 + 1;
   layout->forward_starts = make(4 * (P + 1));
   layout->forward_panel = make(4 * B);
   layout->backward_starts = make(4 * (P + 1));
@@ -82,11 +81,12 @@ void VulkanFactorSolve::make_layout(const Eigen::SparseMatrix<double>& L, const 
   upload_ints(layout->backward_panel, b.backward_panel());
   upload_ints(layout->slot_rows, b.slot_rows());
   const char* name = split_ > 1 ? "factor_solve_split" : shared_ ? "factor_solve_shared" : "factor_solve";
-  layout->kernel = device_.kernel(name, SF_FACTOR_SOLVE_WORK_STORES + 1, {group_, static_cast<std::uint32_t>(P)});
+  layout->kernel = device_.kernel(name, SF_FACTOR_SOLVE_BINDINGS, {group_, static_cast<std::uint32_t>(P)});
   const Layout& l = *layout;
   layout->set = device_.bind(l.kernel, {l.forward_starts, l.forward_panel, l.backward_starts, l.backward_panel,
-                                        l.slot_rows, r_, z_, active_, spring_at_, spring_solves_, spring_coupling_,
-                                        l.triangles, l.forward_blocks, l.backward_blocks, l.work, l.work});
+                                        l.slot_rows, cg_.r, cg_.z, cg_.active, spring_at_, spring_solves_,
+                                        spring_coupling_, l.triangles, l.forward_blocks, l.backward_blocks, l.work,
+                                        l.work, cg_.d, cg_.rz});
   layout_ = std::move(layout);
 }
 
@@ -164,7 +164,7 @@ void VulkanFactorSolve::upload_diagonal(const Eigen::SparseMatrix<double>& A) {
 
 void VulkanFactorSolve::plan_dispatches() {
   // The steps of factor_solve.comp (the forward block rows, the correction's 2m + u, the
-  // backward block columns from the last) cut into ranges of at most loop_turns_ turns.
+  // backward block columns from the last, CG's d) cut into ranges of at most loop_turns_ turns.
   ranges_.clear();
   const FactorBlocks& b = *layout_->blocks;
   const auto [m, reached] = spring_steps_;
@@ -179,6 +179,10 @@ void VulkanFactorSolve::plan_dispatches() {
   turns.insert(turns.end(), static_cast<std::size_t>(reached), quads + 2);   // y -= V H V^T y, a slot
   for (int p = b.panels() - 1; p >= 0; --p)
     turns.push_back(block_turns(b.backward_starts()[p + 1] - b.backward_starts()[p]));
+  // CG's d after them, SF_FACTOR_FINISH_QUADS of y's quads a step (a lane's share).
+  const int finish_quads = static_cast<int>(SF_FACTOR_FINISH_QUADS);
+  turns.insert(turns.end(), static_cast<std::size_t>((b.panels() + finish_quads - 1) / finish_quads),
+               (finish_quads + split_ - 1) / split_ + kStepTurns);
   long long sum = 0;
   std::uint32_t first = 0;
   for (std::size_t step = 0; step < turns.size(); ++step) {
@@ -196,9 +200,10 @@ void VulkanFactorSolve::plan_dispatches() {
   ranges_.emplace_back(first, static_cast<std::uint32_t>(turns.size()));
 }
 
-void VulkanFactorSolve::record(VkCommandBuffer cmd) const {
-  VulkanPushConstants push;   // S, the first step, one past the last (factor_solve.comp)
+void VulkanFactorSolve::record(VkCommandBuffer cmd, std::uint32_t finish) const {
+  VulkanPushConstants push;   // S, the first step, one past the last, the finish (factor_solve.comp)
   push.S = static_cast<std::uint32_t>(S_);
+  push.max_iterations = static_cast<std::int32_t>(finish);
   for (const auto& [first, last] : ranges_) {
     push.count = first;
     push.p = last;

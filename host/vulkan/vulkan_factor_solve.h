@@ -16,6 +16,7 @@
 #include <utility>
 #include <vector>
 
+#include "device_layout.h"
 #include "host/reference/factor_blocks.h"
 #include "host/reference/factorised_preconditioner.h"
 #include "host/reference/spring_correction.h"
@@ -39,12 +40,17 @@ class VulkanFactorSolve {
   static bool shares_blocks(const VulkanDeviceInfo& info, int sigma_count);
   bool shared() const { return shared_; }
 
+  // CG's buffers the solve reads and writes: r, z, d ([row S + s]), the active flags and r.z
+  // (S each).
+  struct CgBuffers {
+    VulkanBuffer r, z, d, active, rz;
+  };
   // For a factor of n rows and `sigma_count` sigma points, with a correction for each one's
-  // springs at `spring_rows` rows (m; 0: none); r, z and the active flags are CG's buffers,
-  // [row S + s]. `loop_turns`: the most a dispatch may turn (DeviceOptions). The factor's
-  // buffers are made at the first upload of its pattern (their size is its blocks').
-  VulkanFactorSolve(VulkanDevice& device, int rows, int spring_rows, int sigma_count, const VulkanBuffer& r,
-                    const VulkanBuffer& z, const VulkanBuffer& active, long long loop_turns);
+  // springs at `spring_rows` rows (m; 0: none). `loop_turns`: the most a dispatch may turn
+  // (DeviceOptions). The factor's buffers are made at the first upload of its pattern (their
+  // size is its blocks').
+  VulkanFactorSolve(VulkanDevice& device, int rows, int spring_rows, int sigma_count, const CgBuffers& cg,
+                    long long loop_turns);
 
   // Sends a fresh factorisation (factor.ready(); after the first only the values go while
   // L's pattern stays, else the blocks' buffers are made anew), uncorrected until
@@ -63,9 +69,10 @@ class VulkanFactorSolve {
   // Whether a factor (or the stand-in) is on the device.
   bool ready() const { return layout_ != nullptr; }
 
-  // Records z = M^-1 r for the sigma points still iterating: the dispatches, each followed
-  // by a barrier. Needs ready().
-  void record(VkCommandBuffer cmd) const;
+  // Records z = M^-1 r for the sigma points still iterating, and after it `finish`
+  // (SF_FACTOR_FINISH_*, device_layout.h: CG's r.z and d at the start or in an iteration):
+  // the dispatches, each followed by a barrier. Needs ready().
+  void record(VkCommandBuffer cmd, std::uint32_t finish = SF_FACTOR_FINISH_NONE) const;
   // Dispatches a solve takes with the pattern on the device.
   int dispatches() const { return static_cast<int>(ranges_.size()); }
   // Bytes of device memory the factor's buffers hold (they grow at an upload of a new pattern).
@@ -100,7 +107,8 @@ class VulkanFactorSolve {
   int rows_ = 0, S_ = 0, spring_rows_ = 0;
   long long loop_turns_ = 0;
   std::size_t bytes_ = 0;
-  VulkanBuffer r_, z_, active_, spring_at_, spring_solves_, spring_coupling_;
+  CgBuffers cg_;
+  VulkanBuffer spring_at_, spring_solves_, spring_coupling_;
   std::unique_ptr<Layout> layout_;
   // The correction's m and reached slots, and the dispatches: ranges [first, last) of the
   // steps (factor_solve.comp).

@@ -25,7 +25,7 @@
   }
 
 /* The same without z and d, where a factor forms them after the start (OpenCL's SF_FACTOR,
- * Vulkan's factor_solve and cg_factor_start): r = b - q; b.b, r.r. */
+ * Vulkan's factor_solve): r = b - q; b.b, r.r. */
 #define SF_CG_START_R_ROW(at, q_value, b_, r_, sum_bb, sum_rr) \
   {                                                            \
     SF_REAL bi_ = SF_LOAD(b_, at);                             \

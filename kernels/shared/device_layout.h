@@ -169,7 +169,8 @@
  * point's springs (host/reference/spring_correction.h): [m, reached slots u, the slots], V
  * there by rows and each sigma point's m x m H; the panels' triangles, the blocks' values by
  * rows and by columns, and the work vector y (bound twice: read as texels, written as a storage
- * buffer, where llvmpipe stores a texel several times slower: factor_solve.comp). */
+ * buffer, where llvmpipe stores a texel several times slower: factor_solve.comp); CG's d and
+ * r.z, which it finishes (push constant max_iterations: SF_FACTOR_FINISH_*). */
 #define SF_FACTOR_SOLVE_FORWARD_STARTS 0
 #define SF_FACTOR_SOLVE_FORWARD_PANEL 1
 #define SF_FACTOR_SOLVE_BACKWARD_STARTS 2
@@ -186,6 +187,16 @@
 #define SF_FACTOR_SOLVE_BACKWARD_BLOCKS 13
 #define SF_FACTOR_SOLVE_WORK 14
 #define SF_FACTOR_SOLVE_WORK_STORES 15
+#define SF_FACTOR_SOLVE_D 16
+#define SF_FACTOR_SOLVE_RZ 17
+#define SF_FACTOR_SOLVE_BINDINGS 18
+/* What factor_solve does after z = M^-1 r: nothing (z alone), CG's start (r.z, d = z) or an
+ * iteration's direction (r.z, beta = r.z / the last r.z, d = z + beta d). */
+#define SF_FACTOR_FINISH_NONE 0u
+#define SF_FACTOR_FINISH_START 1u
+#define SF_FACTOR_FINISH_DIRECTION 2u
+/* y's quads a step of that d takes (a step's loop turns: factor_solve.comp) */
+#define SF_FACTOR_FINISH_QUADS 64u
 /* Vulkan's multigrid shaders (mg_smooth, mg_residual, mg_product: the V-cycle of
  * host/reference/nested_multigrid.h; host/vulkan/vulkan_multigrid.h): a level's matrix in CSR,
  * its diagonal, its Chebyshev steps, the finest level's shifts, the input vector (b, or x of a

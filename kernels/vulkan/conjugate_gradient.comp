@@ -14,12 +14,11 @@
  *
  * With a factor as the preconditioner (one partition; host/vulkan/vulkan_factor_solve.h),
  * factor_solve.comp forms z = M^-1 r after the start and after each iteration's update, and
- * these finish what Jacobi's z lets the shaders above do at once:
+ * r.z and the direction after it (its SF_FACTOR_FINISH_*), where Jacobi's z lets the shaders
+ * above do them at once; these stop before:
  *   -DSF_ENTRY_CG_ITERATION_FACTOR, -DSF_ENTRY_CG_NODE_ITERATION_FACTOR  cg_iteration and
  *                            cg_node_iteration up to the stop test: no r.z, no new direction
  *   -DSF_ENTRY_CG_START_FACTOR      cg_start_factor: cg_start's r = b - A x and sums, no z or d
- *   -DSF_ENTRY_CG_FACTOR_START      cg_factor_start: r.z and d = z after the warm start's solve
- *   -DSF_ENTRY_CG_FACTOR_DIRECTION  cg_factor_direction: r.z, beta and d = z + beta d
  *
  * With the multigrid V-cycle as the preconditioner (multigrid.comp; host/vulkan/vulkan_multigrid.h),
  * CG runs in the partitions' shaders (with P = 1 on a small mesh) and the V-cycle writes z over
@@ -189,7 +188,7 @@ void sf_start_rows(uint s, uint S, uint begin, uint end, out real sum_bb, out re
     for (uint k = 0u; k < 3u; ++k) {
       uint row = (3u * n + k) * S + s;
       real q = SF_SYSTEM_ROW(c, s, S, Kd[k], spring, m, SF_LOAD(x, row));
-#  if defined(SF_FACTOR) /* z, d and r.z are factor_solve's and cg_factor_start's */
+#  if defined(SF_FACTOR) /* z, d and r.z are factor_solve's */
       SF_CG_START_R_ROW(row, q, b, r, sum_bb, sum_rr)
 #  else
       SF_CG_START_ROW(row, q, b, inverse_diagonal, r, z, d, sum_bb, sum_rr, sum_rz)
@@ -360,7 +359,7 @@ bool sf_stop(bool done, real sum_rr, int count) {
 }
 
 /* Sigma point s's scalars after an iteration (read by the host and the other shaders); r.z
- * with the factor is cg_factor_direction's. */
+ * with the factor is factor_solve's. */
 void sf_store_scalars(uint s, int count, real sum_rr, real sum_rz, bool done, bool stop) {
   iterations[s] = count;
   rr[s] = sum_rr;
@@ -387,39 +386,10 @@ void main() {
   bool stop = sf_stop(done, sum_rr, count);
   sf_scalars_read();
   if (sf_leads()) sf_store_scalars(s, count, sum_rr, sum_rz, done, stop);
-#    if !defined(SF_FACTOR) /* else factor_solve's z, then cg_factor_direction */
+#    if !defined(SF_FACTOR) /* else factor_solve's z, r.z and direction */
   if (stop) return;
   sf_direction_rows(s, S, 0u, sf_push.count, sum_rz / rz_old);
 #    endif
-}
-
-#  elif defined(SF_ENTRY_CG_FACTOR_START) || defined(SF_ENTRY_CG_FACTOR_DIRECTION)
-/* After factor_solve's z = M^-1 r: r.z, and d = z (the start) or d = z + beta d with
- * beta = r.z / the last r.z. */
-void main() {
-  uint S = sf_push.S;
-  uint s = sf_sigma_point();
-  if (s >= S || active_flags[s] == 0u) return; /* the same for the whole group */
-#    if defined(SF_ENTRY_CG_FACTOR_DIRECTION)
-  real rz_old = rz[s];   /* before the lead's lane may write it */
-#    endif
-  real sum_rz = real(0);
-  for (uint row = sf_first_row(); row < 3u * sf_push.count; row += sf_row_step())
-    sum_rz += r[row * S + s] * z[row * S + s];
-  sum_rz = sf_group_sum(sum_rz);
-#    if defined(SF_ENTRY_CG_FACTOR_DIRECTION)
-  real beta = sum_rz / rz_old;
-  sf_scalars_read();
-#    endif
-  if (sf_leads()) rz[s] = sum_rz;
-  for (uint row = sf_first_row(); row < 3u * sf_push.count; row += sf_row_step()) {
-    uint at = row * S + s;
-#    if defined(SF_ENTRY_CG_FACTOR_START)
-    d[at] = z[at];
-#    else
-    d[at] = z[at] + beta * d[at];
-#    endif
-  }
 }
 
 #  elif defined(SF_ENTRY_CG_PRECONDITIONED)

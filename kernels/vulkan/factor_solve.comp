@@ -26,8 +26,16 @@
  *   [P, P + M/4)                    V^T y, 4 of its m at a time, a sum over the u slots each
  *   [P + M/4, P + M/4 + m)          H_s V^T y, a sum over m each
  *   [P + M/4 + m, ... + u)          y -= V H_s V^T y at one reached slot each, M/4 turns
- *   [P + M/4 + m + u, 2P + ... + u) the backward block columns, from the last.
+ *   [P + M/4 + m + u, 2P + ... + u) the backward block columns, from the last
+ *   [2P + M/4 + m + u, ...)          CG's d (below), SF_FACTOR_FINISH_QUADS of y's quads each.
  * An inactive sigma point (CG done) is left alone.
+ *
+ * CG's own step after z (push constant max_iterations, SF_FACTOR_FINISH_*; none for z alone):
+ * r.z is summed as the backward substitution stores each panel's z (kept in y's quad
+ * P + 2 M / 4 between dispatches, with beta = r.z / the last r.z after the last), r.z stored,
+ * and the last steps form d = z (the start) or d = z + beta d (an iteration) from y's slots,
+ * which hold z: the lanes own their sigma points, so that this needs no dispatch of its own
+ * (what conjugate_gradient.comp's cg_factor_start and cg_factor_direction did until stop 59).
  *
  * In float32, y and the blocks are rgba32f storage texel buffers and V an rgba32f uniform
  * texel buffer: llvmpipe loads a storage buffer at lane-varying addresses one lane at a time,
@@ -56,6 +64,8 @@ layout(std430, binding = SF_FACTOR_SOLVE_Z) restrict writeonly buffer Z { real z
 SF_READ_UINTS(SF_FACTOR_SOLVE_ACTIVE, active_flags)
 SF_READ_INTS(SF_FACTOR_SOLVE_SPRING_AT, spring_at)
 SF_READ_REALS(SF_FACTOR_SOLVE_SPRING_COUPLING, spring_coupling)
+layout(std430, binding = SF_FACTOR_SOLVE_D) restrict buffer D { real d[]; };
+layout(std430, binding = SF_FACTOR_SOLVE_RZ) restrict buffer RZ { real rz[]; };
 #if defined(SF_USE_DOUBLE)
 #  define real4 dvec4
 layout(std430, binding = SF_FACTOR_SOLVE_TRIANGLES) restrict readonly buffer Triangles { dvec4 triangles[]; };
@@ -170,6 +180,7 @@ void main() {
   if (s >= S || SF_LOAD(active_flags, s) == 0u) return;
 #endif
   uint P = SF_FACTOR_PANELS;
+  uint finish = uint(sf_push.max_iterations);
   uint m = uint(SF_LOAD(spring_at, 0)), reached = uint(SF_LOAD(spring_at, 1));
   uint quads = (m + 3u) / 4u;   /* M / 4 */
   uint projected = P, coupled = P + quads, updated = P + quads + m, backward = P + quads + m + reached;
@@ -238,8 +249,13 @@ void main() {
     for (uint i = h; i < quads; i += H) sum += dot(SF_V4(u * quads + i), SF_Y4(y_quad(P + quads + i)));
     set_y_at(at, y_at(at) - add_parts(sum));
   }
-  for (uint step = max(first, backward); step < last; ++step) { /* L^T w = y: block column p */
-    uint p = backward + P - 1u - step;
+  /* r.z so far, kept in y's quad P + 2 M / 4 between dispatches (then r.z, beta). */
+  uint rz_quad = P + 2u * quads;
+  uint finishing = backward + P;   /* the steps of CG's d, SF_FACTOR_FINISH_QUADS of y's quads each */
+  bool finishes = finish != SF_FACTOR_FINISH_NONE;
+  real sum_rz = finishes && first > backward ? SF_Y4(y_quad(rz_quad)).x : real(0);
+  for (uint step = max(first, backward); step < min(last, finishing); ++step) { /* L^T w = y: block column p */
+    uint p = finishing - 1u - step;
     real4 a = h == 0u ? SF_Y4(y_quad(p)) : real4(0);   /* y_p once */
     int end = SF_LOAD(backward_starts, p + 1u);
 #if defined(SF_SHARED_BLOCKS)
@@ -273,7 +289,37 @@ void main() {
     SF_SET_Y4(y_quad(p), wp);
     for (uint c = 0u; c < 4u; ++c) {
       int row = SF_LOAD(slot_rows, 4u * p + c);
-      if (row >= 0 && h == 0u && writes) z[uint(row) * S + s] = wp[c];
+      if (row < 0) continue;
+      if (h == 0u && writes) z[uint(row) * S + s] = wp[c];
+      if (finishes) sum_rz += SF_LOAD(r, uint(row) * S + s) * wp[c];
+    }
+  }
+  if (!finishes) return;
+  if (first < finishing && last > backward) {   /* backward steps ran here: keep r.z, or end it */
+    real beta = real(0);
+    if (last >= finishing) {   /* the last: r.z (lane 0 of the sigma point's H reads and writes it) */
+      if (finish == SF_FACTOR_FINISH_DIRECTION && h == 0u) beta = sum_rz / rz[s];
+#if defined(SF_SPLIT_BLOCK_ROWS)
+      beta = subgroupShuffle(beta, s);   /* lane 0 of sigma point s's H is lane s */
+#endif
+      if (h == 0u && writes) rz[s] = sum_rz;
+    }
+    SF_SET_Y4(y_quad(rz_quad), real4(sum_rz, beta, 0, 0));
+  }
+  /* CG's d = z (the start) or z + beta d over y's slots, which hold z: a lane's share of a
+   * step's quads (the H lanes of a sigma point hold the same y). */
+  for (uint step = max(first, finishing); step < last; ++step) {
+    real beta = SF_Y4(y_quad(rz_quad)).y;
+    uint begin = (step - finishing) * SF_FACTOR_FINISH_QUADS;
+    uint end = min(P, begin + SF_FACTOR_FINISH_QUADS);
+    for (uint t = begin + h; t < end; t += H) {
+      real4 w = SF_Y4(y_quad(t));
+      for (uint c = 0u; c < 4u; ++c) {   /* constant bounds: unrolled */
+        int row = SF_LOAD(slot_rows, 4u * t + c);
+        if (row < 0 || !writes) continue;
+        uint at = uint(row) * S + s;
+        d[at] = finish == SF_FACTOR_FINISH_START ? w[c] : w[c] + beta * d[at];
+      }
     }
   }
 }

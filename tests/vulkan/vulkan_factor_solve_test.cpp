@@ -23,7 +23,8 @@ namespace sigmafem {
 namespace {
 
 // A device with CG's buffers for a solve of S sigma points in Real (float or double): r
-// uploaded, z, and the active flags (every sigma point iterating but `inactive`).
+// uploaded, z, the active flags (every sigma point iterating but `inactive`), and CG's d and
+// r.z, which the solve may finish (d_before and rz_before uploaded).
 template <typename Real>
 struct SolveBuffers {
   SolveBuffers(const std::vector<Real>& r, int S, int inactive, bool texel_reads)
@@ -31,22 +32,33 @@ struct SolveBuffers {
         bytes(r.size() * sizeof(Real)),
         r_buffer(device.buffer(bytes, "r")),
         z_buffer(device.buffer(bytes, "z")),
-        active(device.buffer(4 * static_cast<std::size_t>(S), "active")) {
+        active(device.buffer(4 * static_cast<std::size_t>(S), "active")),
+        d_buffer(device.buffer(bytes, "d")),
+        rz_buffer(device.buffer(sizeof(Real) * static_cast<std::size_t>(S), "rz")),
+        d_before(r.size()),
+        rz_before(static_cast<std::size_t>(S)) {
     device.set_texel_reads(texel_reads);
     std::vector<std::uint32_t> flags(static_cast<std::size_t>(S), 1u);
     if (inactive >= 0) flags[static_cast<std::size_t>(inactive)] = 0u;
     device.upload(r_buffer, r.data(), bytes);
     device.upload(active, flags.data(), 4 * flags.size());
+    for (std::size_t i = 0; i < d_before.size(); ++i) d_before[i] = static_cast<Real>(std::cos(0.21 * static_cast<double>(i)));
+    for (int s = 0; s < S; ++s) rz_before[static_cast<std::size_t>(s)] = static_cast<Real>(1 + s);
+    device.upload(d_buffer, d_before.data(), bytes);
+    device.upload(rz_buffer, rz_before.data(), sizeof(Real) * rz_before.size());
   }
-  // z after the solve recorded.
-  std::vector<Real> z() {
-    std::vector<Real> values(bytes / sizeof(Real));
-    device.download(z_buffer, values.data(), bytes);
+  std::vector<Real> read(const VulkanBuffer& buffer, std::size_t count) {
+    std::vector<Real> values(count);
+    device.download(buffer, values.data(), count * sizeof(Real));
     return values;
   }
+  // z after the solve recorded.
+  std::vector<Real> z() { return read(z_buffer, bytes / sizeof(Real)); }
+  VulkanFactorSolve::CgBuffers cg() const { return {r_buffer, z_buffer, d_buffer, active, rz_buffer}; }
   VulkanDevice device;
   std::size_t bytes;
-  VulkanBuffer r_buffer, z_buffer, active;
+  VulkanBuffer r_buffer, z_buffer, active, d_buffer, rz_buffer;
+  std::vector<Real> d_before, rz_before;
 };
 
 class VulkanFactorSolveTest : public ::testing::Test {
@@ -102,16 +114,18 @@ class VulkanFactorSolveTest : public ::testing::Test {
   // z of S sigma points ([row S + s]) for r, on device 0 in float32, with sigma point
   // `inactive` left alone (its z stays at `untouched`).
   // With `springs`, each sigma point's correction for spring_delta(s).
+  // With `finish` (SF_FACTOR_FINISH_*), CG's d and r.z after it in *d and *rz.
   std::vector<float> device_solve(const std::vector<float>& r, int S, int inactive, bool texel_reads,
                                   long long loop_turns, bool diagonal, int* dispatches = nullptr,
-                                  bool springs = false, int* split = nullptr, bool* shared = nullptr) {
+                                  bool springs = false, int* split = nullptr, bool* shared = nullptr,
+                                  std::uint32_t finish = SF_FACTOR_FINISH_NONE, std::vector<float>* d = nullptr,
+                                  std::vector<float>* rz = nullptr) {
     SolveBuffers<float> buffers(r, S, inactive, texel_reads);
     VulkanDevice& device = buffers.device;
     const std::vector<float> sentinel(r.size(), untouched);
     device.upload(buffers.z_buffer, sentinel.data(), buffers.bytes);
     SpringCorrection correction(springs ? spring_rows_ : std::vector<int>{});
-    VulkanFactorSolve solve(device, n_, correction.size(), S, buffers.r_buffer, buffers.z_buffer,
-                            buffers.active, loop_turns);
+    VulkanFactorSolve solve(device, n_, correction.size(), S, buffers.cg(), loop_turns);
     if (diagonal)
       solve.upload_diagonal(A_);
     else
@@ -129,8 +143,10 @@ class VulkanFactorSolveTest : public ::testing::Test {
       solve.record_couplings(cmd, couplings_);
       device.barrier(cmd);
     }
-    solve.record(cmd);
+    solve.record(cmd, finish);
     device.submit_and_wait(cmd);
+    if (d) *d = buffers.read(buffers.d_buffer, r.size());
+    if (rz) *rz = buffers.read(buffers.rz_buffer, static_cast<std::size_t>(S));
     return buffers.z();
   }
 
@@ -238,6 +254,60 @@ TEST(VulkanFactorSolveShared, GroupsOfEightReadTheBlocksTogetherWhereNoSplitIs) 
   EXPECT_FALSE(VulkanFactorSolve::shares_blocks(info, 16));
 }
 
+// The solve finishing CG's step (SF_FACTOR_FINISH_*): at the start r.z and d = z, in an
+// iteration r.z, beta = r.z / the last r.z and d = z + beta d, against the host's sums of the
+// device's z; the same bits however the solve is cut (the partial r.z kept between dispatches:
+// 150 turns cut the box's solve into tens, 3000 with its springs' correction, which needs a
+// dispatch of m + 5); an inactive sigma point's d and r.z untouched. S = 11 (the shared reads on
+// lavapipe), 4 (the split), 3; without a finish d and r.z stay as they were.
+TEST_F(VulkanFactorSolveTest, ItFinishesCgsStartAndDirection) {
+  for (const int S : {11, 4, 3})
+  for (const bool springs : {false, true}) {
+    const int inactive = S / 2;
+    const std::vector<float> r = residuals(S);
+    const std::size_t size = r.size();
+    for (const std::uint32_t finish : {SF_FACTOR_FINISH_NONE, SF_FACTOR_FINISH_START, SF_FACTOR_FINISH_DIRECTION}) {
+      SCOPED_TRACE("S = " + std::to_string(S) + (springs ? ", springs" : "") + ", finish " + std::to_string(finish));
+      std::vector<float> d_cut, rz_cut, d, rz;
+      int many = 0;
+      const std::vector<float> z_cut = device_solve(r, S, inactive, true, springs ? 3000 : 150, false, &many, springs,
+                                                    nullptr, nullptr, finish, &d_cut, &rz_cut);
+      const std::vector<float> z = device_solve(r, S, inactive, true, kFactorLoopTurns, false, nullptr, springs,
+                                                nullptr, nullptr, finish, &d, &rz);
+      EXPECT_GT(many, 2);
+      EXPECT_EQ(0, std::memcmp(z_cut.data(), z.data(), size * sizeof(float)));
+      EXPECT_EQ(0, std::memcmp(d_cut.data(), d.data(), size * sizeof(float)));
+      EXPECT_EQ(0, std::memcmp(rz_cut.data(), rz.data(), static_cast<std::size_t>(S) * sizeof(float)));
+      for (int s = 0; s < S; ++s) {
+        const float rz_before = static_cast<float>(1 + s);
+        double sum = 0.0;
+        for (int i = 0; i < n_; ++i) {
+          const std::size_t at = static_cast<std::size_t>(i) * S + s;
+          sum += static_cast<double>(r[at]) * z[at];
+        }
+        const bool untouched_here = finish == SF_FACTOR_FINISH_NONE || s == inactive;
+        if (untouched_here) {
+          EXPECT_EQ(rz[static_cast<std::size_t>(s)], rz_before) << "sigma point " << s;
+        } else {
+          EXPECT_NEAR(rz[static_cast<std::size_t>(s)], sum, 1e-5 * std::abs(sum)) << "sigma point " << s;
+        }
+        const double beta = static_cast<double>(rz[static_cast<std::size_t>(s)]) / rz_before;
+        for (int i = 0; i < n_; ++i) {
+          const std::size_t at = static_cast<std::size_t>(i) * S + s;
+          const float d_before = static_cast<float>(std::cos(0.21 * static_cast<double>(at)));
+          if (untouched_here)
+            ASSERT_EQ(d[at], d_before) << "sigma point " << s << ", row " << i;
+          else if (finish == SF_FACTOR_FINISH_START)
+            ASSERT_EQ(d[at], z[at]) << "sigma point " << s << ", row " << i;
+          else
+            ASSERT_NEAR(d[at], z[at] + beta * d_before, 1e-5 * (std::abs(z[at]) + std::abs(beta * d_before)))
+                << "sigma point " << s << ", row " << i;
+        }
+      }
+    }
+  }
+}
+
 // With each sigma point's springs corrected between the substitutions (SpringCorrection): the
 // solve with its own system A + E Delta_s E^T, against Eigen's LDL^T of that system in double,
 // in 1000-turn dispatches and in the default's few (the same bits); on the box (about 35
@@ -286,8 +356,7 @@ TEST_F(VulkanFactorSolveTest, InFloat64EachSigmaPointsOwnSystemToItsRounding) {
     SolveBuffers<double> buffers(r, S, -1, true);
     VulkanDevice& device = buffers.device;
     SpringCorrection correction(spring_rows_);
-    VulkanFactorSolve solve(device, n_, correction.size(), S, buffers.r_buffer, buffers.z_buffer,
-                            buffers.active, kFactorLoopTurns);
+    VulkanFactorSolve solve(device, n_, correction.size(), S, buffers.cg(), kFactorLoopTurns);
     solve.upload(factor_);
     correction.prepare(factor_);
     ASSERT_TRUE(solve.upload_springs(correction));
@@ -316,7 +385,7 @@ TEST_F(VulkanFactorSolveTest, AFactorAfterTheStandInSolvesAsAFreshOne) {
   const std::vector<float> fresh = device_solve(r, S, -1, true, kFactorLoopTurns, false);
   SolveBuffers<float> buffers(r, S, -1, true);
   VulkanDevice& device = buffers.device;
-  VulkanFactorSolve solve(device, n_, 0, S, buffers.r_buffer, buffers.z_buffer, buffers.active, kFactorLoopTurns);
+  VulkanFactorSolve solve(device, n_, 0, S, buffers.cg(), kFactorLoopTurns);
   solve.upload_diagonal(A_);
   const std::size_t stand_in_bytes = solve.bytes();
   std::size_t factor_bytes = 0;
