@@ -99,9 +99,9 @@ struct DeviceOptions {
   // blocks is one; host/reference/factor_blocks.h), below llvmpipe's limit; tests make it small
   // to cut a solve into many.
   long long factor_loop_turns = kFactorLoopTurns;
-  // Vulkan with one CG partition: the most loop turns of one invocation of the CG shaders, whose
-  // lanes walk their sigma point's nodes (cg_loop_turns, host/vulkan/vulkan_ensemble.h): where
-  // the lanes over sigma points would turn more, a work-group a sigma point, grown until its
+  // Vulkan: the most loop turns of one invocation of the CG shaders, whose lanes walk their
+  // sigma point's nodes (cg_loop_turns, host/vulkan/vulkan_ensemble.h): where the lanes over
+  // sigma points would turn more, a work-group a sigma point (or partition), grown until its
   // lanes turn less; tests make it small.
   long long cg_loop_turns = kShaderLoopTurns;
   // Vulkan on lavapipe: below this many element-sigma pairs (elements x S) its shaders run on

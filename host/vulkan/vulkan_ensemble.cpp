@@ -42,7 +42,7 @@ int cg_lane_rows(int lanes_from, int sigma_count, const VulkanDeviceInfo& info, 
   return rows;
 }
 
-long long cg_loop_turns(const Model& model, int row_step) {
+long long cg_loop_turns(const Model& model, int row_step, int partitions) {
   const int nodes = model.node_count();
   std::vector<long long> turns(static_cast<std::size_t>(nodes), kCgNodeTurns);
   for (const ElementRest& element : model.elements)
@@ -50,10 +50,17 @@ long long cg_loop_turns(const Model& model, int row_step) {
   for (const SpringSet& ligament : model.ligaments)
     for (const int n : ligament.nodes) ++turns[static_cast<std::size_t>(n)];
   const int step = std::max(1, row_step);
-  long long total = 0;
-  for (int first = 0; first < nodes; first += step)
-    total += *std::max_element(turns.begin() + first, turns.begin() + std::min(nodes, first + step));
-  return total;
+  // Partition p's nodes as conjugate_gradient.comp's sf_partition_nodes cuts them.
+  const int size = (nodes + std::max(1, partitions) - 1) / std::max(1, partitions);
+  long long busiest = 0;
+  for (int begin = 0; begin < nodes; begin += size) {
+    const int end = std::min(nodes, begin + size);
+    long long total = 0;
+    for (int first = begin; first < end; first += step)
+      total += *std::max_element(turns.begin() + first, turns.begin() + std::min(end, first + step));
+    busiest = std::max(busiest, total);
+  }
+  return busiest;
 }
 
 VulkanEnsemble::VulkanEnsemble(const Model& model, EstimatedParameters estimated,
@@ -112,18 +119,17 @@ VulkanEnsemble::VulkanEnsemble(const Model& model, EstimatedParameters estimated
   }
   cg_lane_rows_ = sigmafem::cg_lane_rows(options.cg_sigma_lanes_from, S_, info, !cg_partitioned_, factor_ != nullptr);
   // Within llvmpipe's loop turns (cg_loop_turns): lanes over sigma points give way to a group a
-  // sigma point, which grows until its lanes' share of the nodes fits (128 invocations a group,
-  // Vulkan's least maximum, at most).
-  if (!cg_partitioned_) {
-    if (cg_lane_rows_ > 0 && cg_loop_turns(model_, cg_lane_rows_) > options.cg_loop_turns) cg_lane_rows_ = 0;
-    while (cg_lane_rows_ == 0 && cg_loop_turns(model_, static_cast<int>(cg_group_)) > options.cg_loop_turns) {
-      if (cg_group_ >= 128)
-        throw DeviceError("the mesh's " + std::to_string(nodes_) + " nodes are too many for Vulkan's CG with one "
-                          "work-group of 128 a sigma point on " + info.name + " (its loops would turn " +
-                          std::to_string(cg_loop_turns(model_, static_cast<int>(cg_group_))) + " times; at most " +
-                          std::to_string(options.cg_loop_turns) + ")");
-      cg_group_ *= 2;
-    }
+  // sigma point (or a partition), which grows until its lanes' share of the nodes fits (128
+  // invocations a group, Vulkan's least maximum, at most).
+  if (cg_lane_rows_ > 0 && cg_loop_turns(model_, cg_lane_rows_) > options.cg_loop_turns) cg_lane_rows_ = 0;
+  auto group_turns = [&] { return cg_loop_turns(model_, static_cast<int>(cg_group_), cg_partitions_); };
+  while (cg_lane_rows_ == 0 && group_turns() > options.cg_loop_turns) {
+    if (cg_group_ >= 128)
+      throw DeviceError("the mesh's " + std::to_string(nodes_) + " nodes are too many for Vulkan's CG with " +
+                        std::to_string(cg_partitions_) + " work-group(s) of 128 a sigma point on " + info.name +
+                        " (its loops would turn " + std::to_string(group_turns()) + " times; at most " +
+                        std::to_string(options.cg_loop_turns) + ")");
+    cg_group_ *= 2;
   }
 
   // The partitions' buffers are bound but unused with one partition; Jacobi's diagonals with

@@ -62,8 +62,9 @@ bool vulkan_uses_multigrid(Preconditioner preconditioner, const std::string& dev
 // subgroup shuffles at S <= 4, 8 / S rounded down to a power of 2 (2 at S = 3-4, 4 at 2, 8 at 1);
 // else 0, a work-group a sigma point.
 int cg_lane_rows(int lanes_from, int sigma_count, const VulkanDeviceInfo& info, bool one_partition, bool factor);
-// The loop turns of the one-partition CG shaders' busiest invocation when their lanes walk every
-// `row_step`-th node of a sigma point (J with lanes over sigma points, else the group size): at
+// The loop turns of the CG shaders' busiest invocation when their lanes walk every `row_step`-th
+// node of a sigma point's partition (J with lanes over sigma points, else the group size; the
+// nodes cut into `partitions` as the shaders cut them): at
 // each node cg_node_iteration, the busiest, turns once per element corner and ligament there
 // and kCgNodeTurns more (the node loops of its d.q and its update, 3 rows each), and lanes that
 // run in one vector turn together, as often as their busiest node needs (an upper bound: the
@@ -71,7 +72,7 @@ int cg_lane_rows(int lanes_from, int sigma_count, const VulkanDeviceInfo& info, 
 // 65535 turns (kShaderLoopTurns), silently: before this bound the 38k liver's CG at S = 4 (2
 // lanes a sigma point, ~115 000 turns) started from a residual with its last rows never written.
 constexpr long long kCgNodeTurns = 8;
-long long cg_loop_turns(const Model& model, int row_step);
+long long cg_loop_turns(const Model& model, int row_step, int partitions = 1);
 
 class VulkanEnsemble : public DeviceEnsemble {
  public:
@@ -94,8 +95,9 @@ class VulkanEnsemble : public DeviceEnsemble {
   // Whether the one-partition CG shaders take a sigma point a lane (conjugate_gradient.comp).
   // Rows (nodes) at once of each sigma point's lanes in them; 0: a work-group a sigma point.
   int cg_lane_rows() const { return cg_lane_rows_; }
-  // Work-items per sigma point in the CG shaders without lanes over sigma points (specialization
-  // constant 0): 8 on a CPU device, more where a mesh's nodes would turn their loops too often.
+  // Work-items per sigma point (or partition) in the CG shaders without lanes over sigma points
+  // (specialization constant 0): 8 on a CPU device, 64 on a GPU, more where a mesh's nodes would
+  // turn their loops too often.
   std::uint32_t cg_group_size() const { return cg_group_; }
   // Host waits (command-buffer submissions) of the last advance().
   int last_step_waits() const { return last_step_waits_; }

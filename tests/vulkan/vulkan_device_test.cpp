@@ -348,7 +348,8 @@ TEST(VulkanCgLanes, LanesOverSigmaPointsWhereTheyFillTheVectors) {
 // The CG shaders' loop turns (cg_loop_turns): lanes walking every node of a sigma point turn
 // each node's element corners and ligaments and kCgNodeTurns more; lanes taking nodes in steps
 // turn as the busiest node of each step needs, so fewer the longer the step, never less than
-// their share, and with one step over all the nodes the busiest node's alone.
+// their share, and with one step over all the nodes the busiest node's alone; partitions as
+// many shares, the busiest counting.
 TEST(VulkanCgLoopTurns, CountTheBusiestLanesCornersAndLigaments) {
   const Model model = make_model(load_scenario(kScenarios + "liver.json"));
   const int nodes = model.node_count();
@@ -370,6 +371,11 @@ TEST(VulkanCgLoopTurns, CountTheBusiestLanesCornersAndLigaments) {
     EXPECT_GE(turns, all / step) << "step " << step;
     last = turns;
   }
+  // Partitions: each walks its share of the nodes; the busiest partition counts.
+  EXPECT_EQ(cg_loop_turns(model, 8, 1), cg_loop_turns(model, 8));
+  EXPECT_LT(cg_loop_turns(model, 8, 2), cg_loop_turns(model, 8));
+  EXPECT_GE(cg_loop_turns(model, 8, 2), cg_loop_turns(model, 8) / 2);
+  EXPECT_EQ(cg_loop_turns(model, 1, nodes), *std::max_element(node_turns.begin(), node_turns.end()));
 }
 
 // Where the lanes over sigma points would turn their loops more than an invocation may

@@ -109,6 +109,34 @@ TEST_F(VulkanMultigridTest, TheEnsemblesCgFollowsJacobiInAFifthOfItsIterationsOr
   }
 }
 
+// The partitioned CG shaders the V-cycle runs in keep within llvmpipe's loop turns as the
+// one-group ones do (DeviceOptions::cg_loop_turns, made small here): one partition's group
+// grows to 16 lanes, with the 8-lane group's positions to float32's rounding; three partitions'
+// groups, each walking a third of the nodes, stay at 8.
+TEST_F(VulkanMultigridTest, ItsGroupsGrowToKeepWithinTheLoopTurns) {
+  const int S = kVulkanMultigridSigmaPoints;
+  const Eigen::MatrixXd theta = test::spread_log_stiffness(scenario_, model_, S, 0.5);
+  DeviceOptions options, bounded;
+  options.preconditioner = bounded.preconditioner = Preconditioner::multigrid;
+  options.cg_partitions = bounded.cg_partitions = 1;
+  bounded.cg_loop_turns = cg_loop_turns(model_, 8) - 1;
+  VulkanEnsemble eight(model_, scenario_.filter->estimate, scenario_.observations.observed, S, options);
+  VulkanEnsemble grown(model_, scenario_.filter->estimate, scenario_.observations.observed, S, bounded);
+  if (eight.cg_group_size() != 8u) GTEST_SKIP() << "not a CPU device's group of 8";
+  ASSERT_EQ(grown.cg_group_size(), 16u);
+  ASSERT_LE(cg_loop_turns(model_, 8, 3), bounded.cg_loop_turns);
+  bounded.cg_partitions = 3;
+  EXPECT_EQ(VulkanEnsemble(model_, scenario_.filter->estimate, scenario_.observations.observed, S, bounded)
+                .cg_group_size(),
+            8u);
+  long iterations_eight = 0, iterations_grown = 0;
+  const Eigen::MatrixXd a = test::run_steps(eight, scenario_, theta, 6, iterations_eight);
+  const Eigen::MatrixXd b = test::run_steps(grown, scenario_, theta, 6, iterations_grown);
+  EXPECT_GT(iterations_eight, 6 * S);
+  EXPECT_LE(std::abs(iterations_eight - iterations_grown), 6 * S);
+  EXPECT_LT((a - b).cwiseAbs().maxCoeff(), 2e-7);
+}
+
 TEST_F(VulkanMultigridTest, IsRefusedOnAMeshThatNoRefinementMade) {
   DeviceOptions options;
   options.preconditioner = Preconditioner::multigrid;
