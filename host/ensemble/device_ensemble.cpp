@@ -29,8 +29,8 @@ DeviceEnsemble::DeviceEnsemble(const Model& model, EstimatedParameters estimated
 
 void DeviceEnsemble::check_device_memory(std::size_t real_size, const std::string& name,
                                          std::size_t memory, std::size_t largest_buffer,
-                                         std::size_t factor_nonzeros) const {
-  const EnsembleMemory need = ensemble_memory(nodes_, elements_, S_, real_size, factor_nonzeros);
+                                         std::size_t factor_nonzeros, FactorStorage storage) const {
+  const EnsembleMemory need = ensemble_memory(nodes_, elements_, S_, real_size, factor_nonzeros, storage);
   if (need.largest > largest_buffer || need.total > memory)
     throw DeviceError(out_of_device_memory_message(need, elements_, S_, name, memory, largest_buffer));
 }

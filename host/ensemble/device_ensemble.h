@@ -18,6 +18,7 @@
 
 #include "host/common/device_options.h"
 #include "host/ensemble/device_buffers.h"
+#include "host/ensemble/device_limits.h"
 #include "host/ensemble/device_step_constants.h"
 #include "host/ensemble/simulation_ensemble.h"
 #include "host/mesh/observed_points.h"
@@ -63,7 +64,8 @@ class DeviceEnsemble : public SimulationEnsemble {
   // Throws DeviceError when the ensemble needs more than `memory` bytes, or a buffer larger
   // than `largest_buffer`, of device `name` (with a shared factor's buffers, ensemble_memory).
   void check_device_memory(std::size_t real_size, const std::string& name, std::size_t memory,
-                           std::size_t largest_buffer, std::size_t factor_nonzeros = 0) const;
+                           std::size_t largest_buffer, std::size_t factor_nonzeros = 0,
+                           FactorStorage storage = FactorStorage::columns) const;
   // The table of buffers with this back end's sizes (device_buffer_specs).
   // Also takes the model's stiffnesses into ligament_k_ (set_parameters() changes only the
   // estimated ligaments').

@@ -34,14 +34,22 @@ constexpr int kPartitionRows = 512;
 constexpr int kMostPartitions = 64;
 int cg_partitions(int nodes, int forced);
 
+// How a device ensemble holds its shared factor: OpenCL's L by columns (its values and row
+// indices), or Vulkan's dense 4 x 4 blocks by rows and by columns (VulkanFactorSolve: each way
+// about 1.4 stored entries a nonzero; in all 12.2 bytes a nonzero in float32 on the 38k liver,
+// bench/RESULTS.md, stop 59).
+enum class FactorStorage { columns, blocks };
+
 // Device memory of an ensemble, in bytes, for `real_size`-byte reals; with a shared factor of
-// `factor_nonzeros` nonzeros (OpenCL's CPU form), its buffers too.
+// `factor_nonzeros` nonzeros (OpenCL's CPU form, Vulkan on a CPU device), its buffers too, and
+// without Jacobi's diagonals (DeviceBufferSizes::jacobi_diagonals).
 struct EnsembleMemory {
   std::size_t total = 0;     // about: all buffers
   std::size_t largest = 0;   // the largest single buffer (12 per element and sigma point, or L)
 };
 EnsembleMemory ensemble_memory(int nodes, int elements, int sigma_count, std::size_t real_size,
-                               std::size_t factor_nonzeros = 0);
+                               std::size_t factor_nonzeros = 0,
+                               FactorStorage storage = FactorStorage::columns);
 
 // The "out of device memory" message: what the ensemble needs and what `device` has.
 std::string out_of_device_memory_message(const EnsembleMemory& need, int elements,

@@ -114,7 +114,8 @@ VulkanEnsemble::VulkanEnsemble(const Model& model, EstimatedParameters estimated
     if (cg_partitions_ == 1) {
       springs_ = spring_correction(options.spring_correction);   // as OpenCL's
       factor_ = analysed_factor(springs_);   // their rows last, as OpenCL's
-      check_device_memory(device_.real_size(), info.name, info.memory, info.max_buffer, factor_->nonzeros());
+      check_device_memory(device_.real_size(), info.name, info.memory, info.max_buffer, factor_->nonzeros(),
+                          FactorStorage::blocks);
     }
   }
   cg_lane_rows_ = sigmafem::cg_lane_rows(options.cg_sigma_lanes_from, S_, info, !cg_partitioned_, factor_ != nullptr);

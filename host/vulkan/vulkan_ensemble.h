@@ -104,6 +104,7 @@ class VulkanEnsemble : public DeviceEnsemble {
   // Whether CG is preconditioned by a factor (vulkan_uses_factor), its factorisations so far
   // (0 with Jacobi), and the dispatches of one solve with it.
   bool factorised() const { return factor_ != nullptr; }
+  std::size_t factor_nonzeros() const { return factor_ ? factor_->nonzeros() : 0; }   // 0: none
   int factorisations() const { return factor_ ? factor_->factorisations() : multigrid_makings_; }
   // Whether CG is preconditioned by the multigrid V-cycle (its makings: factorisations()).
   bool multigrid() const { return multigrid_ != nullptr; }

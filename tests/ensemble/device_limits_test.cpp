@@ -19,13 +19,21 @@ TEST(EnsembleMemory, CountsTheStateTheElementsAndAFactor) {
   EXPECT_EQ(plain.total, (9 * 3 * nodes * S + 33 * elements * S) * real);
   EXPECT_EQ(plain.largest, 12u * elements * S * real);
 
-  // L's values and row indices, its column starts and ordering, a work vector per sigma point.
+  // With a factor no Jacobi diagonals (3 N S and 12 E S reals) but L's values and row indices,
+  // its column starts and ordering, a work vector per sigma point.
   const std::size_t nonzeros = 50000;
+  const std::size_t jacobi = (3u * nodes * S + 12u * elements * S) * real;
   const EnsembleMemory with_factor = ensemble_memory(nodes, elements, S, real, nonzeros);
-  EXPECT_EQ(with_factor.total - plain.total,
+  EXPECT_EQ(with_factor.total + jacobi - plain.total,
             nonzeros * (real + sizeof(std::int32_t)) + (2 * 3 * nodes + 1) * sizeof(std::int32_t) +
                 3u * nodes * S * real);
   EXPECT_EQ(with_factor.largest, nonzeros * real) << "L is the largest buffer here";
+  // Vulkan's blocks: 1.5 entries a nonzero each way, a panel index a block each way, the work
+  // vector's copies.
+  const EnsembleMemory blocks = ensemble_memory(nodes, elements, S, real, nonzeros, FactorStorage::blocks);
+  EXPECT_EQ(blocks.largest, nonzeros * 3 / 2 * real);
+  EXPECT_EQ(blocks.total + jacobi - plain.total,
+            2 * (nonzeros * 3 / 2 * real) + 2 * (nonzeros * 3 / 32) * sizeof(std::int32_t) + 3u * nodes * 8 * real);
 }
 
 TEST(EnsembleMemory, TheMessageSaysWhatIsNeededAndWhatThereIs) {
