@@ -37,7 +37,6 @@ std::vector<double> StepConstants::next_step(const Model& m, const Eigen::Vector
   std::vector<double> c(size());
   c[SF_H] = h;
   c[SF_CG_TOLERANCE2] = cg_tolerance_ * cg_tolerance_;
-  c[SF_POLAR_ROTATION] = m.material.rotation == ElementRotation::polar ? 1.0 : 0.0;
   for (std::size_t s = 0; s < S; ++s) {
     const PhysicsEffects& e = physics_[s];
     auto at = [&](int k) -> double& { return c[SF_STEP_CONSTANTS + k * S + s]; };

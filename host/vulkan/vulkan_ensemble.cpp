@@ -162,7 +162,11 @@ VulkanEnsemble::VulkanEnsemble(const Model& model, EstimatedParameters estimated
   sigma_quads_ = options.sigma_quads && device_.texel_reads() && S_ % 4 == 0;
   // With a factor, the right-hand side's shaders leave out the Jacobi diagonal (*_factor).
   const std::string rhs_form = std::string(sigma_quads_ ? "_quads" : "") + (factor_ ? "_factor" : "");
-  k_element_rhs_ = kernel(("element_rhs" + rhs_form).c_str(), DeviceKernel::element_rhs);
+  // The rotation method as element_rhs's specialization constant 0 (a branch llvmpipe would run
+  // both sides of, read from the step constants).
+  k_element_rhs_ = device_.kernel(("element_rhs" + rhs_form).c_str(),
+                                  static_cast<int>(kernel_buffers(DeviceKernel::element_rhs).size()),
+                                  {model_.material.rotation == ElementRotation::polar ? 1u : 0u});
   k_node_rhs_ = kernel(("node_rhs" + rhs_form).c_str(), DeviceKernel::node_rhs);
   k_element_product_ =
       kernel(sigma_quads_ ? "element_product_quads" : "element_product", DeviceKernel::element_product);

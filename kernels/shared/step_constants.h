@@ -10,9 +10,7 @@
 
 #define SF_H 0                 /* time step h */
 #define SF_CG_TOLERANCE2 1     /* squared relative CG tolerance */
-#define SF_POLAR_ROTATION 2    /* 1: the elements' polar frames, 0: their QR frames (element.h; Vulkan
-                                  reads it, OpenCL has the method as a build option) */
-#define SF_STEP_CONSTANTS 3
+#define SF_STEP_CONSTANTS 2    /* (the rotation method is the kernels' build option SF_POLAR_FRAMES) */
 
 /* Per sigma point, k: */
 #define SF_GRAVITY 0             /* 3 numbers: gravity (m/s^2) */

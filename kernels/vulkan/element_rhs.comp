@@ -12,6 +12,11 @@
 #include "ensemble_layout.h"
 
 layout(local_size_x = SF_ITEMS_PER_GROUP) in;
+/* The rotation method, the scenario's material.rotation (1 polar, 0 QR), set at pipeline
+ * creation (specialization constant 0), as OpenCL's build option SF_POLAR_FRAMES: read at run
+ * time it was a branch llvmpipe ran both sides of, the polar frame's Newton steps for QR
+ * scenarios too (18% of element_rhs on the 4768 liver; bench/RESULTS.md, stop 60). */
+layout(constant_id = 0) const uint SF_POLAR_FRAMES = 0u;
 #if defined(SF_SIGMA_QUADS) /* four sigma points a lane: sigma_quads.h */
 #include "sigma_quads.h"
 SF_READ_INTS(SF_ELEMENT_RHS_ELEMENT_NODES, nodes)
@@ -40,7 +45,7 @@ void main() {
   SF_REAL force[12];
   SF_REAL product[12];
   SF_GATHER_CORNER_QUADS(x, corner_nodes, q, Q, corner)
-  sf_element_rotation(grad, corner, SF_REAL(SF_LOAD(c, SF_POLAR_ROTATION)), frame);
+  sf_element_rotation(grad, corner, SF_REAL(SF_POLAR_FRAMES), frame);
   SF_STORE_ITEM_QUADS(frames, e, 9u, q, Q, frame)
   sf_element_force(frame, grad, sigma_lambda, sigma_mu, corner, force);
   SF_GATHER_CORNER_QUADS(v, corner_nodes, q, Q, corner)
@@ -82,7 +87,7 @@ void main() {
   real force[12];
   real product[12];
   SF_GATHER_CORNERS(x, corner_nodes, s, S, corner)
-  sf_element_rotation(grad, corner, SF_LOAD(c, SF_POLAR_ROTATION), frame);
+  sf_element_rotation(grad, corner, real(SF_POLAR_FRAMES), frame);
   SF_STORE_FRAME(frames, e, s, S, frame)
   sf_element_force(frame, grad, sigma_lambda, sigma_mu, corner, force);
   SF_GATHER_CORNERS(v, corner_nodes, s, S, corner)
