@@ -7,9 +7,13 @@
 #include <gtest/gtest.h>
 
 #include <Eigen/Core>
+#include <algorithm>
 #include <cmath>
+#include <string>
 
+#include "host/common/device_error.h"
 #include "host/ensemble/device_ensemble.h"
+#include "host/ensemble/device_limits.h"
 #include "host/scenario/scenario.h"
 #include "tests/scenario_directory.h"
 
@@ -49,6 +53,44 @@ inline Eigen::MatrixXd run_steps(SimulationEnsemble& ensemble, const Scenario& s
   Eigen::MatrixXd x, v;
   ensemble.read_states(x, v);
   return x;
+}
+
+// The memory check of an ensemble's multigrid hierarchy (check_more_device_memory), made at the
+// first step, when its matrices are known: `Ensemble` with `options` (the V-cycle) capped by
+// DeviceOptions::device_memory with room for its own buffers but for only half the hierarchy's
+// refuses its first step with "out of device memory" naming the multigrid levels; capped at
+// what it holds with them, it steps.
+template <class Ensemble>
+void expect_multigrid_memory_checked(const Scenario& scenario, const Model& model, int S, DeviceOptions options) {
+  const Eigen::Vector3d so = scenario.control.trajectory.position(scenario.time.dt, scenario.control.start);
+  const auto make = [&] { return Ensemble(model, scenario.filter->estimate, scenario.observations.observed, S, options); };
+  std::size_t own = 0, with_levels = 0;
+  {
+    Ensemble uncapped = make();
+    ASSERT_TRUE(uncapped.multigrid());
+    own = uncapped.device_bytes();
+    uncapped.advance(so);
+    with_levels = uncapped.device_bytes();
+  }
+  const std::size_t levels = with_levels - own;
+  // The construction's own check is of an estimate (ensemble_memory): the cap must pass it.
+  const std::size_t estimate =
+      ensemble_memory(model.node_count(), model.element_count(), S, real_size(options.precision)).total;
+  ASSERT_LT(estimate, own + levels / 2) << "no cap between the ensemble's estimate and its hierarchy";
+  options.device_memory = own + levels / 2;
+  Ensemble capped = make();
+  try {
+    capped.advance(so);
+    ADD_FAILURE() << "expected the multigrid levels to be refused";
+  } catch (const DeviceError& e) {
+    const std::string message = e.what();
+    EXPECT_NE(message.find("out of device memory: the multigrid levels"), std::string::npos) << message;
+    EXPECT_NE(message.find("MiB"), std::string::npos) << message;
+  }
+  options.device_memory = with_levels;
+  Ensemble enough = make();
+  EXPECT_EQ(enough.advance(so).unconverged_count(), 0);
+  EXPECT_EQ(enough.device_bytes(), with_levels);
 }
 
 }  // namespace sigmafem::test

@@ -117,6 +117,10 @@ struct DeviceOptions {
   // Vulkan's CPU form (texel reads) with S a multiple of 4: the element and node shaders take
   // four sigma points a lane (kernels/vulkan/sigma_quads.h); false: one (tests compare).
   bool sigma_quads = true;
+  // The device memory a device ensemble may take, in bytes, where less than the device has (a
+  // GPU shared with other work; tests); 0: the device's. The memory checks hold the ensemble's
+  // buffers to it (usable_device_memory, host/ensemble/device_limits.h).
+  std::size_t device_memory = 0;
   // The CPU back end's worker threads: 0, the machine's cores (over MPI ranks, shared among
   // the ranks on one machine: estimation_job.cpp).
   int cpu_threads = 0;

@@ -29,10 +29,18 @@ DeviceEnsemble::DeviceEnsemble(const Model& model, EstimatedParameters estimated
 
 void DeviceEnsemble::check_device_memory(std::size_t real_size, const std::string& name,
                                          std::size_t memory, std::size_t largest_buffer,
-                                         std::size_t factor_nonzeros, FactorStorage storage) const {
-  const EnsembleMemory need = ensemble_memory(nodes_, elements_, S_, real_size, factor_nonzeros, storage);
+                                         std::size_t factor_nonzeros, FactorStorage storage, int factor_copies) {
+  const EnsembleMemory need =
+      ensemble_memory(nodes_, elements_, S_, real_size, factor_nonzeros, storage, factor_copies);
   if (need.largest > largest_buffer || need.total > memory)
     throw DeviceError(out_of_device_memory_message(need, elements_, S_, name, memory, largest_buffer));
+  device_memory_ = memory;
+  device_name_ = name;
+}
+
+void DeviceEnsemble::check_more_device_memory(std::size_t more, const std::string& what) const {
+  if (device_bytes_ + more > device_memory_)
+    throw DeviceError(out_of_device_memory_message(what, more, device_bytes_, device_name_, device_memory_));
 }
 
 std::vector<DeviceBufferSpec> DeviceEnsemble::buffer_specs(const DeviceBufferSizes& sizes) {

@@ -62,10 +62,15 @@ class DeviceEnsemble : public SimulationEnsemble {
                  int sigma_count, Precision precision, const char* backend, const char* who);
 
   // Throws DeviceError when the ensemble needs more than `memory` bytes, or a buffer larger
-  // than `largest_buffer`, of device `name` (with a shared factor's buffers, ensemble_memory).
+  // than `largest_buffer`, of device `name` (with a shared factor's buffers, ensemble_memory);
+  // keeps `memory` and `name` for check_more_device_memory.
   void check_device_memory(std::size_t real_size, const std::string& name, std::size_t memory,
                            std::size_t largest_buffer, std::size_t factor_nonzeros = 0,
-                           FactorStorage storage = FactorStorage::columns) const;
+                           FactorStorage storage = FactorStorage::columns, int factor_copies = 1);
+  // Throws DeviceError when `more` bytes of buffers for `what`, made after the ensemble's own
+  // (a multigrid hierarchy, known at its first making), would take the ensemble past the
+  // memory check_device_memory was given.
+  void check_more_device_memory(std::size_t more, const std::string& what) const;
   // The table of buffers with this back end's sizes (device_buffer_specs).
   // Also takes the model's stiffnesses into ligament_k_ (set_parameters() changes only the
   // estimated ligaments').
@@ -147,6 +152,8 @@ class DeviceEnsemble : public SimulationEnsemble {
   StepConstants step_constants_;  // per step, with the per-sigma effects
   std::vector<double> ligament_k_;   // per ligament and sigma, N/m per node: [l S + s]
   std::size_t device_bytes_ = 0;
+  std::size_t device_memory_ = 0;   // check_device_memory's `memory` and `name`
+  std::string device_name_;
   int expected_iterations_ = 1;   // CG iterations the last step needed (at most)
   const char* backend_;
   const char* who_;

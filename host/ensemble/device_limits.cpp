@@ -38,7 +38,7 @@ int cg_partitions(int nodes, int forced) {
 }
 
 EnsembleMemory ensemble_memory(int nodes, int elements, int S, std::size_t real_size,
-                               std::size_t factor_nonzeros, FactorStorage storage) {
+                               std::size_t factor_nonzeros, FactorStorage storage, int factor_copies) {
   // Per dof and sigma: x, v, dv, rhs, r, z, d, q and without a factor the Jacobi diagonal; per
   // element and sigma: the frame (9), the element outputs (12) and without a factor diagonals (12).
   const bool factor = factor_nonzeros > 0;
@@ -50,9 +50,11 @@ EnsembleMemory ensemble_memory(int nodes, int elements, int S, std::size_t real_
   if (!factor) return need;
   const std::size_t rows = 3 * static_cast<std::size_t>(nodes);
   if (storage == FactorStorage::columns) {
-    // L's values and row indices, its column starts and ordering, a work vector per sigma.
-    need.largest = std::max(need.largest, factor_nonzeros * std::max(real_size, sizeof(std::int32_t)));
-    need.total += factor_nonzeros * (real_size + sizeof(std::int32_t)) +
+    // L's values (a copy a sigma point with own factors) and row indices, its column starts and
+    // ordering, a work vector per sigma.
+    const std::size_t values = factor_nonzeros * static_cast<std::size_t>(std::max(1, factor_copies)) * real_size;
+    need.largest = std::max(need.largest, std::max(values, factor_nonzeros * sizeof(std::int32_t)));
+    need.total += values + factor_nonzeros * sizeof(std::int32_t) +
                   (2 * rows + 1) * sizeof(std::int32_t) + dof * real_size;
   } else {
     // The blocks' entries each way, 1.5 a nonzero (1.38 measured on the 38k liver), a panel
@@ -65,6 +67,28 @@ EnsembleMemory ensemble_memory(int nodes, int elements, int S, std::size_t real_
   return need;
 }
 
+std::size_t multigrid_memory(const NestedMultigrid& multigrid, int S, std::size_t real_size) {
+  const auto matrix = [&](const RowMajorMatrix& M) {
+    return (static_cast<std::size_t>(M.rows()) + 1) * sizeof(std::int32_t) +
+           static_cast<std::size_t>(M.nonZeros()) * (sizeof(std::int32_t) + real_size);
+  };
+  std::size_t bytes = 0;
+  for (int l = 0; l < multigrid.level_count(); ++l) {
+    const NestedMultigrid::Level& level = multigrid.level(l);
+    const std::size_t vector = static_cast<std::size_t>(level.matrix.rows()) * S * real_size;
+    bytes += matrix(multigrid.launch_matrix(l));
+    if (!level.smoothing.empty())   // the diagonal, two coefficients a step, x and p twice
+      bytes += (static_cast<std::size_t>(level.matrix.rows()) + 2 * level.smoothing.size()) * real_size + 4 * vector;
+    if (l + 1 < multigrid.level_count()) bytes += matrix(level.prolongation) + matrix(level.restriction) + vector;
+    if (l > 0) bytes += 2 * vector;   // b and the correction
+  }
+  return bytes + static_cast<std::size_t>(multigrid.level(0).matrix.rows()) * S * real_size;   // the shifts
+}
+
+std::size_t usable_device_memory(std::size_t memory, const DeviceOptions& options) {
+  return options.device_memory > 0 ? std::min(memory, options.device_memory) : memory;
+}
+
 std::string out_of_device_memory_message(const EnsembleMemory& need, int elements, int S,
                                          const std::string& device,
                                          std::size_t device_memory, std::size_t largest_buffer) {
@@ -74,6 +98,14 @@ std::string out_of_device_memory_message(const EnsembleMemory& need, int element
          " has " + std::to_string(device_memory >> 20) + " MiB (largest buffer " +
          std::to_string(largest_buffer >> 20) +
          " MiB). Use fewer sigma points, a coarser mesh or another device";
+}
+
+std::string out_of_device_memory_message(const std::string& what, std::size_t more, std::size_t held,
+                                         const std::string& device, std::size_t device_memory) {
+  return "out of device memory: " + what + " need about " + std::to_string(more >> 20) + " MiB more than the " +
+         std::to_string(held >> 20) + " MiB the ensemble holds; " + device + " has " +
+         std::to_string(device_memory >> 20) +
+         " MiB. Use fewer sigma points, a coarser mesh, --preconditioner jacobi or another device";
 }
 
 }  // namespace sigmafem

@@ -11,6 +11,7 @@
 #include "host/mesh/observed_points.h"
 #include "host/model/estimated_parameters.h"
 #include "host/model/model.h"
+#include "host/reference/nested_multigrid.h"
 
 namespace sigmafem {
 
@@ -47,13 +48,28 @@ struct EnsembleMemory {
   std::size_t total = 0;     // about: all buffers
   std::size_t largest = 0;   // the largest single buffer (12 per element and sigma point, or L)
 };
+// OpenCL's own factors (`factor_copies` = S) hold S copies of L's values.
 EnsembleMemory ensemble_memory(int nodes, int elements, int sigma_count, std::size_t real_size,
                                std::size_t factor_nonzeros = 0,
-                               FactorStorage storage = FactorStorage::columns);
+                               FactorStorage storage = FactorStorage::columns, int factor_copies = 1);
+
+// The device buffers of a multigrid V-cycle (OpenClMultigrid, VulkanMultigrid: each level's
+// matrix, prolongation and restriction by rows, its smoothing's diagonal and coefficients, its
+// vectors for S sigma points, and the finest level's spring shifts), in bytes, once `multigrid`
+// has its matrices (set_matrix): they are known only then.
+std::size_t multigrid_memory(const NestedMultigrid& multigrid, int sigma_count, std::size_t real_size);
+
+// The memory checks' share of a device's `memory`: DeviceOptions::device_memory where set and
+// smaller.
+std::size_t usable_device_memory(std::size_t memory, const DeviceOptions& options);
 
 // The "out of device memory" message: what the ensemble needs and what `device` has.
 std::string out_of_device_memory_message(const EnsembleMemory& need, int elements,
                                          int sigma_count, const std::string& device,
                                          std::size_t device_memory, std::size_t largest_buffer);
+// The message when `what`'s `more` bytes would take an ensemble of `held` bytes past
+// `device`'s `device_memory`.
+std::string out_of_device_memory_message(const std::string& what, std::size_t more, std::size_t held,
+                                         const std::string& device, std::size_t device_memory);
 
 }  // namespace sigmafem

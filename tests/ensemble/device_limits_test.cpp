@@ -28,6 +28,10 @@ TEST(EnsembleMemory, CountsTheStateTheElementsAndAFactor) {
             nonzeros * (real + sizeof(std::int32_t)) + (2 * 3 * nodes + 1) * sizeof(std::int32_t) +
                 3u * nodes * S * real);
   EXPECT_EQ(with_factor.largest, nonzeros * real) << "L is the largest buffer here";
+  // OpenCL's own factors: a copy of L's values a sigma point.
+  const EnsembleMemory own = ensemble_memory(nodes, elements, S, real, nonzeros, FactorStorage::columns, S);
+  EXPECT_EQ(own.total - with_factor.total, (S - 1) * nonzeros * real);
+  EXPECT_EQ(own.largest, S * nonzeros * real);
   // Vulkan's blocks: 1.5 entries a nonzero each way, a panel index a block each way, the work
   // vector's copies.
   const EnsembleMemory blocks = ensemble_memory(nodes, elements, S, real, nonzeros, FactorStorage::blocks);
@@ -43,6 +47,21 @@ TEST(EnsembleMemory, TheMessageSaysWhatIsNeededAndWhatThereIs) {
   EXPECT_NE(message.find("out of device memory"), std::string::npos) << message;
   EXPECT_NE(message.find(std::to_string(need.total >> 20) + " MiB"), std::string::npos) << message;
   EXPECT_NE(message.find("a small device has 64 MiB"), std::string::npos) << message;
+}
+
+TEST(EnsembleMemory, AHierarchyMadeLaterIsHeldToWhatIsLeft) {
+  const std::string message = out_of_device_memory_message("the multigrid levels", std::size_t{300} << 20,
+                                                            std::size_t{900} << 20, "a small device",
+                                                            std::size_t{1} << 30);
+  EXPECT_NE(message.find("out of device memory: the multigrid levels need about 300 MiB more than the 900 MiB"),
+            std::string::npos) << message;
+  EXPECT_NE(message.find("a small device has 1024 MiB"), std::string::npos) << message;
+  EXPECT_NE(message.find("--preconditioner jacobi"), std::string::npos) << message;
+  DeviceOptions options;
+  EXPECT_EQ(usable_device_memory(std::size_t{1} << 30, options), std::size_t{1} << 30);
+  options.device_memory = std::size_t{1} << 20;
+  EXPECT_EQ(usable_device_memory(std::size_t{1} << 30, options), std::size_t{1} << 20);
+  EXPECT_EQ(usable_device_memory(std::size_t{1} << 10, options), std::size_t{1} << 10);
 }
 
 }  // namespace

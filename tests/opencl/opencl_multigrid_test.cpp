@@ -63,6 +63,8 @@ TEST_P(OpenClMultigridPrecisionTest, TheDeviceVCycleIsTheHostsForEverySigmaPoint
     ASSERT_TRUE(multigrid.set_matrix(A));
     OpenClMultigrid on_device(device, kMultigridSigmaPoints);
     on_device.upload(multigrid);
+    EXPECT_EQ(on_device.device_bytes(), multigrid_memory(multigrid, kMultigridSigmaPoints, device.real_size()))
+        << "the memory check's count";
     const std::vector<double> shift_rows = to_sigma_rows(shift);
     on_device.upload_shift(shift_rows);
     const std::vector<unsigned char> r_bytes = to_device_reals(to_sigma_rows(r), precision);
@@ -149,6 +151,12 @@ TEST_F(OpenClMultigridTest, TheFiltersEstimatesAreJacobisOnDataGeneratedForTheRe
   ASSERT_EQ(jacobi.size(), multigrid.size());
   for (Eigen::Index j = 0; j < jacobi.size(); ++j)
     EXPECT_NEAR(multigrid[j] / jacobi[j], 1.0, 5e-3) << "parameter " << j << ": " << multigrid[j] << " against " << jacobi[j];
+}
+
+TEST_F(OpenClMultigridTest, ItsLevelsAreCheckedAgainstTheDevicesMemory) {
+  DeviceOptions options;
+  options.kernel_form = KernelForm::gpu;
+  test::expect_multigrid_memory_checked<OpenClEnsemble>(scenario_, model_, kMultigridSigmaPoints, options);
 }
 
 TEST_F(OpenClMultigridTest, IsRefusedOnTheCpuFormAndOnAMeshThatNoRefinementMade) {

@@ -57,8 +57,10 @@ TEST_F(VulkanMultigridTest, TheDeviceVCycleIsTheHostsForEverySigmaPointInBothFor
       const VulkanBuffer r_buffer = device.buffer(r_bytes.size(), "r"), z_buffer = device.buffer(r_bytes.size(), "z");
       device.upload(r_buffer, r_bytes.data(), r_bytes.size());
       VulkanMultigrid on_device(device, S, r_buffer, z_buffer);
+      const std::size_t before = on_device.bytes();
       on_device.upload(multigrid);
       ASSERT_TRUE(on_device.ready());
+      EXPECT_EQ(on_device.bytes() - before, multigrid_memory(multigrid, S, sizeof(float)));   // the memory check's count
       VkCommandBuffer cmd = device.begin();
       on_device.record_shift(cmd, to_sigma_rows(shift));
       device.barrier(cmd);
@@ -135,6 +137,12 @@ TEST_F(VulkanMultigridTest, ItsGroupsGrowToKeepWithinTheLoopTurns) {
   EXPECT_GT(iterations_eight, 6 * S);
   EXPECT_LE(std::abs(iterations_eight - iterations_grown), 6 * S);
   EXPECT_LT((a - b).cwiseAbs().maxCoeff(), 2e-7);
+}
+
+TEST_F(VulkanMultigridTest, ItsLevelsAreCheckedAgainstTheDevicesMemory) {
+  DeviceOptions options;
+  options.preconditioner = Preconditioner::multigrid;
+  test::expect_multigrid_memory_checked<VulkanEnsemble>(scenario_, model_, kVulkanMultigridSigmaPoints, options);
 }
 
 TEST_F(VulkanMultigridTest, IsRefusedOnAMeshThatNoRefinementMade) {
