@@ -12,6 +12,7 @@ DeviceOptions BackendChoice::device_options() const {
                            : preconditioner == "factorised" ? Preconditioner::factorised
                            : preconditioner == "multigrid"  ? Preconditioner::multigrid
                                                             : Preconditioner::automatic;
+  options.device_memory = device_memory_mib << 20;
   return options;
 }
 
@@ -21,7 +22,8 @@ void add_backend_options(CLI::App* command, BackendChoice& choice) {
   command->add_option("--backend", choice.backend,
                       "Where the simulations run: cpu (the double-precision reference), a "
                       "device back end, or auto (a GPU where one is there and the ensemble is "
-                      "large enough to pay, else cpu; the first line of output says which)")
+                      "large enough to pay, else OpenCL on a CPU device where it is faster than "
+                      "cpu, else cpu; the first line of output says which)")
       ->check(CLI::IsMember(names))
       ->capture_default_str();
   command->add_option("--device", choice.device,
@@ -39,6 +41,12 @@ void add_backend_options(CLI::App* command, BackendChoice& choice) {
                       "OpenCL's GPU form and Vulkan) or auto (factorised on cpu and on a CPU device, "
                       "multigrid on a GPU where the mesh was refined, else jacobi)")
       ->check(CLI::IsMember({"auto", "jacobi", "factorised", "multigrid"}))
+      ->capture_default_str();
+  command->add_option("--device-memory", choice.device_memory_mib,
+                      "The most memory a device back end may take, in MiB, where less than the "
+                      "device has (a GPU shared with other work); 0: what the device has. An "
+                      "ensemble that needs more is refused (exit code 3)")
+      ->check(CLI::Range(std::size_t{0}, std::size_t{1} << 40))
       ->capture_default_str();
 }
 

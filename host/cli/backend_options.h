@@ -14,6 +14,7 @@ struct BackendChoice {
   int device = 0;
   std::string precision = "single";
   std::string preconditioner = "auto";
+  std::size_t device_memory_mib = 0;   // DeviceOptions::device_memory, in MiB; 0: the device's
   DeviceOptions device_options() const;
 };
 

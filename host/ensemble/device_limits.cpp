@@ -89,6 +89,10 @@ std::size_t usable_device_memory(std::size_t memory, const DeviceOptions& option
   return options.device_memory > 0 ? std::min(memory, options.device_memory) : memory;
 }
 
+std::string memory_holder(const std::string& device, std::size_t memory, const DeviceOptions& options) {
+  return usable_device_memory(memory, options) < memory ? device + " as held by --device-memory" : device;
+}
+
 std::string out_of_device_memory_message(const EnsembleMemory& need, int elements, int S,
                                          const std::string& device,
                                          std::size_t device_memory, std::size_t largest_buffer) {

@@ -60,8 +60,9 @@ EnsembleMemory ensemble_memory(int nodes, int elements, int sigma_count, std::si
 std::size_t multigrid_memory(const NestedMultigrid& multigrid, int sigma_count, std::size_t real_size);
 
 // The memory checks' share of a device's `memory`: DeviceOptions::device_memory where set and
-// smaller.
+// smaller; and the device's name for their messages, saying so then.
 std::size_t usable_device_memory(std::size_t memory, const DeviceOptions& options);
+std::string memory_holder(const std::string& device, std::size_t memory, const DeviceOptions& options);
 
 // The "out of device memory" message: what the ensemble needs and what `device` has.
 std::string out_of_device_memory_message(const EnsembleMemory& need, int elements,

@@ -629,6 +629,29 @@ TEST_F(CliTest, VulkanDeviceOutOfRangeIsAClearDeviceError) {
   EXPECT_FALSE(fs::exists(dir_ / "out" / "observations.csv"));
 }
 
+// --device-memory holds a device back end to less than the device has (a GPU shared with other
+// work): the 38k liver's one simulation needs about 5 MiB, so 1 MiB is refused before any
+// buffer is made, with the need and the hold in the message; a negative amount is bad input.
+TEST_F(CliTest, TooLittleDeviceMemoryIsAClearDeviceError) {
+  const std::string scenario = (fs::path(SIGMAFEM_SOURCE_DIR) / "scenarios" / "liver_fine.json").string();
+  std::vector<std::string> backends;
+  if (!list_opencl_devices().empty()) backends.push_back("opencl");
+  if (!list_vulkan_devices().empty()) backends.push_back("vulkan");
+  if (backends.empty()) SIGMAFEM_MISSING("no OpenCL or Vulkan device");
+  for (const std::string& backend : backends) {
+    const CommandRun run = run_sigmafem("generate " + scenario + " --out " + (dir_ / "out").string() +
+                                        " --backend " + backend + " --device-memory 1 --vtk-every 0 --quiet");
+    EXPECT_EQ(run.exit_code, 3) << backend << ": " << run.output;
+    EXPECT_NE(run.output.find("out of device memory"), std::string::npos) << run.output;
+    EXPECT_NE(run.output.find("as held by --device-memory has 1 MiB"), std::string::npos) << run.output;
+    EXPECT_FALSE(fs::exists(dir_ / "out" / "observations.csv"));
+  }
+  const CommandRun negative = run_sigmafem("generate " + scenario + " --out " + (dir_ / "out").string() +
+                                           " --backend " + backends.front() + " --device-memory -1 --quiet");
+  EXPECT_EQ(negative.exit_code, 2) << negative.output;
+  EXPECT_NE(negative.output.find("--device-memory"), std::string::npos) << negative.output;
+}
+
 TEST_F(CliTest, DevicesListsVulkanAfterOpenCl) {
   const CommandRun run = run_sigmafem("devices");
   EXPECT_EQ(run.exit_code, 0) << run.output;

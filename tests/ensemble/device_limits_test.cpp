@@ -62,6 +62,8 @@ TEST(EnsembleMemory, AHierarchyMadeLaterIsHeldToWhatIsLeft) {
   options.device_memory = std::size_t{1} << 20;
   EXPECT_EQ(usable_device_memory(std::size_t{1} << 30, options), std::size_t{1} << 20);
   EXPECT_EQ(usable_device_memory(std::size_t{1} << 10, options), std::size_t{1} << 10);
+  EXPECT_EQ(memory_holder("a GPU", std::size_t{1} << 30, options), "a GPU as held by --device-memory");
+  EXPECT_EQ(memory_holder("a GPU", std::size_t{1} << 10, options), "a GPU") << "the device has less than the hold";
 }
 
 }  // namespace
