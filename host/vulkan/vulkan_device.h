@@ -119,8 +119,8 @@ class VulkanDevice {
   // constants[i] (none given: the shader's defaults). The CG and factor shaders take their
   // work-group size as constant 0, the CG shaders their partitions per sigma point as 1
   // (factor_solve its panels of L) and their rows at once of lanes over sigma points as 2;
-  // recenter S and p; element_rhs the rotation method (1 polar). Throws DeviceError when the shader is not embedded, is not SPIR-V or the
-  // driver rejects it.
+  // recenter S and p; element_rhs the rotation method (1 polar). Throws DeviceError when the
+  // shader is not embedded, is not SPIR-V or the driver rejects it.
   VulkanKernel kernel(const char* name, int bindings, const std::vector<std::uint32_t>& constants = {});
   // Same, from given SPIR-V words (tests: a module that fails to load).
   VulkanKernel kernel_from_spirv(const std::string& name, const std::uint32_t* words,
