@@ -202,7 +202,8 @@ VulkanEnsemble::VulkanEnsemble(const Model& model, EstimatedParameters estimated
   else if (!cg_partitioned_)
     k_cg_iteration_ = cg_kernel(factor_ ? lanes("cg_iteration_factor").c_str() : "cg_iteration", iteration);
   if (factor_) {
-    const VulkanFactorSolve::CgBuffers cg{buffer(B::r), buffer(B::z), buffer(B::d), buffer(B::active), buffer(B::rz)};
+    // Without z: the solves always finish CG's step (d and r.z), and no shader reads z then.
+    const VulkanFactorSolve::CgBuffers cg{buffer(B::r), VulkanBuffer{}, buffer(B::d), buffer(B::active), buffer(B::rz)};
     factor_solve_ = std::make_unique<VulkanFactorSolve>(device_, 3 * nodes_, springs_.size(), S_, cg,
                                                         options.factor_loop_turns);
     device_bytes_ += factor_solve_->bytes();

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <stdexcept>
 #include <string>
 
 #include "device_layout.h"
@@ -81,12 +82,15 @@ void VulkanFactorSolve::make_layout(const Eigen::SparseMatrix<double>& L, const 
   upload_ints(layout->backward_panel, b.backward_panel());
   upload_ints(layout->slot_rows, b.slot_rows());
   const char* name = split_ > 1 ? "factor_solve_split" : shared_ ? "factor_solve_shared" : "factor_solve";
-  layout->kernel = device_.kernel(name, SF_FACTOR_SOLVE_BINDINGS, {group_, static_cast<std::uint32_t>(P)});
+  const bool stores_z = cg_.z.buffer != VK_NULL_HANDLE;
+  layout->kernel = device_.kernel(name, SF_FACTOR_SOLVE_BINDINGS,
+                                  {group_, static_cast<std::uint32_t>(P), stores_z ? 1u : 0u});
   const Layout& l = *layout;
+  // Without z, r stands at its binding (never written there).
   layout->set = device_.bind(l.kernel, {l.forward_starts, l.forward_panel, l.backward_starts, l.backward_panel,
-                                        l.slot_rows, cg_.r, cg_.z, cg_.active, spring_at_, spring_solves_,
-                                        spring_coupling_, l.triangles, l.forward_blocks, l.backward_blocks, l.work,
-                                        l.work, cg_.d, cg_.rz});
+                                        l.slot_rows, cg_.r, stores_z ? cg_.z : cg_.r, cg_.active, spring_at_,
+                                        spring_solves_, spring_coupling_, l.triangles, l.forward_blocks,
+                                        l.backward_blocks, l.work, l.work, cg_.d, cg_.rz});
   layout_ = std::move(layout);
 }
 
@@ -201,6 +205,8 @@ void VulkanFactorSolve::plan_dispatches() {
 }
 
 void VulkanFactorSolve::record(VkCommandBuffer cmd, std::uint32_t finish) const {
+  if (finish == SF_FACTOR_FINISH_NONE && cg_.z.buffer == VK_NULL_HANDLE)
+    throw std::logic_error("VulkanFactorSolve::record: z alone asked of a solve made without z");
   VulkanPushConstants push;   // S, the first step, one past the last, the finish (factor_solve.comp)
   push.S = static_cast<std::uint32_t>(S_);
   push.max_iterations = static_cast<std::int32_t>(finish);

@@ -41,7 +41,8 @@ class VulkanFactorSolve {
   bool shared() const { return shared_; }
 
   // CG's buffers the solve reads and writes: r, z, d ([row S + s]), the active flags and r.z
-  // (S each).
+  // (S each). Without z (none made) the solve stores only CG's d and r.z from z: record()
+  // then needs a finish.
   struct CgBuffers {
     VulkanBuffer r, z, d, active, rz;
   };

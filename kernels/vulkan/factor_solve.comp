@@ -53,6 +53,10 @@
 layout(local_size_x_id = 0) in;
 /* P, the panels of L (host/reference/factor_blocks.h), set at pipeline creation. */
 layout(constant_id = 1) const uint SF_FACTOR_PANELS = 1u;
+/* Whether z is stored (1), or only CG's d and r.z from it (0: the ensemble's solves, which
+ * always finish CG's step; llvmpipe loops over the lanes for every store it compiles, taken or
+ * not, and left out the solve took 2-3% less: bench/RESULTS.md, stop 60). */
+layout(constant_id = 2) const uint SF_FACTOR_STORES_Z = 1u;
 
 SF_READ_INTS(SF_FACTOR_SOLVE_FORWARD_STARTS, forward_starts)
 SF_READ_INTS(SF_FACTOR_SOLVE_FORWARD_PANEL, forward_panel)
@@ -290,7 +294,7 @@ void main() {
     for (uint c = 0u; c < 4u; ++c) {
       int row = SF_LOAD(slot_rows, 4u * p + c);
       if (row < 0) continue;
-      if (h == 0u && writes) z[uint(row) * S + s] = wp[c];
+      if (SF_FACTOR_STORES_Z != 0u && h == 0u && writes) z[uint(row) * S + s] = wp[c];
       if (finishes) sum_rz += SF_LOAD(r, uint(row) * S + s) * wp[c];
     }
   }

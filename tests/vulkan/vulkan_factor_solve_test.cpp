@@ -7,8 +7,10 @@
 #include <Eigen/SparseCholesky>
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstring>
+#include <stdexcept>
 #include <string>
 #include <vector>
 
@@ -114,18 +116,21 @@ class VulkanFactorSolveTest : public ::testing::Test {
   // z of S sigma points ([row S + s]) for r, on device 0 in float32, with sigma point
   // `inactive` left alone (its z stays at `untouched`).
   // With `springs`, each sigma point's correction for spring_delta(s).
-  // With `finish` (SF_FACTOR_FINISH_*), CG's d and r.z after it in *d and *rz.
+  // With `finish` (SF_FACTOR_FINISH_*), CG's d and r.z after it in *d and *rz; without
+  // `stores_z` the solve is made without z (z stays at `untouched`).
   std::vector<float> device_solve(const std::vector<float>& r, int S, int inactive, bool texel_reads,
                                   long long loop_turns, bool diagonal, int* dispatches = nullptr,
                                   bool springs = false, int* split = nullptr, bool* shared = nullptr,
                                   std::uint32_t finish = SF_FACTOR_FINISH_NONE, std::vector<float>* d = nullptr,
-                                  std::vector<float>* rz = nullptr) {
+                                  std::vector<float>* rz = nullptr, bool stores_z = true) {
     SolveBuffers<float> buffers(r, S, inactive, texel_reads);
     VulkanDevice& device = buffers.device;
     const std::vector<float> sentinel(r.size(), untouched);
     device.upload(buffers.z_buffer, sentinel.data(), buffers.bytes);
     SpringCorrection correction(springs ? spring_rows_ : std::vector<int>{});
-    VulkanFactorSolve solve(device, n_, correction.size(), S, buffers.cg(), loop_turns);
+    VulkanFactorSolve::CgBuffers cg = buffers.cg();
+    if (!stores_z) cg.z = VulkanBuffer{};
+    VulkanFactorSolve solve(device, n_, correction.size(), S, cg, loop_turns);
     if (diagonal)
       solve.upload_diagonal(A_);
     else
@@ -259,7 +264,9 @@ TEST(VulkanFactorSolveShared, GroupsOfEightReadTheBlocksTogetherWhereNoSplitIs) 
 // device's z; the same bits however the solve is cut (the partial r.z kept between dispatches:
 // 150 turns cut the box's solve into tens, 3000 with its springs' correction, which needs a
 // dispatch of m + 5); an inactive sigma point's d and r.z untouched. S = 11 (the shared reads on
-// lavapipe), 4 (the split), 3; without a finish d and r.z stay as they were.
+// lavapipe), 4 (the split), 3; without a finish d and r.z stay as they were. A solve made
+// without z (the ensemble's) gives the same d and r.z, its z left alone, and refuses to record
+// without a finish.
 TEST_F(VulkanFactorSolveTest, ItFinishesCgsStartAndDirection) {
   for (const int S : {11, 4, 3})
   for (const bool springs : {false, true}) {
@@ -278,6 +285,18 @@ TEST_F(VulkanFactorSolveTest, ItFinishesCgsStartAndDirection) {
       EXPECT_EQ(0, std::memcmp(z_cut.data(), z.data(), size * sizeof(float)));
       EXPECT_EQ(0, std::memcmp(d_cut.data(), d.data(), size * sizeof(float)));
       EXPECT_EQ(0, std::memcmp(rz_cut.data(), rz.data(), static_cast<std::size_t>(S) * sizeof(float)));
+      if (finish == SF_FACTOR_FINISH_NONE) {
+        EXPECT_THROW(device_solve(r, S, inactive, true, kFactorLoopTurns, false, nullptr, springs, nullptr, nullptr,
+                                  finish, nullptr, nullptr, false),
+                     std::logic_error);
+      } else {
+        std::vector<float> d_no_z, rz_no_z;
+        const std::vector<float> no_z = device_solve(r, S, inactive, true, kFactorLoopTurns, false, nullptr, springs,
+                                                     nullptr, nullptr, finish, &d_no_z, &rz_no_z, false);
+        EXPECT_EQ(0, std::memcmp(d_no_z.data(), d.data(), size * sizeof(float)));
+        EXPECT_EQ(0, std::memcmp(rz_no_z.data(), rz.data(), static_cast<std::size_t>(S) * sizeof(float)));
+        EXPECT_TRUE(std::all_of(no_z.begin(), no_z.end(), [](float v) { return v == untouched; }));
+      }
       for (int s = 0; s < S; ++s) {
         const float rz_before = static_cast<float>(1 + s);
         double sum = 0.0;
