@@ -12,7 +12,7 @@
  * factor: 2334 blocks for 26 088 entries; bench/RESULTS.md, stop 55). Both substitutions read,
  * never scatter: L y = P r by block rows (y_q = T_q^-1 ((P r)_q - sum_p<q L_qp y_p)) and
  * L^T w = y by block columns (w_p = T_p^-T (y_p - sum_q>p L_qp^T w_q)), each w_p also stored
- * as z at its original rows. Between them, the correction for the sigma point's own springs
+ * as z at its original rows (unless SF_FACTOR_STORES_Z is 0, below). Between them, the correction for the sigma point's own springs
  * (SpringCorrection, host/reference/spring_correction.h; OpenCL's SF_SPRING_ROWS): y -= V H_s
  * V^T y at the slots V reaches, with V^T y and H_s V^T y kept in slots 4 P .. 4 P + 2M - 1.
  *
