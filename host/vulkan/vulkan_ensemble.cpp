@@ -42,13 +42,17 @@ int cg_lane_rows(int lanes_from, int sigma_count, const VulkanDeviceInfo& info, 
   return rows;
 }
 
-long long cg_loop_turns(const Model& model, int row_step, int partitions) {
-  const int nodes = model.node_count();
-  std::vector<long long> turns(static_cast<std::size_t>(nodes), kCgNodeTurns);
+std::vector<long long> cg_node_turns(const Model& model) {
+  std::vector<long long> turns(static_cast<std::size_t>(model.node_count()), kCgNodeTurns);
   for (const ElementRest& element : model.elements)
     for (const int n : element.nodes) ++turns[static_cast<std::size_t>(n)];
   for (const SpringSet& ligament : model.ligaments)
     for (const int n : ligament.nodes) ++turns[static_cast<std::size_t>(n)];
+  return turns;
+}
+
+long long cg_loop_turns(const std::vector<long long>& turns, int row_step, int partitions) {
+  const int nodes = static_cast<int>(turns.size());
   const int step = std::max(1, row_step);
   // Partition p's nodes as conjugate_gradient.comp's sf_partition_nodes cuts them.
   const int size = (nodes + std::max(1, partitions) - 1) / std::max(1, partitions);
@@ -61,6 +65,10 @@ long long cg_loop_turns(const Model& model, int row_step, int partitions) {
     busiest = std::max(busiest, total);
   }
   return busiest;
+}
+
+long long cg_loop_turns(const Model& model, int row_step, int partitions) {
+  return cg_loop_turns(cg_node_turns(model), row_step, partitions);
 }
 
 VulkanEnsemble::VulkanEnsemble(const Model& model, EstimatedParameters estimated,
@@ -124,8 +132,9 @@ VulkanEnsemble::VulkanEnsemble(const Model& model, EstimatedParameters estimated
   // Within llvmpipe's loop turns (cg_loop_turns): lanes over sigma points give way to a group a
   // sigma point (or a partition), which grows until its lanes' share of the nodes fits (128
   // invocations a group, Vulkan's least maximum, at most).
-  if (cg_lane_rows_ > 0 && cg_loop_turns(model_, cg_lane_rows_) > options.cg_loop_turns) cg_lane_rows_ = 0;
-  auto group_turns = [&] { return cg_loop_turns(model_, static_cast<int>(cg_group_), cg_partitions_); };
+  const std::vector<long long> node_turns = cg_node_turns(model_);   // once: the doublings reuse it
+  if (cg_lane_rows_ > 0 && cg_loop_turns(node_turns, cg_lane_rows_) > options.cg_loop_turns) cg_lane_rows_ = 0;
+  auto group_turns = [&] { return cg_loop_turns(node_turns, static_cast<int>(cg_group_), cg_partitions_); };
   while (cg_lane_rows_ == 0 && group_turns() > options.cg_loop_turns) {
     if (cg_group_ >= 128)
       throw DeviceError("the mesh's " + std::to_string(nodes_) + " nodes are too many for Vulkan's CG with " +
@@ -156,8 +165,8 @@ VulkanEnsemble::VulkanEnsemble(const Model& model, EstimatedParameters estimated
                                              info.max_texel_elements));
 
   using B = DeviceBuffer;
-  auto kernel = [&](const char* name, DeviceKernel k) {
-    return device_.kernel(name, static_cast<int>(kernel_buffers(k).size()));
+  auto kernel = [&](const char* name, DeviceKernel k, const std::vector<std::uint32_t>& constants = {}) {
+    return device_.kernel(name, static_cast<int>(kernel_buffers(k).size()), constants);
   };
   // The element and node shaders four sigma points a lane on a CPU device
   // (kernels/vulkan/sigma_quads.h), where S allows.
@@ -166,9 +175,8 @@ VulkanEnsemble::VulkanEnsemble(const Model& model, EstimatedParameters estimated
   const std::string rhs_form = std::string(sigma_quads_ ? "_quads" : "") + (factor_ ? "_factor" : "");
   // The rotation method as element_rhs's specialization constant 0 (a branch llvmpipe would run
   // both sides of, read from the step constants).
-  k_element_rhs_ = device_.kernel(("element_rhs" + rhs_form).c_str(),
-                                  static_cast<int>(kernel_buffers(DeviceKernel::element_rhs).size()),
-                                  {model_.material.rotation == ElementRotation::polar ? 1u : 0u});
+  k_element_rhs_ = kernel(("element_rhs" + rhs_form).c_str(), DeviceKernel::element_rhs,
+                          {model_.material.rotation == ElementRotation::polar ? 1u : 0u});
   k_node_rhs_ = kernel(("node_rhs" + rhs_form).c_str(), DeviceKernel::node_rhs);
   k_element_product_ =
       kernel(sigma_quads_ ? "element_product_quads" : "element_product", DeviceKernel::element_product);

@@ -73,6 +73,10 @@ int cg_lane_rows(int lanes_from, int sigma_count, const VulkanDeviceInfo& info, 
 // lanes a sigma point, ~115 000 turns) started from a residual with its last rows never written.
 constexpr long long kCgNodeTurns = 8;
 long long cg_loop_turns(const Model& model, int row_step, int partitions = 1);
+// The same from each node's turns (cg_node_turns: its corners, ligaments and kCgNodeTurns), made
+// once where several steps are tried.
+std::vector<long long> cg_node_turns(const Model& model);
+long long cg_loop_turns(const std::vector<long long>& node_turns, int row_step, int partitions = 1);
 
 class VulkanEnsemble : public DeviceEnsemble {
  public:
