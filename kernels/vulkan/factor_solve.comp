@@ -12,9 +12,10 @@
  * factor: 2334 blocks for 26 088 entries; bench/RESULTS.md, stop 55). Both substitutions read,
  * never scatter: L y = P r by block rows (y_q = T_q^-1 ((P r)_q - sum_p<q L_qp y_p)) and
  * L^T w = y by block columns (w_p = T_p^-T (y_p - sum_q>p L_qp^T w_q)), each w_p also stored
- * as z at its original rows (unless SF_FACTOR_STORES_Z is 0, below). Between them, the correction for the sigma point's own springs
- * (SpringCorrection, host/reference/spring_correction.h; OpenCL's SF_SPRING_ROWS): y -= V H_s
- * V^T y at the slots V reaches, with V^T y and H_s V^T y kept in slots 4 P .. 4 P + 2M - 1.
+ * as z at its original rows (unless SF_FACTOR_STORES_Z is 0, below). Between them, the
+ * correction for the sigma point's own springs (SpringCorrection,
+ * host/reference/spring_correction.h; OpenCL's SF_SPRING_ROWS): y -= V H_s V^T y at the slots
+ * V reaches, with V^T y and H_s V^T y kept in slots 4 P .. 4 P + 2M - 1.
  *
  * llvmpipe ends every loop of an invocation, silently, once its loops together have turned
  * 65535 times (gallivm's LP_MAX_TGSI_LOOP_ITERATIONS; bench/RESULTS.md, stop 52). So the
@@ -55,7 +56,8 @@ layout(local_size_x_id = 0) in;
 layout(constant_id = 1) const uint SF_FACTOR_PANELS = 1u;
 /* Whether z is stored (1), or only CG's d and r.z from it (0: the ensemble's solves, which
  * always finish CG's step; llvmpipe loops over the lanes for every store it compiles, taken or
- * not, and left out the solve took 2-3% less: bench/RESULTS.md, stop 60). */
+ * not: left out, the 4768 liver's solve at S = 16 took 1098-1236 us against 1202-1410;
+ * bench/RESULTS.md, stop 60). */
 layout(constant_id = 2) const uint SF_FACTOR_STORES_Z = 1u;
 
 SF_READ_INTS(SF_FACTOR_SOLVE_FORWARD_STARTS, forward_starts)
