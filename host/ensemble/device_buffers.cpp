@@ -120,7 +120,7 @@ std::vector<DeviceBufferSpec> device_buffer_specs(const Model& model, const Obse
       reals_of(B::dv, "velocity change", std::vector<double>(dof, 0.0)),
       reals(B::rhs, "CG vectors", dof),
       reals(B::inverse_diagonal, "CG vectors", sizes.jacobi_diagonals ? dof : 1),
-      reals(B::r, "CG vectors", dof), reals(B::z, "CG vectors", dof),
+      reals(B::r, "CG vectors", dof), reals(B::z, "CG vectors", sizes.cg_z ? dof : 1),
       reals(B::d, "CG vectors", dof), reals(B::q, "CG vectors", dof),
       reals(B::frames, "element frames", 9 * per_element),
       reals(B::element_out, "element outputs", std::max(12 * per_element, sizes.element_out)),

@@ -77,6 +77,9 @@ struct DeviceBufferSizes {
   // Jacobi's diagonals (element_diagonal, inverse_diagonal: 12 E S + 3 N S reals); false with a
   // factor, whose kernels leave them out (*_factor, SF_FACTOR): one element each.
   bool jacobi_diagonals = true;
+  // CG's z (3 N S reals); false with Vulkan's factor, whose solve finishes CG's step (r.z and
+  // the direction) without storing z, and whose CG shaders (SF_FACTOR) leave it out: one element.
+  bool cg_z = true;
 };
 
 // Every buffer of an ensemble of `model` with S sigma points, in DeviceBuffer order. The

@@ -43,7 +43,8 @@ enum class FactorStorage { columns, blocks };
 
 // Device memory of an ensemble, in bytes, for `real_size`-byte reals; with a shared factor of
 // `factor_nonzeros` nonzeros (OpenCL's CPU form, Vulkan on a CPU device), its buffers too, and
-// without Jacobi's diagonals (DeviceBufferSizes::jacobi_diagonals).
+// without Jacobi's diagonals (DeviceBufferSizes::jacobi_diagonals), and with Vulkan's blocks
+// without z (DeviceBufferSizes::cg_z).
 struct EnsembleMemory {
   std::size_t total = 0;     // about: all buffers
   std::size_t largest = 0;   // the largest single buffer (12 per element and sigma point, or L)

@@ -144,10 +144,11 @@ VulkanEnsemble::VulkanEnsemble(const Model& model, EstimatedParameters estimated
     cg_group_ *= 2;
   }
 
-  // The partitions' buffers are bound but unused with one partition; Jacobi's diagonals with
-  // the factor (its *_factor shaders leave them out).
+  // The partitions' buffers are bound but unused with one partition; Jacobi's diagonals and z
+  // with the factor (its *_factor shaders and its solve leave them out).
   DeviceBufferSizes sizes{0, cg_partitions_};
   sizes.jacobi_diagonals = factor_ == nullptr;
+  sizes.cg_z = factor_ == nullptr;
   std::size_t largest = 0;
   for (const DeviceBufferSpec& spec : buffer_specs(sizes)) {
     const std::size_t bytes = take_device_bytes(spec, device_.real_size());
