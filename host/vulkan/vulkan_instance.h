@@ -91,9 +91,9 @@ struct VulkanApi {
   // Loads the instance-level functions (device functions too, through the loader's
   // trampolines) for `instance`.
   void load(VkInstance instance) {
-#define SF_LOAD(name) name = reinterpret_cast<PFN_##name>(vkGetInstanceProcAddr(instance, #name));
-    SF_VULKAN_INSTANCE_FUNCTIONS(SF_LOAD)
-#undef SF_LOAD
+#define SF_LOAD_FUNCTION(name) name = reinterpret_cast<PFN_##name>(vkGetInstanceProcAddr(instance, #name));
+    SF_VULKAN_INSTANCE_FUNCTIONS(SF_LOAD_FUNCTION)
+#undef SF_LOAD_FUNCTION
     vkCreateDebugUtilsMessengerEXT = reinterpret_cast<PFN_vkCreateDebugUtilsMessengerEXT>(
         vkGetInstanceProcAddr(instance, "vkCreateDebugUtilsMessengerEXT"));
     vkDestroyDebugUtilsMessengerEXT = reinterpret_cast<PFN_vkDestroyDebugUtilsMessengerEXT>(
