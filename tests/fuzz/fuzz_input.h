@@ -12,9 +12,12 @@
 #include <filesystem>
 #include <fstream>
 #include <string>
+#include <system_error>
 
 namespace sigmafem::fuzz {
 
+// The folder, made at the first input and removed when the process exits normally (libFuzzer
+// exits so at the end of its time; a crash leaves it, with the input that crashed).
 inline const std::filesystem::path& work_folder() {
   static const std::filesystem::path folder = [] {
     const std::filesystem::path path =
@@ -24,6 +27,12 @@ inline const std::filesystem::path& work_folder() {
       std::filesystem::copy_file(mesh, path / "box.msh", std::filesystem::copy_options::overwrite_existing);
     return path;
   }();
+  // Registered after `folder` is made, so it runs before `folder` is destroyed.
+  static const int removed_at_exit = std::atexit([] {
+    std::error_code ignored;
+    std::filesystem::remove_all(work_folder(), ignored);
+  });
+  (void)removed_at_exit;
   return folder;
 }
 
