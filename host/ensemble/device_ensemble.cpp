@@ -7,6 +7,7 @@
 #include "host/common/device_error.h"
 #include "host/ensemble/device_limits.h"
 #include "host/ensemble/device_readout.h"
+#include "host/model/shared_element.h"
 
 namespace sigmafem {
 
@@ -217,7 +218,10 @@ Eigen::VectorXd DeviceEnsemble::velocities(int s) const {
 }
 
 std::vector<double> DeviceEnsemble::frames(int s) const {
-  return column_of(DeviceBuffer::frames, 9 * static_cast<std::size_t>(elements_), s);
+  std::vector<double> frames = column_of(DeviceBuffer::frames, 9 * static_cast<std::size_t>(elements_), s);
+  if (frames_keep_two_rows_)
+    for (std::size_t at = 0; at < frames.size(); at += 9) shared::sf_frame_third_row(&frames[at]);
+  return frames;
 }
 
 Eigen::MatrixXd DeviceEnsemble::system_product(const Eigen::MatrixXd& d) {

@@ -155,6 +155,9 @@ class DeviceEnsemble : public SimulationEnsemble {
   std::size_t device_memory_ = 0;   // check_device_memory's `memory` and `name`
   std::string device_name_;
   int expected_iterations_ = 1;   // CG iterations the last step needed (at most)
+  // Whether the kernels keep only each frame's first two rows (Vulkan: kernels/vulkan/
+  // ensemble_layout.h's SF_FRAME_ROWS_KEPT); frames() then makes the third as they do.
+  bool frames_keep_two_rows_ = false;
   const char* backend_;
   const char* who_;
 

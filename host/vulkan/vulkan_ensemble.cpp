@@ -149,6 +149,7 @@ VulkanEnsemble::VulkanEnsemble(const Model& model, EstimatedParameters estimated
   DeviceBufferSizes sizes{0, cg_partitions_};
   sizes.jacobi_diagonals = factor_ == nullptr;
   sizes.cg_z = factor_ == nullptr;
+  frames_keep_two_rows_ = true;   // element_rhs stores two rows of each frame (ensemble_layout.h)
   std::size_t largest = 0;
   for (const DeviceBufferSpec& spec : buffer_specs(sizes)) {
     const std::size_t bytes = take_device_bytes(spec, device_.real_size());

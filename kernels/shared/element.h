@@ -55,6 +55,15 @@ SF_FN void sf_element_frame(SF_IN(p, 12), SF_OUT(frame, 9)) {
   }
 }
 
+/* A frame's third row from its first two, z = x cross y: the QR and the polar frames are both
+ * right-handed and orthonormal (to rounding). For back ends that keep two rows of each frame
+ * (Vulkan: kernels/vulkan/ensemble_layout.h's SF_FRAME_ROWS_KEPT). */
+SF_FN void sf_frame_third_row(SF_INOUT(frame, 9)) {
+  frame[6] = frame[1] * frame[5] - frame[2] * frame[4];
+  frame[7] = frame[2] * frame[3] - frame[0] * frame[5];
+  frame[8] = frame[0] * frame[4] - frame[1] * frame[3];
+}
+
 /* y_c = F^T S grad_c for the four corners, with S = V sigma(H) and H = F G (file comment).
  * `G` is sum_c v_c grad_c^T in world-by-rest-frame coordinates; `identity_shift` is 1 when
  * G comes from positions (the rest shape is subtracted: H - I is the co-rotational strain's

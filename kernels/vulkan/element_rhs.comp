@@ -1,7 +1,8 @@
 /* element_rhs: the rotation step and each element's part of the implicit Euler right-hand
  * side and of the Jacobi diagonal, per sigma point (as kernels/opencl/element_rhs.cl):
- *   frame  = the element's frame at x      (QR or polar, element.h; stored: every CG
- *                                           product of the step uses it)
+ *   frame  = the element's frame at x      (QR or polar, element.h; its first two rows
+ *                                           stored, ensemble_layout.h: every CG product of
+ *                                           the step uses it)
  *   rhs_e  = f_e(x) - (h + a) K_e v_e
  *   diag_e = diag(R K_e R^T)
  * One invocation per (element, sigma); or, compiled with SF_SIGMA_QUADS (element_rhs_quads),
@@ -46,7 +47,8 @@ void main() {
   SF_REAL product[12];
   SF_GATHER_CORNER_QUADS(x, corner_nodes, q, Q, corner)
   sf_element_rotation(grad, corner, SF_REAL(SF_POLAR_FRAMES), frame);
-  SF_STORE_ITEM_QUADS(frames, e, 9u, q, Q, frame)
+  sf_frame_third_row(frame);   /* as element_product will make it (ensemble_layout.h) */
+  SF_STORE_KEPT_FRAME_QUADS(frames, e, q, Q, frame)
   sf_element_force(frame, grad, sigma_lambda, sigma_mu, corner, force);
   SF_GATHER_CORNER_QUADS(v, corner_nodes, q, Q, corner)
   sf_element_product(frame, grad, sigma_lambda, sigma_mu, corner, product);
@@ -88,7 +90,8 @@ void main() {
   real product[12];
   SF_GATHER_CORNERS(x, corner_nodes, s, S, corner)
   sf_element_rotation(grad, corner, real(SF_POLAR_FRAMES), frame);
-  SF_STORE_FRAME(frames, e, s, S, frame)
+  sf_frame_third_row(frame);   /* as element_product will make it (ensemble_layout.h) */
+  SF_STORE_KEPT_FRAME(frames, e, s, S, frame)
   sf_element_force(frame, grad, sigma_lambda, sigma_mu, corner, force);
   SF_GATHER_CORNERS(v, corner_nodes, s, S, corner)
   sf_element_product(frame, grad, sigma_lambda, sigma_mu, corner, product);

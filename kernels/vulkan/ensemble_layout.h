@@ -30,6 +30,19 @@
 /* GLSL has no typedef. */
 #define real SF_SCALAR
 
+/* Vulkan keeps an element's frame as its first two rows, 6 of device_layout.h's 9 numbers: a
+ * storage-buffer store costs llvmpipe a loop over its lanes (without the third row's stores
+ * element_rhs took ~12% less on the 4768 liver at S = 16; bench/RESULTS.md, stop 61), and the
+ * third row is their cross product (sf_frame_third_row), made again where a frame is read.
+ * element_rhs makes its frame so before using it too: every shader of a step sees the same one. */
+#define SF_FRAME_ROWS_KEPT 6u
+#define SF_LOAD_KEPT_FRAME(frames, e, s, S, frame)                                          \
+  SF_UNROLL for (uint i_ = 0u; i_ < SF_FRAME_ROWS_KEPT; ++i_)                               \
+    frame[i_] = SF_LOAD(frames, (9u * (e) + i_) * (S) + (s));                               \
+  sf_frame_third_row(frame);
+#define SF_STORE_KEPT_FRAME(frames, e, s, S, frame) \
+  SF_UNROLL for (uint i_ = 0u; i_ < SF_FRAME_ROWS_KEPT; ++i_) frames[(9u * (e) + i_) * (S) + (s)] = frame[i_];
+
 /* The arrays a shader only reads, declared with SF_READ_REALS/INTS/UINTS(binding, name) and
  * read with SF_LOAD(name, index) (dialect.h): storage buffers, or, in the shaders compiled
  * with SF_TEXEL_READS (the CPU form, for lavapipe), uniform texel buffers. llvmpipe turns

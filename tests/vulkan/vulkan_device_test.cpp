@@ -3,6 +3,7 @@
 // and the validation layer, where it is installed, reporting nothing on a whole filter cycle.
 #include "host/vulkan/vulkan_device.h"
 
+#include <Eigen/LU>
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -154,7 +155,17 @@ TEST_F(VulkanDeviceTest, AFilterCycleRunsCleanly) {
     ensemble.predicted_observations(y);
     EXPECT_TRUE(y.allFinite());
     EXPECT_TRUE(ensemble.positions(0).allFinite());
-    EXPECT_EQ(static_cast<int>(ensemble.frames(S - 1).size()), 9 * model.element_count());
+    const std::vector<double> frames = ensemble.frames(S - 1);
+    EXPECT_EQ(static_cast<int>(frames.size()), 9 * model.element_count());
+    // Each a rotation, the third row too, which the shaders do not keep (frames() makes it as
+    // they do): rows orthonormal to float32 rounding, determinant +1.
+    double worst = 0.0;
+    for (std::size_t at = 0; at < frames.size(); at += 9) {
+      const Eigen::Map<const Eigen::Matrix<double, 3, 3, Eigen::RowMajor>> F(&frames[at]);
+      worst = std::max({worst, (F * F.transpose() - Eigen::Matrix3d::Identity()).cwiseAbs().maxCoeff(),
+                        std::abs(F.determinant() - 1.0)});
+    }
+    EXPECT_LT(worst, 1e-5) << "run " << run;
     const Eigen::MatrixXd Ad = ensemble.system_product(Eigen::MatrixXd::Ones(model.dof_count(), S));
     EXPECT_TRUE(Ad.allFinite());
   }
