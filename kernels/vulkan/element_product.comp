@@ -41,7 +41,7 @@ void main() {
   SF_REAL frame[9];
   SF_REAL corner[12];
   SF_REAL product[12];
-  SF_LOAD_KEPT_FRAME_QUADS(frames, e, q, Q, frame)
+  SF_LOAD_KEPT_FRAME(SF_QUAD, frames, e, q, Q, frame)
   SF_GATHER_CORNER_QUADS(d, corner_nodes, q, Q, corner)
   sf_element_product(frame, grad, sigma_lambda, sigma_mu, corner, product);
   SF_STORE_ITEM_QUADS(element_out, e, 12u, q, Q, product)
@@ -73,7 +73,7 @@ void main() {
   real frame[9];
   real corner[12];
   real product[12];
-  SF_LOAD_KEPT_FRAME(frames, e, s, S, frame)
+  SF_LOAD_KEPT_FRAME(SF_LOAD, frames, e, s, S, frame)
   SF_GATHER_CORNERS(d, corner_nodes, s, S, corner)
   sf_element_product(frame, grad, sigma_lambda, sigma_mu, corner, product);
   SF_STORE_CORNERS(element_out, e, s, S, product)

@@ -48,7 +48,7 @@ void main() {
   SF_GATHER_CORNER_QUADS(x, corner_nodes, q, Q, corner)
   sf_element_rotation(grad, corner, SF_REAL(SF_POLAR_FRAMES), frame);
   sf_frame_third_row(frame);   /* as element_product will make it (ensemble_layout.h) */
-  SF_STORE_KEPT_FRAME_QUADS(frames, e, q, Q, frame)
+  SF_STORE_KEPT_FRAME(frames, e, q, Q, frame)
   sf_element_force(frame, grad, sigma_lambda, sigma_mu, corner, force);
   SF_GATHER_CORNER_QUADS(v, corner_nodes, q, Q, corner)
   sf_element_product(frame, grad, sigma_lambda, sigma_mu, corner, product);

@@ -51,14 +51,6 @@
   SF_UNROLL for (uint i_ = 0u; i_ < (N); ++i_) values[i_] = SF_QUAD(in, ((N) * (e) + i_) * (Q) + (q));
 #define SF_STORE_ITEM_QUADS(out, e, N, q, Q, values) \
   SF_UNROLL for (uint i_ = 0u; i_ < (N); ++i_) out[((N) * (e) + i_) * (Q) + (q)] = values[i_];
-/* The kept rows of element e's frame (ensemble_layout.h's SF_FRAME_ROWS_KEPT) for quad q, loaded
- * with the third row made again, and stored. */
-#define SF_LOAD_KEPT_FRAME_QUADS(frames, e, q, Q, frame)                                 \
-  SF_UNROLL for (uint i_ = 0u; i_ < SF_FRAME_ROWS_KEPT; ++i_)                            \
-    frame[i_] = SF_QUAD(frames, (9u * (e) + i_) * (Q) + (q));                            \
-  sf_frame_third_row(frame);
-#define SF_STORE_KEPT_FRAME_QUADS(frames, e, q, Q, frame) \
-  SF_UNROLL for (uint i_ = 0u; i_ < SF_FRAME_ROWS_KEPT; ++i_) frames[(9u * (e) + i_) * (Q) + (q)] = frame[i_];
 /* A per-dof array's quads at an element's four corners. */
 #define SF_GATHER_CORNER_QUADS(v, corner_nodes, q, Q, out)                            \
   SF_UNROLL for (uint c_ = 0u; c_ < 4u; ++c_)                                         \
