@@ -28,15 +28,21 @@ DeviceEnsemble::DeviceEnsemble(const Model& model, EstimatedParameters estimated
   check_ensemble_arguments(model, estimated_, observed_, S_, who);
 }
 
-void DeviceEnsemble::check_device_memory(std::size_t real_size, const std::string& name,
-                                         std::size_t memory, std::size_t largest_buffer,
-                                         std::size_t factor_nonzeros, FactorStorage storage, int factor_copies) {
+void DeviceEnsemble::check_device_memory(const std::string& name, std::size_t memory,
+                                         std::size_t largest_buffer, const DeviceOptions& options) {
+  device_memory_ = usable_device_memory(memory, options);
+  largest_buffer_ = largest_buffer;
+  device_name_ = memory_holder(name, memory, options);
+  check_device_memory_with_factor(0, FactorStorage::columns);
+}
+
+void DeviceEnsemble::check_device_memory_with_factor(std::size_t factor_nonzeros, FactorStorage storage,
+                                                     int factor_copies) const {
   const EnsembleMemory need =
-      ensemble_memory(nodes_, elements_, S_, real_size, factor_nonzeros, storage, factor_copies);
-  if (need.largest > largest_buffer || need.total > memory)
-    throw DeviceError(out_of_device_memory_message(need, elements_, S_, name, memory, largest_buffer));
-  device_memory_ = memory;
-  device_name_ = name;
+      ensemble_memory(nodes_, elements_, S_, real_size(precision_), factor_nonzeros, storage, factor_copies);
+  if (need.largest > largest_buffer_ || need.total > device_memory_)
+    throw DeviceError(
+        out_of_device_memory_message(need, elements_, S_, device_name_, device_memory_, largest_buffer_));
 }
 
 void DeviceEnsemble::check_more_device_memory(std::size_t more, const std::string& what) const {

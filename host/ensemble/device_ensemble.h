@@ -61,12 +61,15 @@ class DeviceEnsemble : public SimulationEnsemble {
   DeviceEnsemble(const Model& model, EstimatedParameters estimated, ObservedPoints observed,
                  int sigma_count, Precision precision, const char* backend, const char* who);
 
-  // Throws DeviceError when the ensemble needs more than `memory` bytes, or a buffer larger
-  // than `largest_buffer`, of device `name` (with a shared factor's buffers, ensemble_memory);
-  // keeps `memory` and `name` for check_more_device_memory.
-  void check_device_memory(std::size_t real_size, const std::string& name, std::size_t memory,
-                           std::size_t largest_buffer, std::size_t factor_nonzeros = 0,
-                           FactorStorage storage = FactorStorage::columns, int factor_copies = 1);
+  // Throws DeviceError when the ensemble needs more than `memory` bytes (or what
+  // options.device_memory holds it to), or a buffer larger than `largest_buffer`, of device
+  // `name` (ensemble_memory); keeps the device's figures for the checks below.
+  void check_device_memory(const std::string& name, std::size_t memory, std::size_t largest_buffer,
+                           const DeviceOptions& options);
+  // The same check, on the device check_device_memory was given, with a shared factor's
+  // buffers too.
+  void check_device_memory_with_factor(std::size_t factor_nonzeros, FactorStorage storage,
+                                       int factor_copies = 1) const;
   // Throws DeviceError when `more` bytes of buffers for `what`, made after the ensemble's own
   // (a multigrid hierarchy, known at its first making), would take the ensemble past the
   // memory check_device_memory was given.
@@ -152,7 +155,8 @@ class DeviceEnsemble : public SimulationEnsemble {
   StepConstants step_constants_;  // per step, with the per-sigma effects
   std::vector<double> ligament_k_;   // per ligament and sigma, N/m per node: [l S + s]
   std::size_t device_bytes_ = 0;
-  std::size_t device_memory_ = 0;   // check_device_memory's `memory` and `name`
+  // check_device_memory's device: its usable memory, largest buffer and name for messages.
+  std::size_t device_memory_ = 0, largest_buffer_ = 0;
   std::string device_name_;
   int expected_iterations_ = 1;   // CG iterations the last step needed (at most)
   // Whether the kernels keep only each frame's first two rows (Vulkan: kernels/vulkan/

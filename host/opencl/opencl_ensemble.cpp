@@ -42,8 +42,7 @@ OpenClEnsemble::OpenClEnsemble(const Model& model, EstimatedParameters estimated
   // Check the memory before asking for it, to say how much is needed (the factor's buffers,
   // when there is one, once it is analysed below).
   const OpenClDeviceInfo& info = device_.info();
-  check_device_memory(device_.real_size(), memory_holder(info.name, info.global_memory, options),
-                      usable_device_memory(info.global_memory, options), info.max_allocation);
+  check_device_memory(info.name, info.global_memory, info.max_allocation, options);
 
   // The CPU form or the GPU form of the kernels (DeviceOptions::kernel_form): the device's
   // type decides unless a test forces one.
@@ -122,9 +121,7 @@ OpenClEnsemble::OpenClEnsemble(const Model& model, EstimatedParameters estimated
     }
     // Again with the factor's buffers (L alone is 125 MB on the 38k liver; the copies of its
     // values add at most own_factors_bytes).
-    check_device_memory(device_.real_size(), memory_holder(info.name, info.global_memory, options),
-                        usable_device_memory(info.global_memory, options), info.max_allocation,
-                        factor_->nonzeros(), FactorStorage::columns, factor_copies_);
+    check_device_memory_with_factor(factor_->nonzeros(), FactorStorage::columns, factor_copies_);
     // The copies in the layout of the blocks that solve with them (conjugate_gradient.cl): cg_solve's
     // blocks of their own vectors one after the other, else all S interleaved.
     factor_block_ = whole_solve_ && solve_block_ < S_ ? solve_block_ : S_;

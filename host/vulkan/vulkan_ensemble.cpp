@@ -80,8 +80,7 @@ VulkanEnsemble::VulkanEnsemble(const Model& model, EstimatedParameters estimated
               static_cast<long long>(model.element_count()) * sigma_count < options.lavapipe_serial_work) {
   // Check the memory before asking for it, to say how much is needed.
   const VulkanDeviceInfo& info = device_.info();
-  check_device_memory(device_.real_size(), memory_holder(info.name, info.memory, options),
-                      usable_device_memory(info.memory, options), info.max_buffer);
+  check_device_memory(info.name, info.memory, info.max_buffer, options);
   // CG's work-groups per sigma point (conjugate_gradient.comp): by the mesh on a GPU, one on
   // a CPU (lavapipe), where S groups already keep its few cores busy, unless a test forces it.
   cg_partitions_ = info.type == "cpu" && options.cg_partitions == 0
@@ -123,9 +122,7 @@ VulkanEnsemble::VulkanEnsemble(const Model& model, EstimatedParameters estimated
     if (cg_partitions_ == 1) {
       springs_ = spring_correction(options.spring_correction);   // as OpenCL's
       factor_ = analysed_factor(springs_);   // their rows last, as OpenCL's
-      check_device_memory(device_.real_size(), memory_holder(info.name, info.memory, options),
-                          usable_device_memory(info.memory, options), info.max_buffer, factor_->nonzeros(),
-                          FactorStorage::blocks);
+      check_device_memory_with_factor(factor_->nonzeros(), FactorStorage::blocks);
     }
   }
   cg_lane_rows_ = sigmafem::cg_lane_rows(options.cg_sigma_lanes_from, S_, info, !cg_partitioned_, factor_ != nullptr);
