@@ -39,6 +39,7 @@ struct Backend {
   KernelForm kernel_form = KernelForm::automatic;
   bool spring_correction = true;   // OpenCL's shared factor corrected for the sigma points' springs
   long long node_iteration_work = kNodeIterationWork;   // Vulkan: CG in two dispatches up to it
+  int cg_sigma_lanes = 0;   // OpenCL's GPU form: sigma points side by side in a CG group (0: chosen)
 };
 
 // The CPU back end with its default preconditioner (factors: one per sigma point within
@@ -81,6 +82,12 @@ const Backend kOpenClUncorrectedFactor{"opencl", Precision::single,
 // multigrid V-cycle on the refinements that made the mesh (stop 54), its default there.
 const Backend kOpenClGpuForm{"opencl", Precision::single, "opencl single, device 0, GPU form, Jacobi",
                              SolveLaunch::automatic, Preconditioner::jacobi, false, 0, KernelForm::gpu};
+// The GPU form's CG with a sigma point a group, as before stop 62's sigma lanes (CgGroups): a
+// warp's work-items each read their own sector (on a GPU the A/B of bench/gpu_checks.sh).
+const Backend kOpenClGpuFormOneLane{"opencl", Precision::single,
+                                    "opencl single, device 0, GPU form, Jacobi, CG a lane a group",
+                                    SolveLaunch::automatic, Preconditioner::jacobi, false, 0, KernelForm::gpu,
+                                    true, kNodeIterationWork, 1};
 const Backend kOpenClMultigrid{"opencl", Precision::single, "opencl single, device 0, GPU form, multigrid",
                                SolveLaunch::automatic, Preconditioner::multigrid, false, 0, KernelForm::gpu};
 // Vulkan with the multigrid V-cycle (asked: on lavapipe the factor is the default; on a GPU
@@ -127,6 +134,7 @@ DeviceOptions device_options(const Backend& backend) {
   if (backend.shared_factor) options.own_factors_bytes = 0;
   options.spring_correction = backend.spring_correction;
   options.node_iteration_work = backend.node_iteration_work;
+  options.cg_sigma_lanes = backend.cg_sigma_lanes;
   return options;
 }
 
@@ -431,13 +439,21 @@ BENCHMARK_CAPTURE(BM_ensemble_step, opencl_factorised_box_large_117240, kOpenClF
 // The GPU form's preconditioners side by side on the refined meshes (on PoCL, forced).
 BENCHMARK_CAPTURE(BM_ensemble_step, opencl_gpu_form_liver_4768, kOpenClGpuForm, std::string("liver"), 1)
     ->Arg(4)->Arg(16)->Unit(benchmark::kMillisecond)->UseRealTime();
+BENCHMARK_CAPTURE(BM_ensemble_step, opencl_gpu_form_one_lane_liver_4768, kOpenClGpuFormOneLane, std::string("liver"), 1)
+    ->Arg(4)->Arg(16)->Unit(benchmark::kMillisecond)->UseRealTime();
 BENCHMARK_CAPTURE(BM_ensemble_step, opencl_multigrid_liver_4768, kOpenClMultigrid, std::string("liver"), 1)
     ->Arg(4)->Arg(16)->Unit(benchmark::kMillisecond)->UseRealTime();
 BENCHMARK_CAPTURE(BM_ensemble_step, opencl_gpu_form_liver_fine_38144, kOpenClGpuForm, std::string("liver_fine"), 0)
     ->Arg(16)->Arg(64)->Unit(benchmark::kMillisecond)->UseRealTime();
+BENCHMARK_CAPTURE(BM_ensemble_step, opencl_gpu_form_one_lane_liver_fine_38144, kOpenClGpuFormOneLane,
+                  std::string("liver_fine"), 0)
+    ->Arg(16)->Arg(64)->Unit(benchmark::kMillisecond)->UseRealTime();
 BENCHMARK_CAPTURE(BM_ensemble_step, opencl_multigrid_liver_fine_38144, kOpenClMultigrid, std::string("liver_fine"), 0)
     ->Arg(16)->Arg(64)->Unit(benchmark::kMillisecond)->UseRealTime();
 BENCHMARK_CAPTURE(BM_ensemble_step, opencl_gpu_form_box_large_117240, kOpenClGpuForm, std::string("box_large"), 0)
+    ->Arg(16)->Arg(64)->Unit(benchmark::kMillisecond)->UseRealTime();
+BENCHMARK_CAPTURE(BM_ensemble_step, opencl_gpu_form_one_lane_box_large_117240, kOpenClGpuFormOneLane,
+                  std::string("box_large"), 0)
     ->Arg(16)->Arg(64)->Unit(benchmark::kMillisecond)->UseRealTime();
 BENCHMARK_CAPTURE(BM_ensemble_step, opencl_multigrid_box_large_117240, kOpenClMultigrid, std::string("box_large"), 0)
     ->Arg(16)->Arg(64)->Unit(benchmark::kMillisecond)->UseRealTime();

@@ -37,6 +37,28 @@ int cg_partitions(int nodes, int forced) {
   return std::clamp(3 * nodes / kPartitionRows, 1, kMostPartitions);
 }
 
+CgGroups cg_groups(int nodes, int S, std::size_t real_size, int group_size, int forced_partitions,
+                   int forced_lanes) {
+  CgGroups groups;
+  groups.partitions = cg_partitions(nodes, forced_partitions);
+  if (forced_lanes > 0) {
+    if (forced_lanes > group_size || group_size % forced_lanes != 0 || (forced_lanes & (forced_lanes - 1)) != 0)
+      throw std::invalid_argument("cg_sigma_lanes: " + std::to_string(forced_lanes) +
+                                  " is not a power of two that divides the work-group's " +
+                                  std::to_string(group_size));
+    groups.sigma_lanes = forced_lanes;
+  } else if (groups.partitions > 1 && forced_partitions <= 0) {
+    const int sector = std::max(1, static_cast<int>(kSectorBytes / real_size));
+    int lanes = 1;
+    while (lanes < S && lanes < sector && lanes < group_size) lanes *= 2;
+    groups.sigma_lanes = lanes;
+  }
+  if (forced_partitions <= 0 && groups.partitions > 1)   // as many groups as with one lane
+    groups.partitions = std::clamp(3 * nodes / kPartitionRows * groups.sigma_lanes, 1,
+                                   kMostPartitions * groups.sigma_lanes);
+  return groups;
+}
+
 EnsembleMemory ensemble_memory(int nodes, int elements, int S, std::size_t real_size,
                                std::size_t factor_nonzeros, FactorStorage storage, int factor_copies) {
   // Per dof and sigma: x, v, dv, rhs, r, d, q, z unless Vulkan's blocks finish CG's step

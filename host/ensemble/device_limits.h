@@ -35,6 +35,24 @@ constexpr int kPartitionRows = 512;
 constexpr int kMostPartitions = 64;
 int cg_partitions(int nodes, int forced);
 
+// OpenCL's GPU form: how CG's work-groups lie over the rows [row S + s] (conjugate_gradient.cl,
+// SF_CG_SIGMA_LANES). A group's work-items are `sigma_lanes` sigma points side by side, so that
+// a warp reads runs of consecutive entries; with one lane (a group per sigma point, as before)
+// every work-item reads its own 32-byte sector for 4 bytes at S = 8 and up.
+struct CgGroups {
+  int partitions = 1;    // partitions of the rows (SF_CG_PARTITIONS)
+  int sigma_lanes = 1;   // sigma points side by side in a group, a power of two
+};
+// Where cg_partitions gives one partition (a small mesh: CG's launches are latency, and one
+// launch an iteration does it) one lane; else lanes up to a sector's worth of reals (8 floats,
+// 4 doubles) or all S where fewer: then a row's S entries are one run with the next row's. The
+// partitions grow with the lanes, so that the groups and the entries a group are as many as
+// with one lane. `forced_partitions`, `forced_lanes` > 0 (DeviceOptions) are taken as they are,
+// forced partitions with one lane unless lanes are forced too.
+constexpr int kSectorBytes = 32;
+CgGroups cg_groups(int nodes, int sigma_count, std::size_t real_size, int group_size,
+                   int forced_partitions, int forced_lanes);
+
 // How a device ensemble holds its shared factor: OpenCL's L by columns (its values and row
 // indices), or Vulkan's dense 4 x 4 blocks by rows and by columns (VulkanFactorSolve: each way
 // about 1.4 stored entries a nonzero; in all 12.2 bytes a nonzero in float32 on the 38k liver,

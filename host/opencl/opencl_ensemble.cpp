@@ -67,10 +67,17 @@ OpenClEnsemble::OpenClEnsemble(const Model& model, EstimatedParameters estimated
                   (options.solve_launch == SolveLaunch::automatic &&
                    static_cast<long long>(elements_) * S_ <= kWholeSolveWork));
   cg_group_ = cg_per_group_ ? 64 : 1;
-  // The GPU form on a large mesh: P work-groups per sigma point in CG (conjugate_gradient.cl,
-  // SF_CG_PARTITIONS), so that S x P groups share the device and each work-item takes about
-  // kPartitionRows / 64 rows rather than thousands.
-  if (cg_per_group_) cg_partitions_ = cg_partitions(nodes_, options.cg_partitions);
+  // The GPU form on a large mesh: CG's rows in P partitions (conjugate_gradient.cl,
+  // SF_CG_PARTITIONS), a work-group for each partition and each SF_CG_SIGMA_LANES sigma points
+  // side by side (CgGroups), so that many groups share the device, each work-item takes a few
+  // rows rather than thousands, and a warp reads runs of consecutive entries.
+  if (cg_per_group_) {
+    const CgGroups groups = cg_groups(nodes_, S_, device_.real_size(), static_cast<int>(cg_group_),
+                                      options.cg_partitions, options.cg_sigma_lanes);
+    cg_partitions_ = groups.partitions;
+    cg_sigma_lanes_ = groups.sigma_lanes;
+    cg_sigma_blocks_ = (S_ + cg_sigma_lanes_ - 1) / cg_sigma_lanes_;
+  }
   const int units = static_cast<int>(std::max(1u, info.compute_units));
   int per_unit = (S_ + units - 1) / units;
   while (S_ % per_unit != 0) --per_unit;
@@ -154,6 +161,7 @@ OpenClEnsemble::OpenClEnsemble(const Model& model, EstimatedParameters estimated
                         " -DSF_CG_SOLVE_BLOCK=" + std::to_string(solve_block_) +
                         " -DSF_CG_SOLVE_VECTORS=" + std::to_string(kCgSolveBlockVectors) +
                         " -DSF_CG_PARTITIONS=" + std::to_string(cg_partitions_) +
+                        " -DSF_CG_SIGMA_LANES=" + std::to_string(cg_sigma_lanes_) +
                         " -DSF_FACTOR=" + std::to_string(factor_ ? 1 : 0) +
                         " -DSF_FACTOR_PER_SIGMA=" + std::to_string(factor_copies_ > 1 ? 1 : 0) +
                         " -DSF_SPRING_ROWS=" + std::to_string(springs_.size()) +
@@ -318,13 +326,13 @@ void OpenClEnsemble::run(cl::Kernel& kernel, std::size_t items, std::size_t loca
 
 void OpenClEnsemble::run_cg(cl::Kernel& kernel) const {
   if (cg_per_group_)
-    run(kernel, cg_group_ * S_, cg_group_);
+    run(kernel, cg_group_ * cg_sigma_blocks_, cg_group_);
   else
     run(kernel, static_cast<std::size_t>(S_ / cg_block_), 1);
 }
 
 void OpenClEnsemble::run_partitions(cl::Kernel& kernel) const {
-  run(kernel, cg_group_ * S_ * cg_partitions_, cg_group_);
+  run(kernel, cg_group_ * cg_sigma_blocks_ * cg_partitions_, cg_group_);
 }
 
 void OpenClEnsemble::run_elements(cl::Kernel& kernel) const {

@@ -112,14 +112,16 @@ class OpenClEnsemble : public DeviceEnsemble {
   void upload_multigrid_shift(const std::vector<double>& constants);
 
   mutable OpenClDevice device_;
-  bool cg_per_group_ = true;                // SF_CG_PER_GROUP: CG kernels a group per sigma (GPU)
-  std::size_t cg_group_ = 64;               // SF_GROUP_SIZE: work-items per sigma point then
+  bool cg_per_group_ = true;                // SF_CG_PER_GROUP: CG kernels in work-groups (GPU)
+  std::size_t cg_group_ = 64;               // SF_GROUP_SIZE: work-items per group then
   int sigma_block_ = 1;                     // SF_SIGMA_BLOCK: sigma points per element work-item
   int element_chunks_ = 0;                  // SF_ELEMENT_CHUNKS: the element kernels' chunks (CPU)
   bool whole_solve_ = false;                // cg_solve: the whole CG solve in one launch (CPU)
   int solve_block_ = 1;                     // SF_CG_SOLVE_BLOCK: cg_solve's sigma points per work-item
   int cg_block_ = 1;                        // SF_CG_BLOCK: sigma points per CG work-item (CPU)
-  int cg_partitions_ = 1;                   // SF_CG_PARTITIONS: CG work-groups per sigma (GPU)
+  int cg_partitions_ = 1;                   // SF_CG_PARTITIONS: partitions of CG's rows (GPU)
+  int cg_sigma_lanes_ = 1;                  // SF_CG_SIGMA_LANES: sigma points side by side in a group
+  int cg_sigma_blocks_ = 1;                 // groups of cg_sigma_lanes_ sigma points: S / lanes, up
   // The GPU form's CG in the three kernels of the partitions (cg_dot, cg_update, cg_direction)
   // with P = cg_partitions_: on a large mesh, and with the multigrid V-cycle between the last two.
   bool cg_partitioned_ = false;

@@ -7,10 +7,10 @@
  * A sigma point that has converged (or hit the iteration cap, or broke down) is inactive and
  * left alone, so the host may enqueue several iterations between checks without changing
  * anyone's result. Two forms of these kernels:
- *  - a GPU (SF_CG_PER_GROUP = 1): one work-group per sigma point owns its rows and reduces
- *    its dot products in the group (a fixed tree: the same bits every run); on a large mesh
- *    P work-groups per sigma point, each with a partition of its rows, and three launches
- *    for what cg_iteration does in one (SF_CG_PARTITIONS, below);
+ *  - a GPU (SF_CG_PER_GROUP = 1): a work-group owns the rows of one sigma point, or of
+ *    SF_CG_SIGMA_LANES side by side (below), and reduces their dot products in the group (a
+ *    fixed tree: the same bits every run); on a large mesh a work-group per partition of the
+ *    rows, and three launches for what cg_iteration does in one (SF_CG_PARTITIONS, below);
  *  - a CPU (SF_CG_PER_GROUP = 0): one work-item per block of SF_CG_BLOCK sigma points goes
  *    down the rows with the block innermost, on contiguous data: vectorised, and each cache
  *    line read once (one work-item per sigma point read a line per sigma point, 16 times at
@@ -51,26 +51,60 @@ static inline int sf_cg_start_scalars(uint s, real sum_bb, real sum_rr, real sum
 }
 
 #if SF_CG_PER_GROUP
-/* Work-items per sigma point: a power of two (the host passes the same number). */
+/* Work-items per group: a power of two (the host passes the same number). */
 #ifndef SF_GROUP_SIZE
 #  define SF_GROUP_SIZE 64
 #endif
+/* Sigma lanes: a group's work-items are SF_CG_SIGMA_LANES sigma points side by side (a power
+ * of two that divides SF_GROUP_SIZE), each with SF_CG_ROW_LANES row lanes: work-item i takes
+ * sigma point block * SF_CG_SIGMA_LANES + i % SF_CG_SIGMA_LANES and the rows i / SF_CG_SIGMA_LANES,
+ * then every SF_CG_ROW_LANES-th. The lanes of a row then read consecutive entries [row S + s]
+ * (with as many lanes as S, the next row's follow), where one lane per group (a sigma point's
+ * group, before) had every work-item of a warp read its own sector for one real. The host's
+ * CgGroups (host/ensemble/device_limits.h) chooses the lanes; the groups are blocks of sigma
+ * points: S / SF_CG_SIGMA_LANES of them, rounded up, the last one's lanes past S idle. */
+#ifndef SF_CG_SIGMA_LANES
+#  define SF_CG_SIGMA_LANES 1
+#endif
+#define SF_CG_ROW_LANES (SF_GROUP_SIZE / SF_CG_SIGMA_LANES)
 
-/* Tree reduction of one value per work-item of the group, returned to every work-item. */
+/* This work-item's sigma point in block `block`, and its first row (of a group's rows). */
+static inline uint sf_lane_sigma(uint block) {
+  return block * SF_CG_SIGMA_LANES + get_local_id(0) % SF_CG_SIGMA_LANES;
+}
+static inline uint sf_row_lane(void) { return get_local_id(0) / SF_CG_SIGMA_LANES; }
+/* The work-item that writes its sigma point's sums and scalars: row lane 0. */
+static inline bool sf_leads(void) { return get_local_id(0) < SF_CG_SIGMA_LANES; }
+
+/* Whether any sigma point of the block has its flag set (flags[s * stride + offset]): the same
+ * answer in every work-item, so that a group with nothing to do returns at once and none
+ * leaves a barrier waiting. */
+static inline bool sf_block_any(__global const uint* flags, uint S, uint block, uint stride,
+                                uint offset) {
+  for (uint l = 0; l < SF_CG_SIGMA_LANES; ++l) {
+    uint s = block * SF_CG_SIGMA_LANES + l;
+    if (s < S && flags[(size_t)s * stride + offset]) return true;
+  }
+  return false;
+}
+
+/* Tree reduction over the row lanes of each sigma lane: every work-item gets its sigma
+ * point's sum (a fixed tree: the same bits every run). */
 static inline real sf_group_sum(__local real* scratch, real value) {
   uint lid = get_local_id(0);
   barrier(CLK_LOCAL_MEM_FENCE); /* the previous sum's result has been read by everyone */
   scratch[lid] = value;
   barrier(CLK_LOCAL_MEM_FENCE);
-  for (uint stride = SF_GROUP_SIZE / 2; stride > 0; stride /= 2) {
+  for (uint stride = SF_GROUP_SIZE / 2; stride >= SF_CG_SIGMA_LANES; stride /= 2) {
     if (lid < stride) scratch[lid] += scratch[lid + stride];
     barrier(CLK_LOCAL_MEM_FENCE);
   }
-  return scratch[0];
+  return scratch[lid % SF_CG_SIGMA_LANES];
 }
 
 /* Rows [begin, end) of sigma point s at the warm start, with q = A x: r = b - q,
- * z = M^-1 r, d = z; the group's sums b.b, r.r, r.z in sums[0..2]. */
+ * z = M^-1 r, d = z; the sums b.b, r.r, r.z of the group's rows in sums[0..2]. A lane with
+ * nothing to do passes begin = end. */
 static inline void sf_start_rows(uint S, uint s, uint begin, uint end, __global const real* q,
                                  __global const real* b, __global const real* inverse_diagonal,
                                  __global real* r, __global real* z, __global real* d,
@@ -78,7 +112,7 @@ static inline void sf_start_rows(uint S, uint s, uint begin, uint end, __global 
   real sum_bb = (real)0;
   real sum_rr = (real)0;
   real sum_rz = (real)0;
-  for (uint row = begin + get_local_id(0); row < end; row += SF_GROUP_SIZE) {
+  for (uint row = begin + sf_row_lane(); row < end; row += SF_CG_ROW_LANES) {
     size_t at = (size_t)row * S + s;
     SF_CG_START_ROW(at, q[at], b, inverse_diagonal, r, z, d, sum_bb, sum_rr, sum_rz)
   }
@@ -89,7 +123,7 @@ static inline void sf_start_rows(uint S, uint s, uint begin, uint end, __global 
 
 /* The warm start's residual and the first direction: with q = A x (x = the last step's dv,
  * from element_product and node_product), r = b - q, z = M^-1 r, d = z; bb, rr, rz; and
- * whether the warm start is already good enough. */
+ * whether the warm start is already good enough. A group per block of sigma points. */
 __kernel __attribute__((reqd_work_group_size(SF_GROUP_SIZE, 1, 1)))
 void cg_start(uint S, uint node_count, __global const real* c, __global const real* q,
               __global const real* b, __global const real* inverse_diagonal, __global real* r,
@@ -97,17 +131,17 @@ void cg_start(uint S, uint node_count, __global const real* c, __global const re
               __global real* rz, __global uint* active, __global uint* converged,
               __global int* iterations) {
   __local real scratch[SF_GROUP_SIZE];
-  uint s = get_group_id(0);
+  uint s = sf_lane_sigma(get_group_id(0));
   real sums[3];
-  sf_start_rows(S, s, 0, 3 * node_count, q, b, inverse_diagonal, r, z, d, scratch, sums);
-  real sum_bb = sums[0], sum_rr = sums[1], sum_rz = sums[2];
-  if (get_local_id(0) == 0)
-    sf_cg_start_scalars(s, sum_bb, sum_rr, sum_rz, c, bb, rr, rz, active, converged, iterations);
+  sf_start_rows(S, s, 0, s < S ? 3 * node_count : 0, q, b, inverse_diagonal, r, z, d, scratch, sums);
+  if (sf_leads() && s < S)
+    sf_cg_start_scalars(s, sums[0], sums[1], sums[2], c, bb, rr, rz, active, converged, iterations);
 }
 
-/* One CG iteration of one sigma point, given q = A d (node_product): alpha = rz / d.q, x += alpha d, r -= alpha q, z = M^-1 r, then the convergence
- * test (|r|^2 <= tol^2 |b|^2), the cap, breakdown (a residual that is not finite: the matrix
- * is not SPD or the input held a NaN), and d = z + beta d. */
+/* One CG iteration of a block of sigma points, given q = A d (node_product): alpha = rz / d.q,
+ * x += alpha d, r -= alpha q, z = M^-1 r, then the convergence test (|r|^2 <= tol^2 |b|^2), the
+ * cap, breakdown (a residual that is not finite: the matrix is not SPD or the input held a
+ * NaN), and d = z + beta d. */
 __kernel __attribute__((reqd_work_group_size(SF_GROUP_SIZE, 1, 1)))
 void cg_iteration(uint S, uint node_count, int max_iterations, __global const real* c,
                   __global const real* inverse_diagonal, __global real* x, __global real* r,
@@ -116,67 +150,63 @@ void cg_iteration(uint S, uint node_count, int max_iterations, __global const re
                   __global real* rr, __global real* rz, __global uint* active,
                   __global uint* converged, __global int* iterations) {
   __local real scratch[SF_GROUP_SIZE];
-  uint s = get_group_id(0);
-  if (!active[s]) return; /* the same for the whole group: no barrier is left waiting */
-  int count = iterations[s] + 1;
-  real rz_old = rz[s];
-  uint first = get_local_id(0);
+  uint block = get_group_id(0);
+  if (!sf_block_any(active, S, block, 1, 0)) return;
+  uint s = sf_lane_sigma(block);
+  bool live = s < S && active[s];
+  uint rows = live ? 3 * node_count : 0;
+  int count = live ? iterations[s] + 1 : 0;
+  real rz_old = live ? rz[s] : (real)1;
 
   real sum_dq = (real)0;
-  for (uint n = first; n < node_count; n += SF_GROUP_SIZE) {
-    SF_UNROLL
-    for (int k = 0; k < 3; ++k) {
-      size_t row = ((size_t)3 * n + k) * S + s;
-      sum_dq += d[row] * q[row];
-    }
+  for (uint row = sf_row_lane(); row < rows; row += SF_CG_ROW_LANES) {
+    size_t at = (size_t)row * S + s;
+    sum_dq += d[at] * q[at];
   }
   real alpha = rz_old / sf_group_sum(scratch, sum_dq);
 
   real sum_rr = (real)0;
   real sum_rz = (real)0;
-  for (uint n = first; n < node_count; n += SF_GROUP_SIZE) {
-    SF_UNROLL
-    for (int k = 0; k < 3; ++k) {
-      size_t row = ((size_t)3 * n + k) * S + s;
-      SF_CG_UPDATE_ROW(row, alpha, q[row], x, r, z, d, inverse_diagonal, sum_rr, sum_rz)
-    }
+  for (uint row = sf_row_lane(); row < rows; row += SF_CG_ROW_LANES) {
+    size_t at = (size_t)row * S + s;
+    SF_CG_UPDATE_ROW(at, alpha, q[at], x, r, z, d, inverse_diagonal, sum_rr, sum_rz)
   }
   sum_rr = sf_group_sum(scratch, sum_rr);
   sum_rz = sf_group_sum(scratch, sum_rz);
 
-  bool done = sf_cg_converged(sum_rr, c[SF_CG_TOLERANCE2], bb[s]);
-  bool stop = sf_cg_stops(done, sum_rr, count, max_iterations);
+  bool done = live && sf_cg_converged(sum_rr, c[SF_CG_TOLERANCE2], bb[s]);
+  bool stop = !live || sf_cg_stops(done, sum_rr, count, max_iterations);
   barrier(CLK_GLOBAL_MEM_FENCE); /* everyone has read the old scalars before they change */
-  if (first == 0) {
+  if (live && sf_leads()) {
     iterations[s] = count;
     rr[s] = sum_rr;
     rz[s] = sum_rz;
     if (done) converged[s] = 1u;
     if (stop) active[s] = 0u;
   }
-  if (stop) return;
+  /* Not a return, where only some of the group's lanes stop: with one, PoCL 3 gave the lanes
+   * that went on wrong sums (unconverged sigma points in the conformance suite). */
+  if (stop) rows = 0;
   real beta = sum_rz / rz_old;
-  for (uint n = first; n < node_count; n += SF_GROUP_SIZE) {
-    SF_UNROLL
-    for (int k = 0; k < 3; ++k) {
-      size_t row = ((size_t)3 * n + k) * S + s;
-      d[row] = z[row] + beta * d[row];
-    }
+  for (uint row = sf_row_lane(); row < rows; row += SF_CG_ROW_LANES) {
+    size_t at = (size_t)row * S + s;
+    d[at] = z[at] + beta * d[at];
   }
 }
 
 /* Partitions: on a large mesh one group per sigma point leaves most of a GPU idle (S groups
  * of 64 work-items, each going down thousands of rows). With SF_CG_PARTITIONS = P > 1 (the
- * host's choice by the rows) each sigma point's rows are cut into P contiguous partitions and
- * every (sigma point, partition) pair is a work-group, S x P in all (group g: s = g / P,
- * p = g % P). An iteration then takes three launches after the product, each ending where a
- * sum over all rows is needed: cg_dot (d.q), cg_update (alpha; x, r, z; r.r and r.z) and
- * cg_direction (the stop test and beta; d). A group's partial sums go to `partial`
- * [(quantity * S + s) * P + p]; a group that needs a sum adds the P partials itself, in
- * partition order, so every group of a sigma point gets the same bits, in every run. Each group
- * also keeps its own copy of its sigma point's active flag, iteration count and r.z (the own_*
- * arrays, [s * P + p]): no group reads what another group of the same launch writes. Group
- * (s, 0) writes the per-sigma scalars that the host and the other kernels read. */
+ * host's choice by the rows) the rows are cut into P contiguous partitions and every (block of
+ * sigma points, partition) pair is a work-group (group g: block g / P, partition p = g % P).
+ * An iteration then takes three launches after the product, each ending where a sum over all
+ * rows is needed: cg_dot (d.q), cg_update (alpha; x, r, z; r.r and r.z) and cg_direction (the
+ * stop test and beta; d). A group's partial sums go to `partial` [(quantity * S + s) * P + p];
+ * a group that needs a sum adds the P partials itself, its row lanes each every
+ * SF_CG_ROW_LANES-th and then by the tree, so every group of a sigma point gets the same bits,
+ * in every run. Each group also keeps its own copy of each of its sigma points' active flag,
+ * iteration count and r.z (the own_* arrays, [s * P + p]): no group reads what another group
+ * of the same launch writes. Group (block, 0) writes the per-sigma scalars that the host and
+ * the other kernels read. */
 #ifndef SF_CG_PARTITIONS
 #  define SF_CG_PARTITIONS 1
 #endif
@@ -192,8 +222,41 @@ static inline void sf_partition_rows(uint rows, uint p, uint* begin, uint* end) 
   *end = min(rows, *begin + size);
 }
 
-/* Sigma point s's P partials of one quantity, summed in partition order. */
-static inline real sf_partials_sum(__global const real* partial, uint quantity, uint S, uint s) {
+/* This group's block and partition, this work-item's sigma point, and whether it takes part:
+ * s < S and, where `own_active` is given, its copy of the active flag set. */
+typedef struct {
+  uint block, p, s, own;
+  bool live;
+} sf_lane;
+static inline sf_lane sf_partition_lane(uint S, __global const uint* own_active) {
+  sf_lane lane;
+  uint g = get_group_id(0);
+  lane.block = g / SF_CG_PARTITIONS;
+  lane.p = g % SF_CG_PARTITIONS;
+  lane.s = sf_lane_sigma(lane.block);
+  lane.own = lane.s * SF_CG_PARTITIONS + lane.p;
+  lane.live = lane.s < S && (own_active == 0 || own_active[lane.own]);
+  return lane;
+}
+/* The lane's rows of its partition, none where it does not take part. */
+static inline void sf_lane_rows(sf_lane lane, uint node_count, uint* begin, uint* end) {
+  sf_partition_rows(3 * node_count, lane.p, begin, end);
+  if (!lane.live) *end = *begin;
+}
+
+/* Sigma point s's P partials of one quantity, summed in a fixed order (above); every
+ * work-item of the group calls it. */
+static inline real sf_partials_sum(__local real* scratch, __global const real* partial,
+                                   uint quantity, uint S, uint s) {
+  real sum = (real)0;
+  if (s < S) {
+    __global const real* at = partial + ((size_t)quantity * S + s) * SF_CG_PARTITIONS;
+    for (uint p = sf_row_lane(); p < SF_CG_PARTITIONS; p += SF_CG_ROW_LANES) sum += at[p];
+  }
+  return sf_group_sum(scratch, sum);
+}
+/* The same in one work-item (cg_start_scalars'), in partition order. */
+static inline real sf_partials_sum_serial(__global const real* partial, uint quantity, uint S, uint s) {
   __global const real* at = partial + ((size_t)quantity * S + s) * SF_CG_PARTITIONS;
   real sum = (real)0;
   for (uint p = 0; p < SF_CG_PARTITIONS; ++p) sum += at[p];
@@ -206,17 +269,15 @@ void cg_start_partials(uint S, uint node_count, __global const real* q, __global
                        __global const real* inverse_diagonal, __global real* r, __global real* z,
                        __global real* d, __global real* partial) {
   __local real scratch[SF_GROUP_SIZE];
-  uint s = get_group_id(0) / SF_CG_PARTITIONS;
-  uint p = get_group_id(0) % SF_CG_PARTITIONS;
+  sf_lane lane = sf_partition_lane(S, 0);
   uint begin, end;
-  sf_partition_rows(3 * node_count, p, &begin, &end);
+  sf_lane_rows(lane, node_count, &begin, &end);
   real sums[3];
-  sf_start_rows(S, s, begin, end, q, b, inverse_diagonal, r, z, d, scratch, sums);
-  real sum_bb = sums[0], sum_rr = sums[1], sum_rz = sums[2];
-  if (get_local_id(0) == 0) {
-    partial[((size_t)SF_PARTIAL_BB * S + s) * SF_CG_PARTITIONS + p] = sum_bb;
-    partial[((size_t)SF_PARTIAL_RR * S + s) * SF_CG_PARTITIONS + p] = sum_rr;
-    partial[((size_t)SF_PARTIAL_RZ * S + s) * SF_CG_PARTITIONS + p] = sum_rz;
+  sf_start_rows(S, lane.s, begin, end, q, b, inverse_diagonal, r, z, d, scratch, sums);
+  if (sf_leads() && lane.live) {
+    partial[((size_t)SF_PARTIAL_BB * S + lane.s) * SF_CG_PARTITIONS + lane.p] = sums[0];
+    partial[((size_t)SF_PARTIAL_RR * S + lane.s) * SF_CG_PARTITIONS + lane.p] = sums[1];
+    partial[((size_t)SF_PARTIAL_RZ * S + lane.s) * SF_CG_PARTITIONS + lane.p] = sums[2];
   }
 }
 
@@ -228,10 +289,10 @@ __kernel void cg_start_scalars(uint S, __global const real* c, __global const re
                                __global int* own_iterations, __global real* own_rz) {
   uint s = get_global_id(0);
   if (s >= S) return;
-  real sum_rz = sf_partials_sum(partial, SF_PARTIAL_RZ, S, s);
-  int going = sf_cg_start_scalars(s, sf_partials_sum(partial, SF_PARTIAL_BB, S, s),
-                                  sf_partials_sum(partial, SF_PARTIAL_RR, S, s), sum_rz, c, bb, rr,
-                                  rz, active, converged, iterations);
+  real sum_rz = sf_partials_sum_serial(partial, SF_PARTIAL_RZ, S, s);
+  int going = sf_cg_start_scalars(s, sf_partials_sum_serial(partial, SF_PARTIAL_BB, S, s),
+                                  sf_partials_sum_serial(partial, SF_PARTIAL_RR, S, s), sum_rz, c,
+                                  bb, rr, rz, active, converged, iterations);
   for (uint p = 0; p < SF_CG_PARTITIONS; ++p) {
     own_active[s * SF_CG_PARTITIONS + p] = going ? 1u : 0u;
     own_iterations[s * SF_CG_PARTITIONS + p] = 0;
@@ -244,19 +305,18 @@ __kernel __attribute__((reqd_work_group_size(SF_GROUP_SIZE, 1, 1)))
 void cg_dot(uint S, uint node_count, __global const real* d, __global const real* q,
             __global real* partial, __global const uint* own_active) {
   __local real scratch[SF_GROUP_SIZE];
-  uint g = get_group_id(0);
-  if (!own_active[g]) return; /* the same for the whole group: no barrier is left waiting */
-  uint s = g / SF_CG_PARTITIONS;
-  uint p = g % SF_CG_PARTITIONS;
+  sf_lane lane = sf_partition_lane(S, own_active);
+  if (!sf_block_any(own_active, S, lane.block, SF_CG_PARTITIONS, lane.p)) return;
   uint begin, end;
-  sf_partition_rows(3 * node_count, p, &begin, &end);
+  sf_lane_rows(lane, node_count, &begin, &end);
   real sum_dq = (real)0;
-  for (uint row = begin + get_local_id(0); row < end; row += SF_GROUP_SIZE) {
-    size_t at = (size_t)row * S + s;
+  for (uint row = begin + sf_row_lane(); row < end; row += SF_CG_ROW_LANES) {
+    size_t at = (size_t)row * S + lane.s;
     sum_dq += d[at] * q[at];
   }
   sum_dq = sf_group_sum(scratch, sum_dq);
-  if (get_local_id(0) == 0) partial[((size_t)SF_PARTIAL_DQ * S + s) * SF_CG_PARTITIONS + p] = sum_dq;
+  if (sf_leads() && lane.live)
+    partial[((size_t)SF_PARTIAL_DQ * S + lane.s) * SF_CG_PARTITIONS + lane.p] = sum_dq;
 }
 
 /* The second part: alpha = r.z / d.q, x += alpha d, r -= alpha q, z = M^-1 r; partial r.r, r.z. */
@@ -266,24 +326,23 @@ void cg_update(uint S, uint node_count, __global const real* inverse_diagonal, _
                __global const real* q, __global real* partial, __global const uint* own_active,
                __global const real* own_rz) {
   __local real scratch[SF_GROUP_SIZE];
-  uint g = get_group_id(0);
-  if (!own_active[g]) return;
-  uint s = g / SF_CG_PARTITIONS;
-  uint p = g % SF_CG_PARTITIONS;
-  real alpha = own_rz[g] / sf_partials_sum(partial, SF_PARTIAL_DQ, S, s);
+  sf_lane lane = sf_partition_lane(S, own_active);
+  if (!sf_block_any(own_active, S, lane.block, SF_CG_PARTITIONS, lane.p)) return;
+  real dq = sf_partials_sum(scratch, partial, SF_PARTIAL_DQ, S, lane.s);
+  real alpha = lane.live ? own_rz[lane.own] / dq : (real)0;
   uint begin, end;
-  sf_partition_rows(3 * node_count, p, &begin, &end);
+  sf_lane_rows(lane, node_count, &begin, &end);
   real sum_rr = (real)0;
   real sum_rz = (real)0;
-  for (uint row = begin + get_local_id(0); row < end; row += SF_GROUP_SIZE) {
-    size_t at = (size_t)row * S + s;
+  for (uint row = begin + sf_row_lane(); row < end; row += SF_CG_ROW_LANES) {
+    size_t at = (size_t)row * S + lane.s;
     SF_CG_UPDATE_ROW(at, alpha, q[at], x, r, z, d, inverse_diagonal, sum_rr, sum_rz)
   }
   sum_rr = sf_group_sum(scratch, sum_rr);
   sum_rz = sf_group_sum(scratch, sum_rz);
-  if (get_local_id(0) == 0) {
-    partial[((size_t)SF_PARTIAL_RR * S + s) * SF_CG_PARTITIONS + p] = sum_rr;
-    partial[((size_t)SF_PARTIAL_RZ * S + s) * SF_CG_PARTITIONS + p] = sum_rz;
+  if (sf_leads() && lane.live) {
+    partial[((size_t)SF_PARTIAL_RR * S + lane.s) * SF_CG_PARTITIONS + lane.p] = sum_rr;
+    partial[((size_t)SF_PARTIAL_RZ * S + lane.s) * SF_CG_PARTITIONS + lane.p] = sum_rz;
   }
 }
 
@@ -295,35 +354,34 @@ void cg_direction(uint S, uint node_count, int max_iterations, __global const re
                   __global uint* active, __global uint* converged, __global int* iterations,
                   __global uint* own_active, __global int* own_iterations,
                   __global real* own_rz) {
-  uint g = get_group_id(0);
-  if (!own_active[g]) return;
-  uint s = g / SF_CG_PARTITIONS;
-  uint p = g % SF_CG_PARTITIONS;
-  int count = own_iterations[g] + 1;
-  real rz_old = own_rz[g];
-  real sum_rr = sf_partials_sum(partial, SF_PARTIAL_RR, S, s);
-  real sum_rz = sf_partials_sum(partial, SF_PARTIAL_RZ, S, s);
-  bool done = sf_cg_converged(sum_rr, c[SF_CG_TOLERANCE2], bb[s]);
-  bool stop = sf_cg_stops(done, sum_rr, count, max_iterations);
+  __local real scratch[SF_GROUP_SIZE];
+  sf_lane lane = sf_partition_lane(S, own_active);
+  if (!sf_block_any(own_active, S, lane.block, SF_CG_PARTITIONS, lane.p)) return;
+  int count = lane.live ? own_iterations[lane.own] + 1 : 0;
+  real rz_old = lane.live ? own_rz[lane.own] : (real)1;
+  real sum_rr = sf_partials_sum(scratch, partial, SF_PARTIAL_RR, S, lane.s);
+  real sum_rz = sf_partials_sum(scratch, partial, SF_PARTIAL_RZ, S, lane.s);
+  bool done = lane.live && sf_cg_converged(sum_rr, c[SF_CG_TOLERANCE2], bb[lane.s]);
+  bool stop = !lane.live || sf_cg_stops(done, sum_rr, count, max_iterations);
   barrier(CLK_GLOBAL_MEM_FENCE); /* everyone has read the old copies before they change */
-  if (get_local_id(0) == 0) {
-    own_iterations[g] = count;
-    own_rz[g] = sum_rz;
-    if (stop) own_active[g] = 0u;
-    if (p == 0) {
-      iterations[s] = count;
-      rr[s] = sum_rr;
-      rz[s] = sum_rz;
-      if (done) converged[s] = 1u;
-      if (stop) active[s] = 0u;
+  if (sf_leads() && lane.live) {
+    own_iterations[lane.own] = count;
+    own_rz[lane.own] = sum_rz;
+    if (stop) own_active[lane.own] = 0u;
+    if (lane.p == 0) {
+      iterations[lane.s] = count;
+      rr[lane.s] = sum_rr;
+      rz[lane.s] = sum_rz;
+      if (done) converged[lane.s] = 1u;
+      if (stop) active[lane.s] = 0u;
     }
   }
-  if (stop) return;
   real beta = sum_rz / rz_old;
   uint begin, end;
-  sf_partition_rows(3 * node_count, p, &begin, &end);
-  for (uint row = begin + get_local_id(0); row < end; row += SF_GROUP_SIZE) {
-    size_t at = (size_t)row * S + s;
+  sf_lane_rows(lane, node_count, &begin, &end);
+  if (stop) end = begin;   /* not a return: as cg_iteration's */
+  for (uint row = begin + sf_row_lane(); row < end; row += SF_CG_ROW_LANES) {
+    size_t at = (size_t)row * S + lane.s;
     d[at] = z[at] + beta * d[at];
   }
 }
@@ -335,21 +393,21 @@ void cg_preconditioned(uint S, uint node_count, uint start, __global const real*
                        __global const real* z, __global real* d, __global real* partial,
                        __global const uint* own_active) {
   __local real scratch[SF_GROUP_SIZE];
-  uint g = get_group_id(0);
-  if (!start && !own_active[g]) return;
-  uint s = g / SF_CG_PARTITIONS;
-  uint p = g % SF_CG_PARTITIONS;
+  __global const uint* flags = start ? 0 : own_active;
+  sf_lane lane = sf_partition_lane(S, flags);
+  if (!start && !sf_block_any(own_active, S, lane.block, SF_CG_PARTITIONS, lane.p)) return;
   uint begin, end;
-  sf_partition_rows(3 * node_count, p, &begin, &end);
+  sf_lane_rows(lane, node_count, &begin, &end);
   real sum_rz = (real)0;
-  for (uint row = begin + get_local_id(0); row < end; row += SF_GROUP_SIZE) {
-    size_t at = (size_t)row * S + s;
+  for (uint row = begin + sf_row_lane(); row < end; row += SF_CG_ROW_LANES) {
+    size_t at = (size_t)row * S + lane.s;
     real zi = z[at];
     sum_rz += r[at] * zi;
     if (start) d[at] = zi;
   }
   sum_rz = sf_group_sum(scratch, sum_rz);
-  if (get_local_id(0) == 0) partial[((size_t)SF_PARTIAL_RZ * S + s) * SF_CG_PARTITIONS + p] = sum_rz;
+  if (sf_leads() && lane.live)
+    partial[((size_t)SF_PARTIAL_RZ * S + lane.s) * SF_CG_PARTITIONS + lane.p] = sum_rz;
 }
 #endif /* SF_CG_PER_GROUP */
 

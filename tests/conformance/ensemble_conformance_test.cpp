@@ -69,6 +69,7 @@ struct BackendCase {
   // DeviceOptions::node_iteration_work: 0 for Vulkan's CG in three dispatches an iteration
   // (what larger meshes run) on the meshes that would take two.
   long long node_iteration_work = kNodeIterationWork;
+  int cg_sigma_lanes = 0;   // DeviceOptions::cg_sigma_lanes (OpenCL's GPU form)
 };
 
 // The back ends to check: OpenCL device 0 and Vulkan device 0, each in single and, where the
@@ -116,6 +117,15 @@ std::vector<BackendCase> backend_cases() {
   // on meshes of more than about 340 nodes; these meshes would get one partition).
   cases.push_back({"opencl", Precision::single, "OpenClSingleGpuFormPartitions",
                    SolveLaunch::automatic, KernelForm::gpu, 3});
+  // Its CG's groups with sigma points side by side (CgGroups) where they do not fill the
+  // groups as the chosen lanes do (S lanes, or 8): 8 lanes for S = 4, half of them idle, in
+  // cg_iteration (one partition); 2 lanes, two groups of sigma points, in three partitions.
+  cases.push_back({"opencl", Precision::single, "OpenClSingleGpuFormEightLanes", SolveLaunch::automatic,
+                   KernelForm::gpu, 1, Preconditioner::jacobi, DeviceOptions{}.own_factors_bytes, 4, true,
+                   kNodeIterationWork, 8});
+  cases.push_back({"opencl", Precision::single, "OpenClSingleGpuFormTwoLanes", SolveLaunch::automatic,
+                   KernelForm::gpu, 3, Preconditioner::jacobi, DeviceOptions{}.own_factors_bytes, 4, true,
+                   kNodeIterationWork, 2});
   // Vulkan as it runs on a CPU device (lavapipe): float32 shaders with texel reads; on these
   // meshes CG in two dispatches an iteration (cg_node_iteration forms q = A d); Jacobi.
   cases.push_back({"vulkan", Precision::single, "VulkanSingle"});
@@ -149,6 +159,7 @@ DeviceOptions device_options(const BackendCase& c) {
   options.own_factors_bytes = c.own_factors_bytes;
   options.spring_correction = c.spring_correction;
   options.node_iteration_work = c.node_iteration_work;
+  options.cg_sigma_lanes = c.cg_sigma_lanes;
   return options;
 }
 
@@ -857,7 +868,7 @@ TEST_P(RegionConformance, EstimatedModuliFollowTheReference) {
 std::vector<BackendCase> region_cases() {
   std::vector<BackendCase> cases;
   for (const BackendCase& c : backend_cases())
-    if (c.cg_partitions == 0 && c.node_iteration_work != 0 &&
+    if (c.cg_partitions == 0 && c.cg_sigma_lanes == 0 && c.node_iteration_work != 0 &&
         (c.precision == Precision::single || c.preconditioner != Preconditioner::jacobi))
       cases.push_back(c);
   return cases;

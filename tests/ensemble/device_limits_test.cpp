@@ -7,10 +7,41 @@
 #include <gtest/gtest.h>
 
 #include <cstdint>
+#include <stdexcept>
 #include <string>
 
 namespace sigmafem {
 namespace {
+
+// OpenCL's GPU form lays CG's groups over sigma points side by side where the rows are in
+// partitions: a sector's worth (8 floats, 4 doubles) or all S where fewer, and as many groups
+// as with a sigma point a group (S x P: the partitions grow with the lanes).
+TEST(CgGroups, SigmaPointsSideBySideInPartitionsAsManyGroupsAsBefore) {
+  const int small = 100, large = 30036;   // 300 rows: one partition; the 38k liver: 64
+  ASSERT_EQ(cg_partitions(small, 0), 1);
+  ASSERT_EQ(cg_partitions(large, 0), kMostPartitions);
+  // A small mesh: a group per sigma point in cg_iteration, as before.
+  EXPECT_EQ(cg_groups(small, 16, sizeof(float), 64, 0, 0).sigma_lanes, 1);
+  EXPECT_EQ(cg_groups(small, 16, sizeof(float), 64, 0, 0).partitions, 1);
+  for (int S : {1, 4, 16, 65}) {
+    const CgGroups groups = cg_groups(large, S, sizeof(float), 64, 0, 0);
+    EXPECT_EQ(groups.sigma_lanes, S == 1 ? 1 : S == 4 ? 4 : 8) << S;
+    EXPECT_EQ(groups.partitions, kMostPartitions * groups.sigma_lanes) << S;
+    const int blocks = (S + groups.sigma_lanes - 1) / groups.sigma_lanes;
+    EXPECT_GE(blocks * groups.partitions, S * kMostPartitions) << S;
+  }
+  EXPECT_EQ(cg_groups(large, 16, sizeof(double), 64, 0, 0).sigma_lanes, 4);
+  // Forced partitions keep a lane a sigma point (the benchmarks' one group per sigma point);
+  // forced lanes are taken as they are, and a number that is not a power of two dividing the
+  // group is refused.
+  EXPECT_EQ(cg_groups(large, 4, sizeof(float), 64, 1, 0).sigma_lanes, 1);
+  EXPECT_EQ(cg_groups(small, 4, sizeof(float), 64, 3, 0).sigma_lanes, 1);
+  EXPECT_EQ(cg_groups(small, 4, sizeof(float), 64, 3, 0).partitions, 3);
+  EXPECT_EQ(cg_groups(small, 4, sizeof(float), 64, 3, 2).sigma_lanes, 2);
+  EXPECT_EQ(cg_groups(small, 4, sizeof(float), 64, 0, 8).sigma_lanes, 8);
+  EXPECT_THROW(cg_groups(small, 4, sizeof(float), 64, 0, 3), std::invalid_argument);
+  EXPECT_THROW(cg_groups(small, 4, sizeof(float), 64, 0, 128), std::invalid_argument);
+}
 
 TEST(EnsembleMemory, CountsTheStateTheElementsAndAFactor) {
   const int nodes = 100, elements = 300, S = 4;
