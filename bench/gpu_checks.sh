@@ -4,10 +4,10 @@
 # OpenCL and Vulkan side by side in one run. Device 0 of each back end must be the GPU
 # (`sigmafem devices`, first line of devices.txt); no GPU is needed to build or test.
 # Usage: bench/gpu_checks.sh [BUILD [OUT]]   (defaults: build, BUILD/gpu)
-# Each part has a time limit (seconds: SIGMAFEM_GPU_TEST_LIMIT, SIGMAFEM_GPU_BENCH_LIMIT,
-# SIGMAFEM_GPU_DIAGNOSE_LIMIT; 240 + 240 + 100 s by default, under a 10-minute call) so that a
-# lease of a few minutes always brings its logs back. On the H200 the conformance part took
-# about 170 s and the liver diagnoses 78 s.
+# Each part has a time limit (seconds: SIGMAFEM_GPU_TEST_LIMIT, SIGMAFEM_GPU_LANES_LIMIT,
+# SIGMAFEM_GPU_BENCH_LIMIT, SIGMAFEM_GPU_DIAGNOSE_LIMIT; 220 + 40 + 240 + 100 s by default, under
+# a 10-minute call) so that a lease of a few minutes always brings its logs back. On the H200
+# the conformance part took about 170 s and the liver diagnoses 78 s.
 set -u
 build=${1:-build}
 out=${2:-$build/gpu}
@@ -27,8 +27,8 @@ for api in OpenCL Vulkan; do
 done
 
 # The WholeSolve cases force the CPU devices' one-work-item CG solve; a GPU never chooses it.
-echo "== conformance (limit ${SIGMAFEM_GPU_TEST_LIMIT:-240} s)"
-SIGMAFEM_TESTS_REQUIRE=all timeout "${SIGMAFEM_GPU_TEST_LIMIT:-240}" "$build/tests/sigmafem_tests" \
+echo "== conformance (limit ${SIGMAFEM_GPU_TEST_LIMIT:-220} s)"
+SIGMAFEM_TESTS_REQUIRE=all timeout "${SIGMAFEM_GPU_TEST_LIMIT:-220}" "$build/tests/sigmafem_tests" \
   --gtest_filter='Backends/*:Precisions/*:OpenClDeviceTest.*:VulkanDeviceTest.*:OpenClMultigridTest.*:VulkanMultigridTest.*-*WholeSolve*' \
   --gtest_output="xml:$out/conformance.xml" >"$out/conformance.log" 2>&1
 code=$?
@@ -37,6 +37,15 @@ echo "conformance exit $code"
 grep -E "^\[  FAILED  \]" "$out/conformance.log" | sort -u | head -60
 grep -E 'tests ran|FAILED TEST' "$out/conformance.log"
 [ $code -eq 0 ] || tail -n 5 "$out/conformance.log"
+
+# OpenCL's CG with sigma points side by side in its groups (stop 62, the default) against a
+# sigma point a group, on the large meshes, first: the A/B that PoCL could only stand in for.
+echo "== CG sigma lanes (limit ${SIGMAFEM_GPU_LANES_LIMIT:-40} s)"
+timeout "${SIGMAFEM_GPU_LANES_LIMIT:-40}" "$build/bench/sigmafem_bench" \
+  --benchmark_filter='BM_ensemble_step/opencl(_gpu_form_one_lane)?_(liver_fine_38144|box_large_117240)/' \
+  --benchmark_min_time=0.3 >"$out/lanes.log" 2>&1
+echo "lanes exit $?"
+cat "$out/lanes.log"
 
 echo "== benchmarks (limit ${SIGMAFEM_GPU_BENCH_LIMIT:-240} s)"
 timeout "${SIGMAFEM_GPU_BENCH_LIMIT:-240}" "$build/bench/sigmafem_bench" \
