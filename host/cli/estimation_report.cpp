@@ -1,6 +1,7 @@
 #include "host/cli/estimation_report.h"
 
 #include <algorithm>
+#include <vector>
 #include <cmath>
 #include <filesystem>
 #include <sstream>
@@ -230,8 +231,34 @@ nlohmann::ordered_json write_estimation_report(const EstimationReport& report, c
   }
   summary["final"] = final_estimates;
   const double steps_count = std::max<double>(1.0, static_cast<double>(run.steps.size()));
+  // A real-time user's figures: the first step apart (it makes the first preconditioner), the
+  // slowest of the others and where, and the time 99% of the steps keep within.
+  double first_seconds = 0.0, slowest_seconds = 0.0;
+  int slowest_step = 0;
+  std::vector<double> seconds;
+  for (const EstimationStep& step : run.steps) {
+    if (&step == &run.steps.front()) {
+      first_seconds = step.seconds;
+      continue;
+    }
+    seconds.push_back(step.seconds);
+    if (step.seconds > slowest_seconds) {
+      slowest_seconds = step.seconds;
+      slowest_step = step.step;
+    }
+  }
+  double p99_seconds = 0.0;
+  if (!seconds.empty()) {
+    const std::size_t at = std::min(seconds.size() - 1, static_cast<std::size_t>(0.99 * static_cast<double>(seconds.size())));
+    std::nth_element(seconds.begin(), seconds.begin() + static_cast<std::ptrdiff_t>(at), seconds.end());
+    p99_seconds = seconds[at];
+  }
   summary["timing"] = {{"filter_step_mean_ms", 1e3 * sum_seconds / steps_count},
                        {"filter_step_max_ms", 1e3 * max_seconds},
+                       {"filter_step_first_ms", 1e3 * first_seconds},
+                       {"filter_step_max_after_first_ms", 1e3 * slowest_seconds},
+                       {"slowest_step_after_first", slowest_step},
+                       {"filter_step_p99_ms", 1e3 * p99_seconds},
                        {"total_s", report.total_seconds}};
   summary["cg"] = {{"max_iterations", max_cg}, {"unconverged_sigma_steps", unconverged},
                    {"factorisations", factorisations}};

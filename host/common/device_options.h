@@ -48,6 +48,15 @@ constexpr int kOwnFactorsFromSigmaPoints = 16;
 // each sigma point's own springs (DeviceOptions::spring_correction; its kernels keep two
 // arrays of that many reals per work-item).
 constexpr std::size_t kSpringRowsTimesSigmaPoints = 4096;
+
+// A shared factor whose making is the work of at least this many solves with it
+// (FactorisedPreconditioner::factorisation_in_solves) is made again on a host thread while the
+// ensemble steps on with the last one (host/reference/background_making.h): the 38k liver's
+// (320; a making 3-4 s), not the liver's (31) or the box's (55), made in milliseconds.
+constexpr double kBackgroundMakingSolves = 100.0;
+// And handed over this many steps after it began: longer than the 38k liver's making on two
+// cores shared with the device's threads (measured: bench/RESULTS.md, stop 62).
+constexpr int kBackgroundMakingSteps = 50;
 inline bool spring_correction_fits(std::size_t spring_rows, int sigma_count) {
   return spring_rows > 0 && spring_rows * static_cast<std::size_t>(sigma_count) <= kSpringRowsTimesSigmaPoints;
 }
@@ -121,6 +130,11 @@ struct DeviceOptions {
   // Vulkan's CPU form (texel reads) with S a multiple of 4: the element and node shaders take
   // four sigma points a lane (kernels/vulkan/sigma_quads.h); false: one (tests compare).
   bool sigma_quads = true;
+  // OpenCL's shared factor where its making is the work of background_making_solves solves
+  // or more: made again in the background and handed over background_making_steps steps later;
+  // 0 steps: made at once, the step waiting for it (tests compare).
+  int background_making_steps = kBackgroundMakingSteps;
+  double background_making_solves = kBackgroundMakingSolves;
   // The device memory a device ensemble may take, in bytes, where less than the device has (a
   // GPU shared with other work; tests); 0: the device's. The memory checks hold the ensemble's
   // buffers to it (usable_device_memory, host/ensemble/device_limits.h).

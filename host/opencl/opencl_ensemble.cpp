@@ -129,6 +129,8 @@ OpenClEnsemble::OpenClEnsemble(const Model& model, EstimatedParameters estimated
     // Again with the factor's buffers (L alone is 125 MB on the 38k liver; the copies of its
     // values add at most own_factors_bytes).
     check_device_memory_with_factor(factor_->nonzeros(), FactorStorage::columns, factor_copies_);
+    background_making_steps_ = options.background_making_steps;
+    background_making_solves_ = options.background_making_solves;
     // The copies in the layout of the blocks that solve with them (conjugate_gradient.cl): cg_solve's
     // blocks of their own vectors one after the other, else all S interleaved.
     factor_block_ = whole_solve_ && solve_block_ < S_ ? solve_block_ : S_;
@@ -404,7 +406,12 @@ StepReport OpenClEnsemble::advance(const Eigen::Vector3d& so_position) {
   const int factorisations_before = factorisations();
   try {
     const std::vector<double> constants = step_constants_.next_step(model_, so_position);
-    if (factor_ && factor_->due()) refresh_factor(constants);
+    if (factor_making_.pending()) {
+      bool made = false;
+      if (factor_making_.hand_over(made) && made) upload_factor(making_constants_);
+    } else if (factor_ && factor_->due()) {
+      refresh_factor(constants);
+    }
     if (multigrid_ && multigrid_refresh_.due()) refresh_multigrid(constants);
     write_reals(DeviceBuffer::constants, constants);
     if (coupling_stale_) upload_spring_coupling(constants);
@@ -428,7 +435,8 @@ StepReport OpenClEnsemble::advance(const Eigen::Vector3d& so_position) {
     const Precision precision = device_.precision();
     report = step_report(iterations, converged, from_device_reals(rr_bytes.data(), S_, precision),
                          from_device_reals(bb_bytes.data(), S_, precision));
-    if (factor_) factor_->record(*std::max_element(iterations.begin(), iterations.end()));
+    // Not while the factor is being made (the rule counts from the step it is handed over).
+    if (factor_ && !factor_making_.pending()) factor_->record(*std::max_element(iterations.begin(), iterations.end()));
     if (multigrid_) multigrid_refresh_.record(*std::max_element(iterations.begin(), iterations.end()));
     report.factorisations = factorisations() - factorisations_before;
   } catch (const cl::Error& error) {
@@ -438,25 +446,43 @@ StepReport OpenClEnsemble::advance(const Eigen::Vector3d& so_position) {
 }
 
 void OpenClEnsemble::refresh_factor(const std::vector<double>& constants) {
-  std::vector<double> values;
   if (factor_copies_ == 1) {
     const Eigen::SparseMatrix<double> A = representative_system();
-    if (!factor_->factorise(A)) return fall_back_to_diagonal(A);
-    const Eigen::SparseMatrix<double>& L = factor_->lower();
-    values.assign(L.valuePtr(), L.valuePtr() + L.nonZeros());
-    if (springs_.size() > 0) prepare_spring_correction(constants);
-  } else {
-    // Each sigma point's own system at its own state, factorised on the same analysis (the
-    // pattern is the assembly's, the same for all).
-    Eigen::MatrixXd X, V;
-    read_states(X, V);
-    values.resize(factor_->nonzeros() * static_cast<std::size_t>(S_));
-    for (int s = 0; s < S_; ++s) {
-      if (!factor_->factorise(sigma_system(s, X.col(s), V.col(s)))) return fall_back_to_diagonal(representative_system());
-      const double* L = factor_->lower().valuePtr();
-      for (std::size_t k = 0; k < factor_->nonzeros(); ++k) values[factor_value_index(s, k, factor_->nonzeros())] = L[k];
+    // A large factor in the background where the device has one to step on meanwhile; a failed
+    // making leaves that one in place, and the rule asks again at the next step.
+    if (on_device_ == FactorOnDevice::factor && background_making_steps_ > 0 &&
+        factor_->factorisation_in_solves() >= background_making_solves_) {
+      making_constants_ = constants;
+      factor_making_.start(background_making_steps_, [this, A] { return factor_->factorise(A); });
+      return;
     }
+    if (!factor_->factorise(A)) return fall_back_to_diagonal(A);
+    return upload_factor(constants);
   }
+  // Each sigma point's own system at its own state, factorised on the same analysis (the
+  // pattern is the assembly's, the same for all).
+  Eigen::MatrixXd X, V;
+  read_states(X, V);
+  std::vector<double> values(factor_->nonzeros() * static_cast<std::size_t>(S_));
+  for (int s = 0; s < S_; ++s) {
+    if (!factor_->factorise(sigma_system(s, X.col(s), V.col(s)))) return fall_back_to_diagonal(representative_system());
+    const double* L = factor_->lower().valuePtr();
+    for (std::size_t k = 0; k < factor_->nonzeros(); ++k) values[factor_value_index(s, k, factor_->nonzeros())] = L[k];
+  }
+  upload_factor_pattern();
+  write_reals(DeviceBuffer::factor_values, values);
+  factor_makings_ += S_;
+}
+
+void OpenClEnsemble::upload_factor(const std::vector<double>& constants) {
+  const Eigen::SparseMatrix<double>& L = factor_->lower();
+  if (springs_.size() > 0) prepare_spring_correction(constants);
+  upload_factor_pattern();
+  write_reals(DeviceBuffer::factor_values, std::vector<double>(L.valuePtr(), L.valuePtr() + L.nonZeros()));
+  ++factor_makings_;
+}
+
+void OpenClEnsemble::upload_factor_pattern() {
   // The factor's pattern and ordering are the same at every refresh (the representative's
   // assembly pattern does not change, so neither does the analysis): only the values go down
   // again.
@@ -467,7 +493,6 @@ void OpenClEnsemble::refresh_factor(const std::vector<double>& constants) {
     write_integers(DeviceBuffer::factor_rows, L.innerIndexPtr(), static_cast<std::size_t>(L.nonZeros()));
     write_integers(DeviceBuffer::factor_order, factor_->order(), rows);
   }
-  write_reals(DeviceBuffer::factor_values, values);
   on_device_ = FactorOnDevice::factor;
 }
 

@@ -18,6 +18,7 @@
 #include "host/model/model.h"
 #include "host/opencl/opencl_device.h"
 #include "host/opencl/opencl_multigrid.h"
+#include "host/reference/background_making.h"
 #include "host/reference/factorised_preconditioner.h"
 #include "host/reference/nested_multigrid.h"
 #include "host/reference/refresh_rule.h"
@@ -59,7 +60,7 @@ class OpenClEnsemble : public DeviceEnsemble {
   const OpenClDeviceInfo& device_info() const { return device_.info(); }
   // Factorisations of the shared factor, or makings of the multigrid hierarchy, so far (0 with
   // Jacobi).
-  int factorisations() const { return factor_ ? factor_->factorisations() : multigrid_makings_; }
+  int factorisations() const { return factor_ ? factor_makings_ : multigrid_makings_; }
   // Whether CG is preconditioned by the multigrid V-cycle.
   bool multigrid() const { return multigrid_ != nullptr; }
 
@@ -93,8 +94,14 @@ class OpenClEnsemble : public DeviceEnsemble {
   // Makes the factor again from the representative (the mean sigma point), or each sigma
   // point's from its own system, when it is due, and uploads it; with no factor yet and a
   // system that is not positive definite, uploads the representative's diagonal instead
-  // (upload_diagonal_factor).
+  // (upload_diagonal_factor). A large shared factor with one on the device already is made in
+  // the background instead (factor_making_), and upload_factor() runs at its hand-over.
   void refresh_factor(const std::vector<double>& constants);
+  // The shared factor just made goes down (its values; its pattern the first time), with its
+  // spring correction from the step constants it was made at.
+  void upload_factor(const std::vector<double>& constants);
+  // The factor's pattern and ordering, where the device has none yet (later ones keep them).
+  void upload_factor_pattern();
   // The spring correction of a fresh shared factor (SpringCorrection): V at the rows it
   // reaches goes down, and the representative's springs are kept for the couplings.
   void prepare_spring_correction(const std::vector<double>& constants);
@@ -155,6 +162,14 @@ class OpenClEnsemble : public DeviceEnsemble {
   // pattern and ordering later refreshes keep).
   enum class FactorOnDevice { none, diagonal, factor };
   FactorOnDevice on_device_ = FactorOnDevice::none;
+  // A large shared factor made again in the background (DeviceOptions::background_making_steps)
+  // and the step constants it was made at; factor_ is the making's until it is handed over.
+  // Declared after factor_: destroyed first, waiting for a making still running.
+  BackgroundMaking factor_making_;
+  int background_making_steps_ = 0;      // DeviceOptions::background_making_steps
+  double background_making_solves_ = 0;  // DeviceOptions::background_making_solves
+  std::vector<double> making_constants_;
+  int factor_makings_ = 0;   // successful factorisations (not read from factor_ while it is made)
   // CG's preconditioner on the GPU form where the mesh is a refinement (opencl_uses_multigrid):
   // the hierarchy of the representative's system, its copy on the device (once one has been
   // made), when to make it again, the estimated ligaments' rows with the hierarchy's springs

@@ -123,6 +123,8 @@ VulkanEnsemble::VulkanEnsemble(const Model& model, EstimatedParameters estimated
       springs_ = spring_correction(options.spring_correction);   // as OpenCL's
       factor_ = analysed_factor(springs_);   // their rows last, as OpenCL's
       check_device_memory_with_factor(factor_->nonzeros(), FactorStorage::blocks);
+      background_making_steps_ = options.background_making_steps;
+      background_making_solves_ = options.background_making_solves;
     }
   }
   cg_lane_rows_ = sigmafem::cg_lane_rows(options.cg_sigma_lanes_from, S_, info, !cg_partitioned_, factor_ != nullptr);
@@ -400,12 +402,28 @@ void VulkanEnsemble::refresh_factor(const std::vector<double>& constants) {
   // A matrix that is not positive definite (a diverged state?) leaves the last factor in
   // place, and the next step tries again.
   const Eigen::SparseMatrix<double> A = representative_system();
-  const std::size_t before = factor_solve_->bytes();   // a new pattern's buffers are made at its upload
-  if (!factor_->factorise(A)) {
-    if (!factor_solve_->ready()) factor_solve_->upload_diagonal(A);
-    device_bytes_ += factor_solve_->bytes() - before;
+  // A large factor in the background where the device has one to step on meanwhile (as
+  // OpenClEnsemble's): a failed making leaves that one in place.
+  if (factor_makings_ > 0 && background_making_steps_ > 0 &&
+      factor_->factorisation_in_solves() >= background_making_solves_) {
+    making_constants_ = constants;
+    factor_making_.start(background_making_steps_, [this, A] { return factor_->factorise(A); });
     return;
   }
+  if (!factor_->factorise(A)) {
+    if (!factor_solve_->ready()) {
+      const std::size_t before = factor_solve_->bytes();
+      factor_solve_->upload_diagonal(A);
+      device_bytes_ += factor_solve_->bytes() - before;
+    }
+    return;
+  }
+  upload_factor(constants);
+}
+
+void VulkanEnsemble::upload_factor(const std::vector<double>& constants) {
+  const std::size_t before = factor_solve_->bytes();   // a new pattern's buffers are made at its upload
+  ++factor_makings_;
   factor_solve_->upload(*factor_);
   device_bytes_ += factor_solve_->bytes() - before;
   if (springs_.size() == 0) return;
@@ -428,7 +446,12 @@ StepReport VulkanEnsemble::advance(const Eigen::Vector3d& so_position) {
   observations_current_ = false;
   const int factorisations_before = factorisations();
   const std::vector<double> step_constants = step_constants_.next_step(model_, so_position);
-  if (factor_ && factor_->due()) refresh_factor(step_constants);
+  if (factor_making_.pending()) {
+    bool made = false;
+    if (factor_making_.hand_over(made) && made) upload_factor(making_constants_);
+  } else if (factor_ && factor_->due()) {
+    refresh_factor(step_constants);
+  }
   if (multigrid_ && multigrid_refresh_.due()) refresh_multigrid(step_constants);
 
   // The right-hand side, the warm start and the first batch of iterations: as many as the
@@ -507,7 +530,8 @@ StepReport VulkanEnsemble::advance(const Eigen::Vector3d& so_position) {
   }
   StepReport report = step_report(iterations, converged, from_device_reals(area + at_rr, S, precision),
                                   from_device_reals(area + at_bb, S, precision));
-  if (factor_) factor_->record(*std::max_element(iterations.begin(), iterations.end()));
+  // Not while the factor is being made (the rule counts from the step it is handed over).
+  if (factor_ && !factor_making_.pending()) factor_->record(*std::max_element(iterations.begin(), iterations.end()));
   if (multigrid_) multigrid_refresh_.record(*std::max_element(iterations.begin(), iterations.end()));
   report.factorisations = factorisations() - factorisations_before;
   return report;

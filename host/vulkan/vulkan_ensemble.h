@@ -28,6 +28,7 @@
 #include "device_layout.h"
 #include "host/ensemble/device_ensemble.h"
 #include "host/model/model.h"
+#include "host/reference/background_making.h"
 #include "host/reference/factorised_preconditioner.h"
 #include "host/vulkan/vulkan_device.h"
 #include "host/vulkan/vulkan_factor_solve.h"
@@ -109,7 +110,7 @@ class VulkanEnsemble : public DeviceEnsemble {
   // (0 with Jacobi), and the dispatches of one solve with it.
   bool factorised() const { return factor_ != nullptr; }
   std::size_t factor_nonzeros() const { return factor_ ? factor_->nonzeros() : 0; }   // 0: none
-  int factorisations() const { return factor_ ? factor_->factorisations() : multigrid_makings_; }
+  int factorisations() const { return factor_ ? factor_makings_ : multigrid_makings_; }
   // Whether CG is preconditioned by the multigrid V-cycle (its makings: factorisations()).
   bool multigrid() const { return multigrid_ != nullptr; }
   int factor_solve_dispatches() const { return factor_solve_ ? factor_solve_->dispatches() : 0; }
@@ -132,7 +133,12 @@ class VulkanEnsemble : public DeviceEnsemble {
   // Makes the factor again from the representative (the mean sigma point) when it is due and
   // uploads it with its spring correction; with no factor yet and a failed factorisation,
   // A's diagonal (Jacobi) instead.
+  // A large factor (DeviceOptions::background_making_solves) with one on the device already is
+  // made in the background instead (factor_making_), and upload_factor() runs at its hand-over.
   void refresh_factor(const std::vector<double>& constants);
+  // The factor just made goes down with its spring correction from the step constants it was
+  // made at.
+  void upload_factor(const std::vector<double>& constants);
   // Makes the multigrid hierarchy again of the representative's system and uploads it; after
   // a failure the last one stays (none yet: Jacobi, cg_update's z, for the step).
   void refresh_multigrid(const std::vector<double>& constants);
@@ -186,6 +192,14 @@ class VulkanEnsemble : public DeviceEnsemble {
   SpringCorrection springs_;
   std::vector<double> factorised_springs_;
   bool coupling_stale_ = false;
+  // A large factor made again in the background (as OpenClEnsemble's; declared after factor_:
+  // destroyed first, waiting for a making still running), the step constants it was made at,
+  // and the successful makings (not read from factor_ while it is made).
+  BackgroundMaking factor_making_;
+  int background_making_steps_ = 0;
+  double background_making_solves_ = 0;
+  std::vector<double> making_constants_;
+  int factor_makings_ = 0;
   // The GPU form's multigrid V-cycle (vulkan_uses_multigrid): the hierarchy of the
   // representative's system, its dispatches, when to make it again, the estimated ligaments'
   // rows with the hierarchy's springs there, and whether the sigma points' shifts are stale.

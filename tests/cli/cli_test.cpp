@@ -303,6 +303,18 @@ TEST_F(CliTest, EstimateWritesEstimatesSummaryResidualsAndPlots) {
   }
   EXPECT_TRUE(summary["complete"].get<bool>());
   EXPECT_EQ(summary["filter_steps"].get<int>(), 30);
+  // The steps' times for a real-time user: the first apart, the slowest of the others (one of
+  // steps 2-30) and the 99th percentile, within the slowest of all.
+  const json& timing = summary["timing"];
+  const double max_ms = timing["filter_step_max_ms"].get<double>();
+  const double after_first_ms = timing["filter_step_max_after_first_ms"].get<double>();
+  EXPECT_GT(timing["filter_step_first_ms"].get<double>(), 0.0);
+  EXPECT_LE(timing["filter_step_first_ms"].get<double>(), max_ms);
+  EXPECT_GT(after_first_ms, 0.0);
+  EXPECT_LE(after_first_ms, max_ms);
+  EXPECT_LE(timing["filter_step_p99_ms"].get<double>(), after_first_ms);
+  EXPECT_GE(timing["slowest_step_after_first"].get<int>(), 2);
+  EXPECT_LE(timing["slowest_step_after_first"].get<int>(), 30);
   EXPECT_TRUE(summary["errors"].is_object()) << "truth.csv was in the data folder";
   EXPECT_TRUE(summary["final"].contains("middle"));
   // The residual diagnostics: 30 steps less the 10% burn-in, six tests and a verdict.

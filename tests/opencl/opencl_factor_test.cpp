@@ -8,6 +8,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <iostream>
 #include <string>
 
 #include "host/ensemble/cpu_ensemble.h"
@@ -41,11 +42,11 @@ class OpenClFactorTest : public ::testing::Test {
         theta_(j, s) = std::log(model_.ligaments[estimated[static_cast<std::size_t>(j)]].stiffness) +
                        0.3 * std::sin(static_cast<double>(s + j));
   }
-  // Runs kSteps steps; returns the positions of every sigma point (3N x S) and adds each
+  // Runs `steps` steps (kSteps unless given); returns the positions of every sigma point (3N x S) and adds each
   // step's largest CG iteration count to `iterations`.
-  Eigen::MatrixXd run(SimulationEnsemble& ensemble, long& iterations) const {
+  Eigen::MatrixXd run(SimulationEnsemble& ensemble, long& iterations, int steps = kSteps) const {
     ensemble.set_parameters(theta_);
-    for (int step = 1; step <= kSteps; ++step) {
+    for (int step = 1; step <= steps; ++step) {
       const StepReport report = ensemble.advance(
           scenario_.control.trajectory.position(step * scenario_.time.dt, scenario_.control.start));
       for (int s = 0; s < kSigmaPoints; ++s) {
@@ -143,6 +144,36 @@ TEST_F(OpenClFactorTest, WithoutAFactorTheDiagonalStandsIn) {
     EXPECT_TRUE(report.converged[s]) << s;
     EXPECT_EQ(report.cg_iterations[s], expected.cg_iterations[s]) << s;
   }
+}
+
+// A factor made again in the background (BackgroundMaking; DeviceOptions::background_making_*),
+// forced on the liver, whose factor is made in milliseconds: it is handed over at a step fixed
+// when its making began, so two runs give the same bits, and CG, preconditioned a few steps
+// longer by the older factor, ends within its tolerance of the run that waited for each making.
+TEST_F(OpenClFactorTest, AFactorMadeInTheBackgroundGivesTheSameBitsEveryRun) {
+  const auto run_with = [&](int lag, int& makings, long& iterations) {
+    DeviceOptions options;
+    options.spring_correction = false;   // the factor alone: more makings in few steps
+    options.background_making_solves = 0.0;
+    options.background_making_steps = lag;
+    OpenClEnsemble ensemble(model_, scenario_.filter->estimate, scenario_.observations.observed, kSigmaPoints,
+                            options);
+    const Eigen::MatrixXd x = run(ensemble, iterations, 300);
+    makings = ensemble.factorisations();
+    return x;
+  };
+  int waited_makings = 0, makings = 0, again_makings = 0;
+  long waited_iterations = 0, iterations = 0, again_iterations = 0;
+  const Eigen::MatrixXd waited = run_with(0, waited_makings, waited_iterations);
+  const Eigen::MatrixXd background = run_with(3, makings, iterations);
+  const Eigen::MatrixXd again = run_with(3, again_makings, again_iterations);
+  EXPECT_GE(makings, 2) << "no making in the background: the test tests nothing";
+  EXPECT_EQ(makings, again_makings);
+  EXPECT_EQ(iterations, again_iterations);
+  EXPECT_EQ((background - again).cwiseAbs().maxCoeff(), 0.0);
+  EXPECT_LE((background - waited).cwiseAbs().maxCoeff(), kPositionTolerance);
+  std::cout << "makings " << waited_makings << " waited, " << makings << " in the background; CG iterations "
+            << waited_iterations << " against " << iterations << "\n";
 }
 
 TEST_F(OpenClFactorTest, TheGpuFormRefusesIt) {

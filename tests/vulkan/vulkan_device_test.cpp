@@ -420,6 +420,38 @@ TEST_F(VulkanDeviceTest, CgGroupsGrowToKeepWithinTheLoopTurns) {
   }
 }
 
+// The factor made again in the background (BackgroundMaking), forced on the liver (as
+// OpenClFactorTest's): handed over at a step fixed when its making began, so two runs give the
+// same bits, and the run stays within CG's tolerance of the one that waited for each making.
+TEST_F(VulkanDeviceTest, AFactorMadeInTheBackgroundGivesTheSameBitsEveryRun) {
+  const Scenario scenario = load_scenario(kScenarios + "liver.json");
+  const Model model = make_model(scenario);
+  const int S = 4;
+  const Eigen::MatrixXd theta = test::spread_log_stiffness(scenario, model, S, 0.3);
+  const auto run_with = [&](int lag, int& makings, long& iterations) {
+    DeviceOptions options;
+    options.spring_correction = false;   // the factor alone: more makings in few steps
+    options.background_making_solves = 0.0;
+    options.background_making_steps = lag;
+    VulkanEnsemble ensemble(model, scenario.filter->estimate, scenario.observations.nodes, S, options);
+    if (!ensemble.factorised()) return Eigen::MatrixXd();
+    const Eigen::MatrixXd x = test::run_steps(ensemble, scenario, theta, 300, iterations);
+    makings = ensemble.factorisations();
+    return x;
+  };
+  int waited_makings = 0, makings = 0, again_makings = 0;
+  long waited_iterations = 0, iterations = 0, again_iterations = 0;
+  const Eigen::MatrixXd waited = run_with(0, waited_makings, waited_iterations);
+  if (waited.size() == 0) GTEST_SKIP() << "Vulkan's factor is a CPU device's";
+  const Eigen::MatrixXd background = run_with(3, makings, iterations);
+  const Eigen::MatrixXd again = run_with(3, again_makings, again_iterations);
+  EXPECT_GE(makings, 2) << "no making in the background: the test tests nothing";
+  EXPECT_EQ(makings, again_makings);
+  EXPECT_EQ(iterations, again_iterations);
+  EXPECT_EQ((background - again).cwiseAbs().maxCoeff(), 0.0);
+  EXPECT_LE((background - waited).cwiseAbs().maxCoeff(), 1e-6);
+}
+
 // The 38k liver's filter (S = 4, the factor): its 2 lanes a sigma point would turn the CG
 // shaders' loops ~115 000 times, past lavapipe's 65535, which then ended them silently and CG
 // started from a residual whose last rows were never written (the filter's estimate went
