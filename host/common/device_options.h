@@ -54,9 +54,11 @@ constexpr std::size_t kSpringRowsTimesSigmaPoints = 4096;
 // ensemble steps on with the last one (host/reference/background_making.h): the 38k liver's
 // (320; a making 3-4 s), not the liver's (31) or the box's (55), made in milliseconds.
 constexpr double kBackgroundMakingSolves = 100.0;
-// And handed over this many steps after it began: longer than the 38k liver's making on two
-// cores shared with the device's threads (measured: bench/RESULTS.md, stop 62).
-constexpr int kBackgroundMakingSteps = 50;
+// And handed over this many steps after it began. The 38k liver on PoCL, 2 cores shared with
+// the making (bench/RESULTS.md, stop 62): 10 steps waited for it at 3 of 9 hand-overs (up to
+// 0.86 s), 20 at none; 50 kept CG on a staler factor longer (a step 111 ms on average against
+// 88 with 20 and 81 made at once, when a making stopped its step for 1.5-1.85 s).
+constexpr int kBackgroundMakingSteps = 20;
 inline bool spring_correction_fits(std::size_t spring_rows, int sigma_count) {
   return spring_rows > 0 && spring_rows * static_cast<std::size_t>(sigma_count) <= kSpringRowsTimesSigmaPoints;
 }

@@ -2,8 +2,8 @@
 // with the last one, as SOFA's asynchronous preconditioner does, but handed over at a step
 // fixed when the making began (`lag` steps later) rather than whenever it is done: the runs
 // repeat bit for bit whatever the machine's load. Where a refactorisation took seconds (the
-// 38k liver's shared factor: the filter step it fell in took 2.5 s against 88 ms for the
-// others, bench/RESULTS.md, stop 62), its work is spread over the steps in between.
+// 38k liver's shared factor on PoCL: the filter step it fell in took 1.5-1.85 s against a
+// median of 68 ms, bench/RESULTS.md, stop 62), its work is spread over the steps in between.
 // The owner must not touch what `make` works on until hand_over() says so.
 #pragma once
 

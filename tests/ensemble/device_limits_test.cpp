@@ -17,7 +17,7 @@ namespace {
 // partitions: a sector's worth (8 floats, 4 doubles) or all S where fewer, and as many groups
 // as with a sigma point a group (S x P: the partitions grow with the lanes).
 TEST(CgGroups, SigmaPointsSideBySideInPartitionsAsManyGroupsAsBefore) {
-  const int small = 100, large = 30036;   // 300 rows: one partition; the 38k liver: 64
+  const int small = 100, large = 30036;   // 300 rows: one partition; 90108 rows: the most, 64
   ASSERT_EQ(cg_partitions(small, 0), 1);
   ASSERT_EQ(cg_partitions(large, 0), kMostPartitions);
   // A small mesh: a group per sigma point in cg_iteration, as before.
