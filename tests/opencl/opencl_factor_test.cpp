@@ -8,7 +8,6 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
-#include <iostream>
 #include <string>
 
 #include "host/ensemble/cpu_ensemble.h"
@@ -16,6 +15,7 @@
 #include "host/opencl/opencl_device.h"
 #include "host/opencl/opencl_ensemble.h"
 #include "host/scenario/scenario.h"
+#include "background_making_runs.h"
 #include "requirement.h"
 
 namespace sigmafem {
@@ -151,29 +151,16 @@ TEST_F(OpenClFactorTest, WithoutAFactorTheDiagonalStandsIn) {
 // when its making began, so two runs give the same bits, and CG, preconditioned a few steps
 // longer by the older factor, ends within its tolerance of the run that waited for each making.
 TEST_F(OpenClFactorTest, AFactorMadeInTheBackgroundGivesTheSameBitsEveryRun) {
-  const auto run_with = [&](int lag, int& makings, long& iterations) {
-    DeviceOptions options;
-    options.spring_correction = false;   // the factor alone: more makings in few steps
-    options.background_making_solves = 0.0;
-    options.background_making_steps = lag;
+  const auto run_with = [&](int lag) {
     OpenClEnsemble ensemble(model_, scenario_.filter->estimate, scenario_.observations.observed, kSigmaPoints,
-                            options);
-    const Eigen::MatrixXd x = run(ensemble, iterations, 300);
-    makings = ensemble.factorisations();
-    return x;
+                            test::background_making_options(lag));
+    test::MakingRun made;
+    made.x = run(ensemble, made.iterations, 300);
+    made.makings = ensemble.factorisations();
+    return made;
   };
-  int waited_makings = 0, makings = 0, again_makings = 0;
-  long waited_iterations = 0, iterations = 0, again_iterations = 0;
-  const Eigen::MatrixXd waited = run_with(0, waited_makings, waited_iterations);
-  const Eigen::MatrixXd background = run_with(3, makings, iterations);
-  const Eigen::MatrixXd again = run_with(3, again_makings, again_iterations);
-  EXPECT_GE(makings, 2) << "no making in the background: the test tests nothing";
-  EXPECT_EQ(makings, again_makings);
-  EXPECT_EQ(iterations, again_iterations);
-  EXPECT_EQ((background - again).cwiseAbs().maxCoeff(), 0.0);
-  EXPECT_LE((background - waited).cwiseAbs().maxCoeff(), kPositionTolerance);
-  std::cout << "makings " << waited_makings << " waited, " << makings << " in the background; CG iterations "
-            << waited_iterations << " against " << iterations << "\n";
+  const test::MakingRun waited = run_with(0);
+  test::expect_background_making_repeats(waited, run_with(3), run_with(3), kPositionTolerance);
 }
 
 TEST_F(OpenClFactorTest, TheGpuFormRefusesIt) {

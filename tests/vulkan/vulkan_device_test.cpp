@@ -19,6 +19,7 @@
 #include "host/model/model.h"
 #include "host/scenario/scenario.h"
 #include "host/vulkan/vulkan_ensemble.h"
+#include "background_making_runs.h"
 #include "requirement.h"
 #include "tests/refined_liver.h"
 #include "tests/scenario_directory.h"
@@ -428,28 +429,18 @@ TEST_F(VulkanDeviceTest, AFactorMadeInTheBackgroundGivesTheSameBitsEveryRun) {
   const Model model = make_model(scenario);
   const int S = 4;
   const Eigen::MatrixXd theta = test::spread_log_stiffness(scenario, model, S, 0.3);
-  const auto run_with = [&](int lag, int& makings, long& iterations) {
-    DeviceOptions options;
-    options.spring_correction = false;   // the factor alone: more makings in few steps
-    options.background_making_solves = 0.0;
-    options.background_making_steps = lag;
-    VulkanEnsemble ensemble(model, scenario.filter->estimate, scenario.observations.nodes, S, options);
-    if (!ensemble.factorised()) return Eigen::MatrixXd();
-    const Eigen::MatrixXd x = test::run_steps(ensemble, scenario, theta, 300, iterations);
-    makings = ensemble.factorisations();
-    return x;
+  const auto run_with = [&](int lag) {
+    VulkanEnsemble ensemble(model, scenario.filter->estimate, scenario.observations.nodes, S,
+                            test::background_making_options(lag));
+    test::MakingRun made;
+    if (!ensemble.factorised()) return made;
+    made.x = test::run_steps(ensemble, scenario, theta, 300, made.iterations);
+    made.makings = ensemble.factorisations();
+    return made;
   };
-  int waited_makings = 0, makings = 0, again_makings = 0;
-  long waited_iterations = 0, iterations = 0, again_iterations = 0;
-  const Eigen::MatrixXd waited = run_with(0, waited_makings, waited_iterations);
-  if (waited.size() == 0) GTEST_SKIP() << "Vulkan's factor is a CPU device's";
-  const Eigen::MatrixXd background = run_with(3, makings, iterations);
-  const Eigen::MatrixXd again = run_with(3, again_makings, again_iterations);
-  EXPECT_GE(makings, 2) << "no making in the background: the test tests nothing";
-  EXPECT_EQ(makings, again_makings);
-  EXPECT_EQ(iterations, again_iterations);
-  EXPECT_EQ((background - again).cwiseAbs().maxCoeff(), 0.0);
-  EXPECT_LE((background - waited).cwiseAbs().maxCoeff(), 1e-6);
+  const test::MakingRun waited = run_with(0);
+  if (waited.x.size() == 0) GTEST_SKIP() << "Vulkan's factor is a CPU device's";
+  test::expect_background_making_repeats(waited, run_with(3), run_with(3), 1e-6);
 }
 
 // The 38k liver's filter (S = 4, the factor): its 2 lanes a sigma point would turn the CG
