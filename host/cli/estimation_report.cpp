@@ -1,10 +1,10 @@
 #include "host/cli/estimation_report.h"
 
 #include <algorithm>
-#include <vector>
 #include <cmath>
 #include <filesystem>
 #include <sstream>
+#include <vector>
 
 #include "host/cli/plot.h"
 #include "host/cli/residual_report.h"

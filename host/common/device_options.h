@@ -52,7 +52,8 @@ constexpr std::size_t kSpringRowsTimesSigmaPoints = 4096;
 // A shared factor whose making is the work of at least this many solves with it
 // (FactorisedPreconditioner::factorisation_in_solves) is made again on a host thread while the
 // ensemble steps on with the last one (host/reference/background_making.h): the 38k liver's
-// (320; a making 3-4 s), not the liver's (31) or the box's (55), made in milliseconds.
+// (320; made at once, its making stopped a step for 1.5-1.85 s on PoCL), not the liver's (31)
+// or the box's (55), made in milliseconds.
 constexpr double kBackgroundMakingSolves = 100.0;
 // And handed over this many steps after it began. The 38k liver on PoCL, 2 cores shared with
 // the making (bench/RESULTS.md, stop 62): 10 steps waited for it at 3 of 9 hand-overs (up to
