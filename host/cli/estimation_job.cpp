@@ -166,12 +166,21 @@ std::optional<json> run_estimation_job(const Scenario& scenario, const Estimatio
 
 void print_estimation_summary(std::ostream& out, const json& summary, const std::string& out_dir) {
   char line[256];
+  const json& timing = summary["timing"];
   std::snprintf(line, sizeof line, "estimated '%s' over %d filter steps (%s, %s sigma points x%d): %.2f ms per step\n",
                 summary["scenario"].get<std::string>().c_str(), summary["filter_steps"].get<int>(),
                 summary["backend"].get<std::string>().c_str(),
                 summary["sigma_points"].get<std::string>().c_str(), summary["sigma_count"].get<int>(),
-                summary["timing"]["filter_step_mean_ms"].get<double>());
+                timing["filter_step_mean_ms"].get<double>());
   out << line;
+  // For real time: how long the worst steps took (the first apart: it makes the first
+  // preconditioner).
+  if (summary["filter_steps"].get<int>() > 1) {
+    std::snprintf(line, sizeof line, "  steps after the first: 99%% within %.2f ms, the slowest %.2f ms (step %d); the first %.2f ms\n",
+                  timing["filter_step_p99_ms"].get<double>(), timing["filter_step_max_after_first_ms"].get<double>(),
+                  timing["slowest_step_after_first"].get<int>(), timing["filter_step_first_ms"].get<double>());
+    out << line;
+  }
   if (!summary["complete"].get<bool>())
     out << "  INCOMPLETE: " << summary["stop_reason"].get<std::string>() << '\n';
   for (const auto& [name, value] : summary["final"].items()) {

@@ -281,6 +281,7 @@ TEST_F(CliTest, EstimateWritesEstimatesSummaryResidualsAndPlots) {
                                       " --out " + (dir_ / "estimate").string());
   ASSERT_EQ(run.exit_code, 0) << run.output;
   EXPECT_NE(run.output.find("estimated 'box' over 30 filter steps"), std::string::npos) << run.output;
+  EXPECT_NE(run.output.find("  steps after the first: 99% within "), std::string::npos) << run.output;
   // --backend auto by default: the first line says what it chose and why (the choice itself:
   // tests/ensemble/choose_backend_test.cpp), and so does the summary.
   const BackendDecision expected = choose_backend(find_gpus(), 1344, 4);   // box.json: 1344 tetrahedra, simplex, 3 ligaments
