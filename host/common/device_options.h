@@ -52,7 +52,7 @@ constexpr std::size_t kSpringRowsTimesSigmaPoints = 4096;
 // A shared factor whose making is the work of at least this many solves with it
 // (FactorisedPreconditioner::factorisation_in_solves) is made again on a host thread while the
 // ensemble steps on with the last one (host/reference/background_making.h): the 38k liver's
-// (320 at stop 62; made at once, its making stopped a step for 1.5-1.85 s on PoCL) and the 117k
+// (322; made at once, its making stopped a step for 1.5-1.85 s on PoCL) and the 117k
 // box's (711), not the 4768 liver's (104), the box's (55) or the liver's (35), made in tens of
 // milliseconds or less: they are made at once as before (not measured the other way yet).
 constexpr double kBackgroundMakingSolves = 200.0;
