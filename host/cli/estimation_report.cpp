@@ -210,8 +210,22 @@ nlohmann::ordered_json write_estimation_report(const EstimationReport& report, c
   json final_estimates = json::object();
   double max_seconds = 0.0, sum_seconds = 0.0;
   int max_cg = 0, unconverged = 0, factorisations = 0;
+  // A real-time user's figures: the first step apart (it makes the first preconditioner), the
+  // slowest of the others and where, and the time 99% of them keep within.
+  double first_seconds = 0.0, slowest_seconds = 0.0;
+  int slowest_step = 0;
+  std::vector<double> seconds;   // of the steps after the first
   json changes = json::array();
   for (const EstimationStep& step : run.steps) {
+    if (&step == &run.steps.front()) {
+      first_seconds = step.seconds;
+    } else {
+      seconds.push_back(step.seconds);
+      if (step.seconds > slowest_seconds) {
+        slowest_seconds = step.seconds;
+        slowest_step = step.step;
+      }
+    }
     max_seconds = std::max(max_seconds, step.seconds);
     sum_seconds += step.seconds;
     max_cg = std::max(max_cg, step.max_cg_iterations);
@@ -231,22 +245,6 @@ nlohmann::ordered_json write_estimation_report(const EstimationReport& report, c
   }
   summary["final"] = final_estimates;
   const double steps_count = std::max<double>(1.0, static_cast<double>(run.steps.size()));
-  // A real-time user's figures: the first step apart (it makes the first preconditioner), the
-  // slowest of the others and where, and the time 99% of the steps keep within.
-  double first_seconds = 0.0, slowest_seconds = 0.0;
-  int slowest_step = 0;
-  std::vector<double> seconds;
-  for (const EstimationStep& step : run.steps) {
-    if (&step == &run.steps.front()) {
-      first_seconds = step.seconds;
-      continue;
-    }
-    seconds.push_back(step.seconds);
-    if (step.seconds > slowest_seconds) {
-      slowest_seconds = step.seconds;
-      slowest_step = step.step;
-    }
-  }
   double p99_seconds = 0.0;
   if (!seconds.empty()) {
     const std::size_t at = std::min(seconds.size() - 1, static_cast<std::size_t>(0.99 * static_cast<double>(seconds.size())));

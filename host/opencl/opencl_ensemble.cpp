@@ -129,8 +129,7 @@ OpenClEnsemble::OpenClEnsemble(const Model& model, EstimatedParameters estimated
     // Again with the factor's buffers (L alone is 125 MB on the 38k liver; the copies of its
     // values add at most own_factors_bytes).
     check_device_memory_with_factor(factor_->nonzeros(), FactorStorage::columns, factor_copies_);
-    background_making_steps_ = options.background_making_steps;
-    background_making_solves_ = options.background_making_solves;
+    factor_making_.set_rule(options.background_making_steps, options.background_making_solves);
     // The copies in the layout of the blocks that solve with them (conjugate_gradient.cl): cg_solve's
     // blocks of their own vectors one after the other, else all S interleaved.
     factor_block_ = whole_solve_ && solve_block_ < S_ ? solve_block_ : S_;
@@ -450,10 +449,9 @@ void OpenClEnsemble::refresh_factor(const std::vector<double>& constants) {
     const Eigen::SparseMatrix<double> A = representative_system();
     // A large factor in the background where the device has one to step on meanwhile; a failed
     // making leaves that one in place, and the rule asks again at the next step.
-    if (on_device_ == FactorOnDevice::factor && background_making_steps_ > 0 &&
-        factor_->factorisation_in_solves() >= background_making_solves_) {
+    if (on_device_ == FactorOnDevice::factor && factor_making_.takes(factor_->factorisation_in_solves())) {
       making_constants_ = constants;
-      factor_making_.start(background_making_steps_, [this, A] { return factor_->factorise(A); });
+      factor_making_.start([this, A] { return factor_->factorise(A); });
       return;
     }
     if (!factor_->factorise(A)) return fall_back_to_diagonal(A);

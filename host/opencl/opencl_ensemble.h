@@ -166,8 +166,6 @@ class OpenClEnsemble : public DeviceEnsemble {
   // and the step constants it was made at; factor_ is the making's until it is handed over.
   // Declared after factor_: destroyed first, waiting for a making still running.
   BackgroundMaking factor_making_;
-  int background_making_steps_ = 0;      // DeviceOptions::background_making_steps
-  double background_making_solves_ = 0;  // DeviceOptions::background_making_solves
   std::vector<double> making_constants_;
   int factor_makings_ = 0;   // successful factorisations (not read from factor_ while it is made)
   // CG's preconditioner on the GPU form where the mesh is a refinement (opencl_uses_multigrid):

@@ -23,12 +23,19 @@ class BackgroundMaking {
     if (future_.valid()) future_.wait();
   }
 
+  // Which makings go to the background: those of `least_work` or more (in the owner's unit),
+  // handed over `lag` steps after they begin; lag 0: none.
+  void set_rule(int lag, double least_work) {
+    lag_ = lag;
+    least_work_ = least_work;
+  }
+  bool takes(double work) const { return lag_ > 0 && work >= least_work_; }
   // Whether a making is running or waiting to be handed over.
   bool pending() const { return future_.valid(); }
   // Starts `make` (true where it succeeded) on its own thread, to be handed over at the
-  // `lag`-th hand_over() from now (lag >= 1).
-  void start(int lag, std::function<bool()> make) {
-    steps_left_ = lag < 1 ? 1 : lag;
+  // lag-th hand_over() from now.
+  void start(std::function<bool()> make) {
+    steps_left_ = lag_ < 1 ? 1 : lag_;
     future_ = std::async(std::launch::async, std::move(make));
   }
   // Once at the start of each step while pending(): whether this is the step to hand the
@@ -43,6 +50,8 @@ class BackgroundMaking {
  private:
   std::future<bool> future_;
   int steps_left_ = 0;
+  int lag_ = 0;
+  double least_work_ = 0.0;
 };
 
 }  // namespace sigmafem

@@ -123,8 +123,7 @@ VulkanEnsemble::VulkanEnsemble(const Model& model, EstimatedParameters estimated
       springs_ = spring_correction(options.spring_correction);   // as OpenCL's
       factor_ = analysed_factor(springs_);   // their rows last, as OpenCL's
       check_device_memory_with_factor(factor_->nonzeros(), FactorStorage::blocks);
-      background_making_steps_ = options.background_making_steps;
-      background_making_solves_ = options.background_making_solves;
+      factor_making_.set_rule(options.background_making_steps, options.background_making_solves);
     }
   }
   cg_lane_rows_ = sigmafem::cg_lane_rows(options.cg_sigma_lanes_from, S_, info, !cg_partitioned_, factor_ != nullptr);
@@ -404,10 +403,9 @@ void VulkanEnsemble::refresh_factor(const std::vector<double>& constants) {
   const Eigen::SparseMatrix<double> A = representative_system();
   // A large factor in the background where the device has one to step on meanwhile (as
   // OpenClEnsemble's): a failed making leaves that one in place.
-  if (factor_makings_ > 0 && background_making_steps_ > 0 &&
-      factor_->factorisation_in_solves() >= background_making_solves_) {
+  if (factor_makings_ > 0 && factor_making_.takes(factor_->factorisation_in_solves())) {
     making_constants_ = constants;
-    factor_making_.start(background_making_steps_, [this, A] { return factor_->factorise(A); });
+    factor_making_.start([this, A] { return factor_->factorise(A); });
     return;
   }
   if (!factor_->factorise(A)) {

@@ -196,8 +196,6 @@ class VulkanEnsemble : public DeviceEnsemble {
   // destroyed first, waiting for a making still running), the step constants it was made at,
   // and the successful makings (not read from factor_ while it is made).
   BackgroundMaking factor_making_;
-  int background_making_steps_ = 0;
-  double background_making_solves_ = 0;
   std::vector<double> making_constants_;
   int factor_makings_ = 0;
   // The GPU form's multigrid V-cycle (vulkan_uses_multigrid): the hierarchy of the
