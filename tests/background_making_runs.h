@@ -1,6 +1,7 @@
 // The background making's check, shared by the back ends that have it (OpenClFactorTest,
-// VulkanDeviceTest): three runs of the same steps, the first waiting for each making of the
-// factor, the other two making it in the background (host/reference/background_making.h).
+// VulkanDeviceTest; OpenClMultigridTest, VulkanMultigridTest): three runs of the same steps, the
+// first waiting for each making of the factor or the multigrid hierarchy, the other two making
+// it in the background (host/reference/background_making.h).
 #pragma once
 
 #include <gtest/gtest.h>
@@ -9,6 +10,7 @@
 #include <iostream>
 
 #include "host/common/device_options.h"
+#include "tests/refined_liver.h"
 
 namespace sigmafem::test {
 
@@ -23,7 +25,7 @@ inline DeviceOptions background_making_options(int lag) {
   return options;
 }
 
-// One run: the positions at its end, the factor's makings and the CG iterations.
+// One run: the positions at its end, the preconditioner's makings and the CG iterations.
 struct MakingRun {
   Eigen::MatrixXd x;
   int makings = 0;
@@ -41,7 +43,20 @@ inline void expect_background_making_repeats(const MakingRun& waited, const Maki
   EXPECT_LE((background.x - waited.x).cwiseAbs().maxCoeff(), tolerance);
   std::cout << "makings " << waited.makings << " waited, " << background.makings
             << " in the background; CG iterations " << waited.iterations << " against " << background.iterations
-            << "\n";
+            << "; positions apart by " << (background.x - waited.x).cwiseAbs().maxCoeff() << " m\n";
+}
+
+// The multigrid tests' run (OpenClMultigridTest, VulkanMultigridTest): 8 steps of the
+// scenario's motion with `theta`, then 8 from its start again with every ligament e times as
+// stiff, a system the last hierarchy was not made of: CG takes more iterations, and the rule
+// makes it again (with DeviceOptions::multigrid_making_cycles small).
+template <class Ensemble>
+MakingRun multigrid_making_run(Ensemble& ensemble, const Scenario& scenario, const Eigen::MatrixXd& theta) {
+  MakingRun made;
+  run_steps(ensemble, scenario, theta, 8, made.iterations);
+  made.x = run_steps(ensemble, scenario, Eigen::MatrixXd(theta.array() + 1.0), 8, made.iterations);
+  made.makings = ensemble.factorisations();
+  return made;
 }
 
 }  // namespace sigmafem::test

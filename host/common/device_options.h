@@ -54,13 +54,21 @@ constexpr std::size_t kSpringRowsTimesSigmaPoints = 4096;
 // ensemble steps on with the last one (host/reference/background_making.h): the 38k liver's
 // (322; made at once, its making stopped a step for 1.5-1.85 s on PoCL) and the 117k
 // box's (711), not the 4768 liver's (104), the box's (55) or the liver's (35), made in tens of
-// milliseconds or less: they are made at once as before (not measured the other way yet).
+// milliseconds or less: they are made at once as before. Measured the other way on the 4768
+// liver (2000 steps on PoCL, bench/RESULTS.md, stop 63): in the background its slowest step
+// 35 -> 16 ms, but its mean 3.5 -> 3.8 ms (CG on an older factor).
 constexpr double kBackgroundMakingSolves = 200.0;
 // And handed over this many steps after it began. The 38k liver on PoCL, 2 cores shared with
 // the making (bench/RESULTS.md, stop 62): 10 steps waited for it at 3 of 9 hand-overs (up to
 // 0.86 s), 20 at none; 50 kept CG on a staler factor longer (a step 111 ms on average against
 // 88 with 20 and 81 made at once, when a making stopped its step for 1.5-1.85 s).
 constexpr int kBackgroundMakingSteps = 20;
+// The least work (in V-cycles) of a making of the multigrid hierarchy that goes to the
+// background: any after the first. Its host work stops a GPU's step of a few milliseconds for
+// as long as it takes (the 38k liver's: ~110 ms here on PoCL, against the 16 V-cycles of a
+// step; bench/RESULTS.md, stop 63), and the hierarchy is made seldom (once in 190 steps there),
+// so that 20 more steps on the last one cost little.
+constexpr double kBackgroundMultigridCycles = 0.0;
 inline bool spring_correction_fits(std::size_t spring_rows, int sigma_count) {
   return spring_rows > 0 && spring_rows * static_cast<std::size_t>(sigma_count) <= kSpringRowsTimesSigmaPoints;
 }
@@ -134,11 +142,16 @@ struct DeviceOptions {
   // Vulkan's CPU form (texel reads) with S a multiple of 4: the element and node shaders take
   // four sigma points a lane (kernels/vulkan/sigma_quads.h); false: one (tests compare).
   bool sigma_quads = true;
-  // OpenCL's shared factor where its making is the work of background_making_solves solves
-  // or more: made again in the background and handed over background_making_steps steps later;
-  // 0 steps: made at once, the step waiting for it (tests compare).
+  // The shared factor (OpenCL's CPU form, Vulkan on a CPU device) where its making is the work
+  // of background_making_solves solves or more, and the multigrid hierarchy at every making
+  // after the first: made again in the background and handed over background_making_steps
+  // steps later; 0 steps: made at once, the step waiting for it (tests compare).
   int background_making_steps = kBackgroundMakingSteps;
   double background_making_solves = kBackgroundMakingSolves;
+  // The V-cycles a making of the multigrid hierarchy counts for in its refresh rule
+  // (host/reference/refresh_rule.h); 0: its arithmetic's (NestedMultigrid::setup_in_cycles).
+  // Tests make it small, to make the hierarchy again within a few steps.
+  double multigrid_making_cycles = 0.0;
   // The device memory a device ensemble may take, in bytes, where less than the device has (a
   // GPU shared with other work; tests); 0: the device's. The memory checks hold the ensemble's
   // buffers to it (usable_device_memory, host/ensemble/device_limits.h).

@@ -190,11 +190,18 @@ std::vector<double> DeviceEnsemble::representative_ligament_k() const {
 }
 
 Eigen::SparseMatrix<double> DeviceEnsemble::representative_system() const {
+  return representative_system_later()();
+}
+
+std::function<Eigen::SparseMatrix<double>()> DeviceEnsemble::representative_system_later() const {
   const std::size_t rows = 3 * static_cast<std::size_t>(nodes_);
   const auto mean = [&](DeviceBuffer buffer) -> Eigen::VectorXd {
     return from_sigma_rows(read_reals(buffer, rows * S_), rows, S_).rowwise().mean();
   };
-  return representative_system(mean(DeviceBuffer::x), mean(DeviceBuffer::v));
+  // As representative_system(x, v), with copies of what the next steps change.
+  const Eigen::VectorXd theta = theta_.size() > 0 ? Eigen::VectorXd(theta_.rowwise().mean()) : Eigen::VectorXd();
+  return [this, theta, effects = effects_.empty() ? PhysicsEffects{} : effects_.front(), x = mean(DeviceBuffer::x),
+          v = mean(DeviceBuffer::v)] { return system_at(theta, effects, x, v); };
 }
 
 std::vector<double> DeviceEnsemble::column_of(DeviceBuffer buffer, std::size_t rows, int s) const {

@@ -12,6 +12,7 @@
 #include <algorithm>
 #include <cstddef>
 #include <cstdint>
+#include <functional>
 #include <memory>
 #include <string>
 #include <vector>
@@ -108,6 +109,11 @@ class DeviceEnsemble : public SimulationEnsemble {
   Eigen::SparseMatrix<double> sigma_system(int s, const Eigen::VectorXd& x, const Eigen::VectorXd& v) const;
   // The same at the sigma points' mean state.
   Eigen::SparseMatrix<double> representative_system() const;
+  // ... its inputs (the mean state, the parameters, the effects) read now and the matrix
+  // assembled when called: on a background making's thread (host/reference/background_making.h),
+  // so that the step that starts it does not stop for the assembly (~60 ms on the 38k liver).
+  // The representative simulation it assembles with must not be used elsewhere meanwhile.
+  std::function<Eigen::SparseMatrix<double>()> representative_system_later() const;
   // ligament_k_ with every sigma point's estimated ligaments at the representative's
   // stiffnesses (the sigma points' mean log-stiffnesses, as representative_system has them).
   std::vector<double> representative_ligament_k() const;

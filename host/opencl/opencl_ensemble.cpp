@@ -129,7 +129,7 @@ OpenClEnsemble::OpenClEnsemble(const Model& model, EstimatedParameters estimated
     // Again with the factor's buffers (L alone is 125 MB on the 38k liver; the copies of its
     // values add at most own_factors_bytes).
     check_device_memory_with_factor(factor_->nonzeros(), FactorStorage::columns, factor_copies_);
-    factor_making_.set_rule(options.background_making_steps, options.background_making_solves);
+    preconditioner_making_.set_rule(options.background_making_steps, options.background_making_solves);
     // The copies in the layout of the blocks that solve with them (conjugate_gradient.cl): cg_solve's
     // blocks of their own vectors one after the other, else all S interleaved.
     factor_block_ = whole_solve_ && solve_block_ < S_ ? solve_block_ : S_;
@@ -147,6 +147,8 @@ OpenClEnsemble::OpenClEnsemble(const Model& model, EstimatedParameters estimated
                         "(a scenario's mesh.refine makes one)");
     multigrid_ = std::make_unique<NestedMultigrid>(std::move(prolongations));
     shift_rows_ = SpringCorrection(estimated_spring_rows(model_, estimated_));
+    multigrid_making_cycles_ = options.multigrid_making_cycles;
+    preconditioner_making_.set_rule(options.background_making_steps, kBackgroundMultigridCycles);
   }
   cg_partitioned_ = cg_per_group_ && (cg_partitions_ > 1 || multigrid_);
   // With a factor the solve is most of an iteration, and each block solves with a work vector
@@ -405,13 +407,14 @@ StepReport OpenClEnsemble::advance(const Eigen::Vector3d& so_position) {
   const int factorisations_before = factorisations();
   try {
     const std::vector<double> constants = step_constants_.next_step(model_, so_position);
-    if (factor_making_.pending()) {
+    if (preconditioner_making_.pending()) {
       bool made = false;
-      if (factor_making_.hand_over(made) && made) upload_factor(making_constants_);
+      if (preconditioner_making_.hand_over(made)) hand_over_making(made);
     } else if (factor_ && factor_->due()) {
       refresh_factor(constants);
+    } else if (multigrid_ && multigrid_refresh_.due()) {
+      refresh_multigrid(constants);
     }
-    if (multigrid_ && multigrid_refresh_.due()) refresh_multigrid(constants);
     write_reals(DeviceBuffer::constants, constants);
     if (coupling_stale_) upload_spring_coupling(constants);
     if (shift_stale_) upload_multigrid_shift(constants);
@@ -434,9 +437,12 @@ StepReport OpenClEnsemble::advance(const Eigen::Vector3d& so_position) {
     const Precision precision = device_.precision();
     report = step_report(iterations, converged, from_device_reals(rr_bytes.data(), S_, precision),
                          from_device_reals(bb_bytes.data(), S_, precision));
-    // Not while the factor is being made (the rule counts from the step it is handed over).
-    if (factor_ && !factor_making_.pending()) factor_->record(*std::max_element(iterations.begin(), iterations.end()));
-    if (multigrid_) multigrid_refresh_.record(*std::max_element(iterations.begin(), iterations.end()));
+    // Not while a preconditioner is being made (the rule counts from the step it is handed over).
+    if (!preconditioner_making_.pending()) {
+      const int most = *std::max_element(iterations.begin(), iterations.end());
+      if (factor_) factor_->record(most);
+      if (multigrid_) multigrid_refresh_.record(most);
+    }
     report.factorisations = factorisations() - factorisations_before;
   } catch (const cl::Error& error) {
     throw opencl_failure("advancing the OpenCL ensemble", error);
@@ -446,16 +452,16 @@ StepReport OpenClEnsemble::advance(const Eigen::Vector3d& so_position) {
 
 void OpenClEnsemble::refresh_factor(const std::vector<double>& constants) {
   if (factor_copies_ == 1) {
-    const Eigen::SparseMatrix<double> A = representative_system();
     // A large factor in the background where the device has one to step on meanwhile; a failed
     // making leaves that one in place, and the rule asks again at the next step.
-    if (on_device_ == FactorOnDevice::factor && factor_making_.takes(factor_->factorisation_in_solves())) {
-      making_constants_ = constants;
-      factor_making_.start([this, A] { return factor_->factorise(A); });
+    if (on_device_ == FactorOnDevice::factor && preconditioner_making_.takes(factor_->factorisation_in_solves())) {
+      making_springs_ = factorised_springs(springs_, constants);
+      preconditioner_making_.start([this, system = representative_system_later()] { return factor_->factorise(system()); });
       return;
     }
+    const Eigen::SparseMatrix<double> A = representative_system();
     if (!factor_->factorise(A)) return fall_back_to_diagonal(A);
-    return upload_factor(constants);
+    return upload_factor(factorised_springs(springs_, constants));
   }
   // Each sigma point's own system at its own state, factorised on the same analysis (the
   // pattern is the assembly's, the same for all).
@@ -472,9 +478,9 @@ void OpenClEnsemble::refresh_factor(const std::vector<double>& constants) {
   factor_makings_ += S_;
 }
 
-void OpenClEnsemble::upload_factor(const std::vector<double>& constants) {
+void OpenClEnsemble::upload_factor(const std::vector<double>& springs) {
   const Eigen::SparseMatrix<double>& L = factor_->lower();
-  if (springs_.size() > 0) prepare_spring_correction(constants);
+  if (springs_.size() > 0) prepare_spring_correction(springs);
   upload_factor_pattern();
   write_reals(DeviceBuffer::factor_values, std::vector<double>(L.valuePtr(), L.valuePtr() + L.nonZeros()));
   ++factor_makings_;
@@ -494,17 +500,41 @@ void OpenClEnsemble::upload_factor_pattern() {
   on_device_ = FactorOnDevice::factor;
 }
 
+void OpenClEnsemble::hand_over_making(bool made) {
+  if (factor_) {
+    if (made) upload_factor(making_springs_);
+    return;
+  }
+  multigrid_refresh_.made(made, multigrid_making_cost());
+  if (made) upload_multigrid(making_springs_);
+}
+
 void OpenClEnsemble::refresh_multigrid(const std::vector<double>& constants) {
+  // Made in the background where the device has a hierarchy to step on meanwhile; a failed
+  // making leaves that one in place, and the rule asks again at the next step.
+  if (multigrid_on_device_ && preconditioner_making_.takes(multigrid_->setup_in_cycles())) {
+    making_springs_ = factorised_springs(shift_rows_, constants);
+    preconditioner_making_.start([this, system = representative_system_later()] { return multigrid_->set_matrix(system()); });
+    return;
+  }
   const bool made = multigrid_->set_matrix(representative_system());
-  multigrid_refresh_.made(made, multigrid_->setup_in_cycles());
-  if (!made) return;   // the last hierarchy stays, or Jacobi until one is made
-  if (!multigrid_on_device_)   // later refreshes make buffers of the same sizes in their place
+  multigrid_refresh_.made(made, multigrid_making_cost());
+  // Else the last hierarchy stays, or Jacobi until one is made.
+  if (made) upload_multigrid(factorised_springs(shift_rows_, constants));
+}
+
+double OpenClEnsemble::multigrid_making_cost() const {
+  return multigrid_making_cycles_ > 0.0 ? multigrid_making_cycles_ : multigrid_->setup_in_cycles();
+}
+
+void OpenClEnsemble::upload_multigrid(const std::vector<double>& springs) {
+  if (!multigrid_on_device_)   // later makings are written into the same buffers
     check_more_device_memory(multigrid_memory(*multigrid_, S_, device_.real_size()), "the multigrid levels");
   device_multigrid_->upload(*multigrid_);
   if (!multigrid_on_device_) device_bytes_ += device_multigrid_->device_bytes();
   multigrid_on_device_ = true;
   ++multigrid_makings_;
-  multigrid_springs_ = factorised_springs(shift_rows_, constants);
+  multigrid_springs_ = springs;
   shift_stale_ = true;
 }
 
@@ -513,9 +543,9 @@ void OpenClEnsemble::upload_multigrid_shift(const std::vector<double>& constants
   shift_stale_ = false;
 }
 
-void OpenClEnsemble::prepare_spring_correction(const std::vector<double>& constants) {
+void OpenClEnsemble::prepare_spring_correction(const std::vector<double>& springs) {
   springs_.prepare(*factor_);
-  factorised_springs_ = factorised_springs(springs_, constants);
+  factorised_springs_ = springs;
   const std::vector<int>& reached = springs_.reached();
   std::vector<int> at = {static_cast<int>(reached.size())};
   at.insert(at.end(), reached.begin(), reached.end());

@@ -95,16 +95,17 @@ class OpenClEnsemble : public DeviceEnsemble {
   // point's from its own system, when it is due, and uploads it; with no factor yet and a
   // system that is not positive definite, uploads the representative's diagonal instead
   // (upload_diagonal_factor). A large shared factor with one on the device already is made in
-  // the background instead (factor_making_), and upload_factor() runs at its hand-over.
+  // the background instead (preconditioner_making_), and upload_factor() runs at its hand-over.
   void refresh_factor(const std::vector<double>& constants);
   // The shared factor just made goes down (its values; its pattern the first time), with its
-  // spring correction from the step constants it was made at.
-  void upload_factor(const std::vector<double>& constants);
+  // spring correction for `springs`, its system's springs at the correction's rows
+  // (factorised_springs at the step it was made at).
+  void upload_factor(const std::vector<double>& springs);
   // The factor's pattern and ordering, where the device has none yet (later ones keep them).
   void upload_factor_pattern();
   // The spring correction of a fresh shared factor (SpringCorrection): V at the rows it
-  // reaches goes down, and the representative's springs are kept for the couplings.
-  void prepare_spring_correction(const std::vector<double>& constants);
+  // reaches goes down, and its system's `springs` are kept for the couplings.
+  void prepare_spring_correction(const std::vector<double>& springs);
   // Each sigma point's coupling H for its springs against the representative's.
   void upload_spring_coupling(const std::vector<double>& constants);
   // A stand-in for the factor: L = sqrt(|diag A|), no reordering, so that z = r / |diag A|,
@@ -113,8 +114,17 @@ class OpenClEnsemble : public DeviceEnsemble {
   // After a failed factorisation: the last factor stays; with none yet, A's diagonal goes down.
   void fall_back_to_diagonal(const Eigen::SparseMatrix<double>& A);
   // Makes the multigrid hierarchy again of the representative's system and uploads it; after a
-  // failure the last one stays (none yet: Jacobi, from cg_update, for the step).
+  // failure the last one stays (none yet: Jacobi, from cg_update, for the step). With one on
+  // the device already it is made in the background instead (preconditioner_making_).
   void refresh_multigrid(const std::vector<double>& constants);
+  // The hierarchy just made goes down, with its system's `springs` at the estimated ligaments'
+  // rows (factorised_springs at the step it was made at), against which the shifts are taken.
+  void upload_multigrid(const std::vector<double>& springs);
+  // A making in the hierarchy's refresh rule, in V-cycles (DeviceOptions::multigrid_making_cycles).
+  double multigrid_making_cost() const;
+  // At the step a background making is handed over: its factor or hierarchy goes down where it
+  // was made (`made`); a failed one leaves the last in place.
+  void hand_over_making(bool made);
   // Each sigma point's springs against the hierarchy's, the finest level's shift.
   void upload_multigrid_shift(const std::vector<double>& constants);
 
@@ -162,11 +172,6 @@ class OpenClEnsemble : public DeviceEnsemble {
   // pattern and ordering later refreshes keep).
   enum class FactorOnDevice { none, diagonal, factor };
   FactorOnDevice on_device_ = FactorOnDevice::none;
-  // A large shared factor made again in the background (DeviceOptions::background_making_steps)
-  // and the step constants it was made at; factor_ is the making's until it is handed over.
-  // Declared after factor_: destroyed first, waiting for a making still running.
-  BackgroundMaking factor_making_;
-  std::vector<double> making_constants_;
   int factor_makings_ = 0;   // successful factorisations (not read from factor_ while it is made)
   // CG's preconditioner on the GPU form where the mesh is a refinement (opencl_uses_multigrid):
   // the hierarchy of the representative's system, its copy on the device (once one has been
@@ -180,6 +185,14 @@ class OpenClEnsemble : public DeviceEnsemble {
   SpringCorrection shift_rows_;
   std::vector<double> multigrid_springs_;
   bool shift_stale_ = false;
+  double multigrid_making_cycles_ = 0.0;   // DeviceOptions::multigrid_making_cycles
+  // A large shared factor, or the multigrid hierarchy, made again in the background
+  // (DeviceOptions::background_making_steps), and its system's springs at the step it began
+  // (the sigma points' parameters move on before the hand-over); factor_ or multigrid_ is the
+  // making's until it is handed over. Declared after both: destroyed first, waiting for a
+  // making still running.
+  BackgroundMaking preconditioner_making_;
+  std::vector<double> making_springs_;
 
   // Mutable: enqueueing a kernel (also from the const read-outs) changes no visible state.
   mutable cl::Kernel k_element_rhs_, k_node_rhs_, k_element_product_, k_node_product_;

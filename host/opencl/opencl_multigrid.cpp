@@ -1,6 +1,10 @@
 #include "host/opencl/opencl_multigrid.h"
 
+#include <algorithm>
+#include <string>
+
 #include "device_layout.h"
+#include "host/common/device_error.h"
 #include "host/ensemble/device_readout.h"
 
 namespace sigmafem {
@@ -19,44 +23,55 @@ OpenClMultigrid::~OpenClMultigrid() {
   }
 }
 
-cl::Buffer OpenClMultigrid::reals(const std::vector<double>& values) {
-  std::vector<unsigned char> bytes = to_device_reals(values, device_.precision());
-  bytes_ += bytes.size();
-  return cl::Buffer(device_.context(), CL_MEM_READ_WRITE | CL_MEM_COPY_HOST_PTR, bytes.size(), bytes.data());
+cl::Buffer OpenClMultigrid::buffer(std::size_t bytes) {
+  bytes = std::max<std::size_t>(bytes, 1);
+  bytes_ += bytes;
+  return cl::Buffer(device_.context(), CL_MEM_READ_WRITE, bytes);
 }
 
 cl::Buffer OpenClMultigrid::vector_buffer(Eigen::Index rows) {
-  const std::size_t bytes = static_cast<std::size_t>(rows) * S_ * device_.real_size();
-  bytes_ += bytes;
-  return cl::Buffer(device_.context(), CL_MEM_READ_WRITE, bytes);
+  return buffer(static_cast<std::size_t>(rows) * S_ * device_.real_size());
 }
 
 OpenClMultigrid::Matrix OpenClMultigrid::matrix_buffers(const RowMajorMatrix& M) {
   Matrix matrix;
   matrix.rows = static_cast<cl_uint>(M.rows());
-  const auto integers = [&](const int* data, std::size_t count) {
-    bytes_ += count * sizeof(cl_int);
-    return cl::Buffer(device_.context(), CL_MEM_READ_ONLY | CL_MEM_COPY_HOST_PTR, count * sizeof(cl_int),
-                      const_cast<int*>(data));
-  };
-  matrix.row_start = integers(M.outerIndexPtr(), static_cast<std::size_t>(M.rows()) + 1);
-  matrix.columns = integers(M.innerIndexPtr(), static_cast<std::size_t>(M.nonZeros()));
-  matrix.values = reals(std::vector<double>(M.valuePtr(), M.valuePtr() + M.nonZeros()));
+  matrix.nonzeros = static_cast<std::size_t>(M.nonZeros());
+  matrix.row_start = buffer((static_cast<std::size_t>(M.rows()) + 1) * sizeof(cl_int));
+  matrix.columns = buffer(matrix.nonzeros * sizeof(cl_int));
+  matrix.values = buffer(matrix.nonzeros * device_.real_size());
   return matrix;
 }
 
-void OpenClMultigrid::upload(const NestedMultigrid& multigrid) {
-  // Made anew at each refresh: the Galerkin products' patterns stay, but a refresh is rare
-  // (the refresh rule) against the steps between.
-  bytes_ = 0;
+void OpenClMultigrid::write(const cl::Buffer& to, const void* data, std::size_t bytes) {
+  // Blocking: an upload is rare (the refresh rule), and the host arrays are temporaries.
+  if (bytes > 0) device_.queue().enqueueWriteBuffer(to, CL_TRUE, 0, bytes, data);
+}
+
+void OpenClMultigrid::write_reals(const cl::Buffer& to, const std::vector<double>& values) {
+  const std::vector<unsigned char> bytes = to_device_reals(values, device_.precision());
+  write(to, bytes.data(), bytes.size());
+}
+
+void OpenClMultigrid::write_matrix(const Matrix& to, const RowMajorMatrix& M) {
+  if (static_cast<cl_uint>(M.rows()) != to.rows || static_cast<std::size_t>(M.nonZeros()) != to.nonzeros)
+    throw DeviceError("a multigrid level of " + std::to_string(M.rows()) + " rows and " +
+                      std::to_string(M.nonZeros()) + " entries where the first had " + std::to_string(to.rows) +
+                      " and " + std::to_string(to.nonzeros));
+  write(to.row_start, M.outerIndexPtr(), (static_cast<std::size_t>(M.rows()) + 1) * sizeof(cl_int));
+  write(to.columns, M.innerIndexPtr(), to.nonzeros * sizeof(cl_int));
+  write_reals(to.values, std::vector<double>(M.valuePtr(), M.valuePtr() + M.nonZeros()));
+}
+
+void OpenClMultigrid::make_levels(const NestedMultigrid& multigrid) {
   levels_.assign(static_cast<std::size_t>(multigrid.level_count()), Level());
   for (int l = 0; l < multigrid.level_count(); ++l) {
     const NestedMultigrid::Level& from = multigrid.level(l);
     Level& level = levels_[static_cast<std::size_t>(l)];
     level.matrix = matrix_buffers(multigrid.launch_matrix(l));
     if (!from.smoothing.empty()) {
-      level.steps = reals(multigrid.smoothing_coefficients(l));
-      level.diagonal = reals(std::vector<double>(from.diagonal.data(), from.diagonal.data() + from.diagonal.size()));
+      level.steps = buffer(2 * from.smoothing.size() * device_.real_size());
+      level.diagonal = buffer(static_cast<std::size_t>(from.diagonal.size()) * device_.real_size());
       for (int i = 0; i < 2; ++i) {
         level.x[i] = vector_buffer(from.matrix.rows());
         level.p[i] = vector_buffer(from.matrix.rows());
@@ -72,15 +87,31 @@ void OpenClMultigrid::upload(const NestedMultigrid& multigrid) {
       level.correction = vector_buffer(from.matrix.rows());
     }
   }
+  shift_ = vector_buffer(multigrid.level(0).matrix.rows());
+  write_reals(shift_, std::vector<double>(static_cast<std::size_t>(multigrid.level(0).matrix.rows()) * S_, 0.0));
   launches_ = multigrid.launches();
-  upload_shift(std::vector<double>(static_cast<std::size_t>(multigrid.level(0).matrix.rows()) * S_, 0.0));
+}
+
+void OpenClMultigrid::upload(const NestedMultigrid& multigrid) {
+  // The buffers are made at the first upload: later hierarchies of the same meshes have the
+  // same sizes (the Galerkin products' patterns stay), and their values are written over.
+  if (levels_.empty()) make_levels(multigrid);
+  for (int l = 0; l < multigrid.level_count(); ++l) {
+    const NestedMultigrid::Level& from = multigrid.level(l);
+    const Level& level = levels_[static_cast<std::size_t>(l)];
+    write_matrix(level.matrix, multigrid.launch_matrix(l));
+    if (!from.smoothing.empty()) {
+      write_reals(level.steps, multigrid.smoothing_coefficients(l));
+      write_reals(level.diagonal, std::vector<double>(from.diagonal.data(), from.diagonal.data() + from.diagonal.size()));
+    }
+    if (l + 1 < multigrid.level_count()) {
+      write_matrix(level.prolongation, from.prolongation);
+      write_matrix(level.restriction, from.restriction);
+    }
+  }
 }
 
 void OpenClMultigrid::upload_shift(const std::vector<double>& shift) {
-  if (!shift_()) {
-    shift_ = reals(shift);
-    return;
-  }
   // Not waited for (a host wait each filter step otherwise): the copy is kept until its write
   // is done, as OpenClEnsemble's writes.
   if (shift_written_()) shift_written_.wait();

@@ -23,7 +23,8 @@ class OpenClMultigrid {
   OpenClMultigrid(const OpenClMultigrid&) = delete;
   OpenClMultigrid& operator=(const OpenClMultigrid&) = delete;
 
-  // The hierarchy's matrices, diagonals and smoothing steps (`multigrid` ready). Throws
+  // The hierarchy's matrices, diagonals and smoothing steps (`multigrid` ready), written over
+  // the last one's (DeviceError where a level's size differs from the first's). Throws
   // cl::Error.
   void upload(const NestedMultigrid& multigrid);
   // Each sigma point's shift at the finest level: rows x S reals, [row S + s].
@@ -37,6 +38,7 @@ class OpenClMultigrid {
   struct Matrix {
     cl::Buffer row_start, columns, values;
     cl_uint rows = 0;
+    std::size_t nonzeros = 0;
   };
   struct Level {
     Matrix matrix, prolongation, restriction;   // matrix: NestedMultigrid::launch_matrix
@@ -46,9 +48,15 @@ class OpenClMultigrid {
     // other), the residual.
     cl::Buffer b, correction, x[2], p[2], r;
   };
+  // The levels' buffers, made at the first upload (sizes from `multigrid`), the shift zero.
+  void make_levels(const NestedMultigrid& multigrid);
   Matrix matrix_buffers(const RowMajorMatrix& M);
-  cl::Buffer reals(const std::vector<double>& values);
+  cl::Buffer buffer(std::size_t bytes);
   cl::Buffer vector_buffer(Eigen::Index rows);
+  void write(const cl::Buffer& to, const void* data, std::size_t bytes);
+  void write_reals(const cl::Buffer& to, const std::vector<double>& values);
+  // M's values into `to`, made for a matrix of its size (else a DeviceError).
+  void write_matrix(const Matrix& to, const RowMajorMatrix& M);
   void run(cl::Kernel& kernel, cl_uint rows);
 
   OpenClDevice& device_;

@@ -105,6 +105,8 @@ VulkanEnsemble::VulkanEnsemble(const Model& model, EstimatedParameters estimated
                         "(a scenario's mesh.refine makes one)");
     multigrid_ = std::make_unique<NestedMultigrid>(std::move(prolongations));
     shift_rows_ = SpringCorrection(estimated_spring_rows(model_, estimated_));
+    multigrid_making_cycles_ = options.multigrid_making_cycles;
+    preconditioner_making_.set_rule(options.background_making_steps, kBackgroundMultigridCycles);
   }
   cg_partitioned_ = cg_partitions_ > 1 || multigrid_;
   // CG's preconditioner (vulkan_uses_factor): one factor of the representative's system,
@@ -123,7 +125,7 @@ VulkanEnsemble::VulkanEnsemble(const Model& model, EstimatedParameters estimated
       springs_ = spring_correction(options.spring_correction);   // as OpenCL's
       factor_ = analysed_factor(springs_);   // their rows last, as OpenCL's
       check_device_memory_with_factor(factor_->nonzeros(), FactorStorage::blocks);
-      factor_making_.set_rule(options.background_making_steps, options.background_making_solves);
+      preconditioner_making_.set_rule(options.background_making_steps, options.background_making_solves);
     }
   }
   cg_lane_rows_ = sigmafem::cg_lane_rows(options.cg_sigma_lanes_from, S_, info, !cg_partitioned_, factor_ != nullptr);
@@ -384,30 +386,54 @@ void VulkanEnsemble::record_multigrid(VkCommandBuffer cmd, bool start) const {
 }
 
 void VulkanEnsemble::refresh_multigrid(const std::vector<double>& constants) {
+  // In the background where the device has a hierarchy to step on meanwhile (as
+  // OpenClEnsemble's): a failed making leaves that one in place.
+  if (multigrid_makings_ > 0 && preconditioner_making_.takes(multigrid_->setup_in_cycles())) {
+    making_springs_ = factorised_springs(shift_rows_, constants);
+    preconditioner_making_.start([this, system = representative_system_later()] { return multigrid_->set_matrix(system()); });
+    return;
+  }
   const bool made = multigrid_->set_matrix(representative_system());
-  multigrid_refresh_.made(made, multigrid_->setup_in_cycles());
-  if (!made) return;   // the last hierarchy stays, or Jacobi until one is made
+  multigrid_refresh_.made(made, multigrid_making_cost());
+  // Else the last hierarchy stays, or Jacobi until one is made.
+  if (made) upload_multigrid(factorised_springs(shift_rows_, constants));
+}
+
+double VulkanEnsemble::multigrid_making_cost() const {
+  return multigrid_making_cycles_ > 0.0 ? multigrid_making_cycles_ : multigrid_->setup_in_cycles();
+}
+
+void VulkanEnsemble::upload_multigrid(const std::vector<double>& springs) {
   const std::size_t before = multigrid_solve_->bytes();   // its buffers are made at the first upload
   if (!multigrid_solve_->ready())
     check_more_device_memory(multigrid_memory(*multigrid_, S_, device_.real_size()), "the multigrid levels");
   multigrid_solve_->upload(*multigrid_);
   device_bytes_ += multigrid_solve_->bytes() - before;
   ++multigrid_makings_;
-  multigrid_springs_ = factorised_springs(shift_rows_, constants);
+  multigrid_springs_ = springs;
   shift_stale_ = true;
+}
+
+void VulkanEnsemble::hand_over_making(bool made) {
+  if (factor_) {
+    if (made) upload_factor(making_springs_);
+    return;
+  }
+  multigrid_refresh_.made(made, multigrid_making_cost());
+  if (made) upload_multigrid(making_springs_);
 }
 
 void VulkanEnsemble::refresh_factor(const std::vector<double>& constants) {
   // A matrix that is not positive definite (a diverged state?) leaves the last factor in
   // place, and the next step tries again.
-  const Eigen::SparseMatrix<double> A = representative_system();
   // A large factor in the background where the device has one to step on meanwhile (as
   // OpenClEnsemble's): a failed making leaves that one in place.
-  if (factor_makings_ > 0 && factor_making_.takes(factor_->factorisation_in_solves())) {
-    making_constants_ = constants;
-    factor_making_.start([this, A] { return factor_->factorise(A); });
+  if (factor_makings_ > 0 && preconditioner_making_.takes(factor_->factorisation_in_solves())) {
+    making_springs_ = factorised_springs(springs_, constants);
+    preconditioner_making_.start([this, system = representative_system_later()] { return factor_->factorise(system()); });
     return;
   }
+  const Eigen::SparseMatrix<double> A = representative_system();
   if (!factor_->factorise(A)) {
     if (!factor_solve_->ready()) {
       const std::size_t before = factor_solve_->bytes();
@@ -416,10 +442,10 @@ void VulkanEnsemble::refresh_factor(const std::vector<double>& constants) {
     }
     return;
   }
-  upload_factor(constants);
+  upload_factor(factorised_springs(springs_, constants));
 }
 
-void VulkanEnsemble::upload_factor(const std::vector<double>& constants) {
+void VulkanEnsemble::upload_factor(const std::vector<double>& springs) {
   const std::size_t before = factor_solve_->bytes();   // a new pattern's buffers are made at its upload
   ++factor_makings_;
   factor_solve_->upload(*factor_);
@@ -430,7 +456,7 @@ void VulkanEnsemble::upload_factor(const std::vector<double>& constants) {
     springs_ = SpringCorrection();   // too large a correction for a dispatch: the factor alone
     return;
   }
-  factorised_springs_ = factorised_springs(springs_, constants);
+  factorised_springs_ = springs;
   coupling_stale_ = true;
 }
 
@@ -444,13 +470,14 @@ StepReport VulkanEnsemble::advance(const Eigen::Vector3d& so_position) {
   observations_current_ = false;
   const int factorisations_before = factorisations();
   const std::vector<double> step_constants = step_constants_.next_step(model_, so_position);
-  if (factor_making_.pending()) {
+  if (preconditioner_making_.pending()) {
     bool made = false;
-    if (factor_making_.hand_over(made) && made) upload_factor(making_constants_);
+    if (preconditioner_making_.hand_over(made)) hand_over_making(made);
   } else if (factor_ && factor_->due()) {
     refresh_factor(step_constants);
+  } else if (multigrid_ && multigrid_refresh_.due()) {
+    refresh_multigrid(step_constants);
   }
-  if (multigrid_ && multigrid_refresh_.due()) refresh_multigrid(step_constants);
 
   // The right-hand side, the warm start and the first batch of iterations: as many as the
   // last step needed (warm-started steps need about the same).
@@ -528,9 +555,12 @@ StepReport VulkanEnsemble::advance(const Eigen::Vector3d& so_position) {
   }
   StepReport report = step_report(iterations, converged, from_device_reals(area + at_rr, S, precision),
                                   from_device_reals(area + at_bb, S, precision));
-  // Not while the factor is being made (the rule counts from the step it is handed over).
-  if (factor_ && !factor_making_.pending()) factor_->record(*std::max_element(iterations.begin(), iterations.end()));
-  if (multigrid_) multigrid_refresh_.record(*std::max_element(iterations.begin(), iterations.end()));
+  // Not while a preconditioner is being made (the rule counts from the step it is handed over).
+  if (!preconditioner_making_.pending()) {
+    const int most = *std::max_element(iterations.begin(), iterations.end());
+    if (factor_) factor_->record(most);
+    if (multigrid_) multigrid_refresh_.record(most);
+  }
   report.factorisations = factorisations() - factorisations_before;
   return report;
 }

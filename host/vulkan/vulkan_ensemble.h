@@ -134,14 +134,24 @@ class VulkanEnsemble : public DeviceEnsemble {
   // uploads it with its spring correction; with no factor yet and a failed factorisation,
   // A's diagonal (Jacobi) instead.
   // A large factor (DeviceOptions::background_making_solves) with one on the device already is
-  // made in the background instead (factor_making_), and upload_factor() runs at its hand-over.
+  // made in the background instead (preconditioner_making_), and upload_factor() runs at its
+  // hand-over.
   void refresh_factor(const std::vector<double>& constants);
-  // The factor just made goes down with its spring correction from the step constants it was
-  // made at.
-  void upload_factor(const std::vector<double>& constants);
+  // The factor just made goes down with its spring correction for `springs`, its system's
+  // springs at the correction's rows (factorised_springs at the step it was made at).
+  void upload_factor(const std::vector<double>& springs);
   // Makes the multigrid hierarchy again of the representative's system and uploads it; after
-  // a failure the last one stays (none yet: Jacobi, cg_update's z, for the step).
+  // a failure the last one stays (none yet: Jacobi, cg_update's z, for the step). With one on
+  // the device already it is made in the background instead (preconditioner_making_).
   void refresh_multigrid(const std::vector<double>& constants);
+  // The hierarchy just made goes down, with its system's `springs` at the estimated ligaments'
+  // rows (factorised_springs at the step it was made at), against which the shifts are taken.
+  void upload_multigrid(const std::vector<double>& springs);
+  // A making in the hierarchy's refresh rule, in V-cycles (DeviceOptions::multigrid_making_cycles).
+  double multigrid_making_cost() const;
+  // At the step a background making is handed over: its factor or hierarchy goes down where it
+  // was made (`made`); a failed one leaves the last in place.
+  void hand_over_making(bool made);
   // With the V-cycle: z = M^-1 r over Jacobi's, then cg_preconditioned (r.z; at the start d = z).
   void record_multigrid(VkCommandBuffer cmd, bool start) const;
   void record_system_product(VkCommandBuffer cmd, VkDescriptorSet element_product_set) const;
@@ -192,12 +202,7 @@ class VulkanEnsemble : public DeviceEnsemble {
   SpringCorrection springs_;
   std::vector<double> factorised_springs_;
   bool coupling_stale_ = false;
-  // A large factor made again in the background (as OpenClEnsemble's; declared after factor_:
-  // destroyed first, waiting for a making still running), the step constants it was made at,
-  // and the successful makings (not read from factor_ while it is made).
-  BackgroundMaking factor_making_;
-  std::vector<double> making_constants_;
-  int factor_makings_ = 0;
+  int factor_makings_ = 0;   // successful factorisations (not read from factor_ while it is made)
   // The GPU form's multigrid V-cycle (vulkan_uses_multigrid): the hierarchy of the
   // representative's system, its dispatches, when to make it again, the estimated ligaments'
   // rows with the hierarchy's springs there, and whether the sigma points' shifts are stale.
@@ -208,6 +213,12 @@ class VulkanEnsemble : public DeviceEnsemble {
   SpringCorrection shift_rows_;
   std::vector<double> multigrid_springs_;
   bool shift_stale_ = false;
+  double multigrid_making_cycles_ = 0.0;   // DeviceOptions::multigrid_making_cycles
+  // A large factor, or the multigrid hierarchy, made again in the background (as
+  // OpenClEnsemble's; declared after factor_ and multigrid_: destroyed first, waiting for a
+  // making still running), and its system's springs at the step it began.
+  BackgroundMaking preconditioner_making_;
+  std::vector<double> making_springs_;
   // Descriptor sets; element_product has three: the warm start's product (dv, all active),
   // the CG product (d, the active flags) and system_product()'s (d, all active).
   VkDescriptorSet s_element_rhs_ = VK_NULL_HANDLE, s_node_rhs_ = VK_NULL_HANDLE;

@@ -18,6 +18,7 @@
 #include "host/opencl/opencl_multigrid.h"
 #include "host/reference/reference_simulation.h"
 #include "host/scenario/scenario.h"
+#include "background_making_runs.h"
 #include "requirement.h"
 #include "tests/refined_liver.h"
 
@@ -151,6 +152,24 @@ TEST_F(OpenClMultigridTest, TheFiltersEstimatesAreJacobisOnDataGeneratedForTheRe
   ASSERT_EQ(jacobi.size(), multigrid.size());
   for (Eigen::Index j = 0; j < jacobi.size(); ++j)
     EXPECT_NEAR(multigrid[j] / jacobi[j], 1.0, 5e-3) << "parameter " << j << ": " << multigrid[j] << " against " << jacobi[j];
+}
+
+// The hierarchy made again in the background after the first (host/reference/background_making.h),
+// made often here (its making counted as one V-cycle in the refresh rule), handed over 3 steps
+// after it began: two runs give the same bits, within CG's tolerance of the run that waited.
+TEST_F(OpenClMultigridTest, AHierarchyMadeInTheBackgroundGivesTheSameBitsEveryRun) {
+  const Eigen::MatrixXd theta = test::spread_log_stiffness(scenario_, model_, kMultigridSigmaPoints, 0.5);
+  const auto run_with = [&](int lag) {
+    DeviceOptions options = test::background_making_options(lag);
+    options.kernel_form = KernelForm::gpu;
+    options.multigrid_making_cycles = 1.0;
+    OpenClEnsemble ensemble(model_, scenario_.filter->estimate, scenario_.observations.observed, kMultigridSigmaPoints,
+                            options);
+    EXPECT_TRUE(ensemble.multigrid());
+    return test::multigrid_making_run(ensemble, scenario_, theta);
+  };
+  const test::MakingRun waited = run_with(0);
+  test::expect_background_making_repeats(waited, run_with(3), run_with(3), 1e-6);
 }
 
 TEST_F(OpenClMultigridTest, ItsLevelsAreCheckedAgainstTheDevicesMemory) {

@@ -16,6 +16,7 @@
 #include "host/reference/reference_simulation.h"
 #include "host/scenario/scenario.h"
 #include "host/vulkan/vulkan_ensemble.h"
+#include "background_making_runs.h"
 #include "requirement.h"
 #include "tests/refined_liver.h"
 
@@ -137,6 +138,22 @@ TEST_F(VulkanMultigridTest, ItsGroupsGrowToKeepWithinTheLoopTurns) {
   EXPECT_GT(iterations_eight, 6 * S);
   EXPECT_LE(std::abs(iterations_eight - iterations_grown), 6 * S);
   EXPECT_LT((a - b).cwiseAbs().maxCoeff(), 2e-7);
+}
+
+// The hierarchy made again in the background after the first, as OpenCL's
+// (OpenClMultigridTest.AHierarchyMadeInTheBackgroundGivesTheSameBitsEveryRun).
+TEST_F(VulkanMultigridTest, AHierarchyMadeInTheBackgroundGivesTheSameBitsEveryRun) {
+  const int S = kVulkanMultigridSigmaPoints;
+  const Eigen::MatrixXd theta = test::spread_log_stiffness(scenario_, model_, S, 0.5);
+  const auto run_with = [&](int lag) {
+    DeviceOptions options = test::background_making_options(lag);
+    options.preconditioner = Preconditioner::multigrid;
+    options.multigrid_making_cycles = 1.0;
+    VulkanEnsemble ensemble(model_, scenario_.filter->estimate, scenario_.observations.observed, S, options);
+    return test::multigrid_making_run(ensemble, scenario_, theta);
+  };
+  const test::MakingRun waited = run_with(0);
+  test::expect_background_making_repeats(waited, run_with(3), run_with(3), 1e-6);
 }
 
 TEST_F(VulkanMultigridTest, ItsLevelsAreCheckedAgainstTheDevicesMemory) {
