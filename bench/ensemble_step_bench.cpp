@@ -39,7 +39,7 @@ struct Backend {
   KernelForm kernel_form = KernelForm::automatic;
   bool spring_correction = true;   // OpenCL's shared factor corrected for the sigma points' springs
   long long node_iteration_work = kNodeIterationWork;   // Vulkan: CG in two dispatches up to it
-  int cg_sigma_lanes = 0;   // OpenCL's GPU form: sigma points side by side in a CG group (0: chosen)
+  int cg_sigma_lanes = 0;   // GPU forms: sigma points side by side in a CG group (0: chosen)
 };
 
 // The CPU back end with its default preconditioner (factors: one per sigma point within
@@ -113,6 +113,11 @@ const Backend kVulkanUncorrectedFactor{"vulkan", Precision::single,
                                        "vulkan single, device 0, one shared factor, not corrected for the springs",
                                        SolveLaunch::automatic, Preconditioner::factorised, false, 0,
                                        KernelForm::automatic, false};
+// Vulkan's partitions with a sigma point a group, as before stop 63's sigma lanes (on a GPU the
+// A/B of bench/gpu_checks.sh; on lavapipe, one partition, the same as kVulkan).
+const Backend kVulkanOneLane{"vulkan", Precision::single, "vulkan single, device 0, Jacobi, CG a lane a group",
+                             SolveLaunch::automatic, Preconditioner::jacobi, false, 0, KernelForm::automatic,
+                             true, kNodeIterationWork, 1};
 const Backend kVulkanOneGroup{"vulkan", Precision::single,
                               "vulkan single, device 0, CG a work-group per sigma point",
                               SolveLaunch::automatic, Preconditioner::jacobi, false, 1};
@@ -430,6 +435,10 @@ BENCHMARK_CAPTURE(BM_ensemble_step, vulkan_one_group_box_large_117240, kVulkanOn
                   std::string("box_large"), 0)
     ->Arg(16)->Arg(64)->Unit(benchmark::kMillisecond)->UseRealTime();
 BENCHMARK_CAPTURE(BM_ensemble_step, vulkan_box_large_117240, kVulkan, std::string("box_large"), 0)
+    ->Arg(16)->Arg(64)->Unit(benchmark::kMillisecond)->UseRealTime();
+BENCHMARK_CAPTURE(BM_ensemble_step, vulkan_one_lane_liver_fine_38144, kVulkanOneLane, std::string("liver_fine"), 0)
+    ->Arg(16)->Arg(64)->Unit(benchmark::kMillisecond)->UseRealTime();
+BENCHMARK_CAPTURE(BM_ensemble_step, vulkan_one_lane_box_large_117240, kVulkanOneLane, std::string("box_large"), 0)
     ->Arg(16)->Arg(64)->Unit(benchmark::kMillisecond)->UseRealTime();
 BENCHMARK_CAPTURE(BM_ensemble_step, cpu_box_large_117240, kCpu, std::string("box_large"), 0)
     ->Arg(16)->Unit(benchmark::kMillisecond)->UseRealTime();

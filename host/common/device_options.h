@@ -98,12 +98,13 @@ struct DeviceOptions {
   Precision precision = Precision::single;
   SolveLaunch solve_launch = SolveLaunch::automatic;
   KernelForm kernel_form = KernelForm::automatic;
-  // Partitions of CG's rows on a GPU, a work-group each for a sigma point (Vulkan on a GPU) or
-  // for its sigma lanes (OpenCL's GPU form; cg_partitions() and cg_groups() in
-  // host/ensemble/device_limits.h); 0 chooses by the mesh's size.
+  // Partitions of CG's rows on a GPU, a work-group each for its sigma lanes (OpenCL's GPU form,
+  // Vulkan on a GPU; cg_partitions() and cg_groups() in host/ensemble/device_limits.h); 0
+  // chooses by the mesh's size.
   int cg_partitions = 0;
-  // OpenCL's GPU form: sigma points side by side in a CG work-group, a power of two (CgGroups,
-  // host/ensemble/device_limits.h); 0 chooses (tests and benchmarks compare).
+  // OpenCL's GPU form and Vulkan's partitioned CG shaders: sigma points side by side in a CG
+  // work-group, a power of two (CgGroups, host/ensemble/device_limits.h); 0 chooses (tests and
+  // benchmarks compare).
   int cg_sigma_lanes = 0;
   Preconditioner preconditioner = Preconditioner::automatic;
   // OpenCL's CPU form with a factor: each sigma point gets its own (of its own system), from

@@ -122,7 +122,7 @@ std::vector<DeviceBufferSpec> device_buffer_specs(const Model& model, const Obse
       reals(B::inverse_diagonal, "CG vectors", sizes.jacobi_diagonals ? dof : 1),
       reals(B::r, "CG vectors", dof), reals(B::z, "CG vectors", sizes.cg_z ? dof : 1),
       reals(B::d, "CG vectors", dof), reals(B::q, "CG vectors", dof),
-      reals(B::frames, "element frames", 9 * per_element),
+      reals(B::frames, "element frames", sizes.frame_numbers * per_element),
       reals(B::element_out, "element outputs", std::max(12 * per_element, sizes.element_out)),
       reals(B::element_diagonal, "element diagonals", sizes.jacobi_diagonals ? 12 * per_element : 1),
       reals(B::observations, "observations", std::max<std::size_t>(1, observed.size()) * 3 * sigma),

@@ -80,6 +80,9 @@ struct DeviceBufferSizes {
   // CG's z (3 N S reals); false with Vulkan's factor, whose solve finishes CG's step (r.z and
   // the direction) without storing z, and whose CG shaders (SF_FACTOR) leave it out: one element.
   bool cg_z = true;
+  // Numbers of each element frame (per element and sigma point): 9, or SF_FRAME_TWO_ROWS where
+  // the kernels keep its first two rows only (Vulkan; device_layout.h).
+  std::size_t frame_numbers = 9;
 };
 
 // Every buffer of an ensemble of `model` with S sigma points, in DeviceBuffer order. The

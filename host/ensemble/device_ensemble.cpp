@@ -4,6 +4,7 @@
 #include <cmath>
 #include <stdexcept>
 
+#include "device_layout.h"
 #include "host/common/device_error.h"
 #include "host/ensemble/device_limits.h"
 #include "host/ensemble/device_readout.h"
@@ -38,8 +39,8 @@ void DeviceEnsemble::check_device_memory(const std::string& name, std::size_t me
 
 void DeviceEnsemble::check_device_memory_with_factor(std::size_t factor_nonzeros, FactorStorage storage,
                                                      int factor_copies) const {
-  const EnsembleMemory need =
-      ensemble_memory(nodes_, elements_, S_, real_size(precision_), factor_nonzeros, storage, factor_copies);
+  const EnsembleMemory need = ensemble_memory(nodes_, elements_, S_, real_size(precision_), factor_nonzeros, storage,
+                                             factor_copies, frame_numbers());
   if (need.largest > largest_buffer_ || need.total > device_memory_)
     throw DeviceError(
         out_of_device_memory_message(need, elements_, S_, device_name_, device_memory_, largest_buffer_));
@@ -230,10 +231,16 @@ Eigen::VectorXd DeviceEnsemble::velocities(int s) const {
   return Eigen::Map<const Eigen::VectorXd>(column.data(), static_cast<Eigen::Index>(column.size()));
 }
 
+std::size_t DeviceEnsemble::frame_numbers() const { return frames_keep_two_rows_ ? SF_FRAME_TWO_ROWS : 9; }
+
 std::vector<double> DeviceEnsemble::frames(int s) const {
-  std::vector<double> frames = column_of(DeviceBuffer::frames, 9 * static_cast<std::size_t>(elements_), s);
-  if (frames_keep_two_rows_)
-    for (std::size_t at = 0; at < frames.size(); at += 9) shared::sf_frame_third_row(&frames[at]);
+  const std::vector<double> kept = column_of(DeviceBuffer::frames, frame_numbers() * elements_, s);
+  if (!frames_keep_two_rows_) return kept;
+  std::vector<double> frames(9 * static_cast<std::size_t>(elements_));
+  for (std::size_t e = 0; e < static_cast<std::size_t>(elements_); ++e) {
+    std::copy_n(&kept[SF_FRAME_TWO_ROWS * e], SF_FRAME_TWO_ROWS, &frames[9 * e]);
+    shared::sf_frame_third_row(&frames[9 * e]);
+  }
   return frames;
 }
 

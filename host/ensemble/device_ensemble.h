@@ -166,8 +166,10 @@ class DeviceEnsemble : public SimulationEnsemble {
   std::string device_name_;
   int expected_iterations_ = 1;   // CG iterations the last step needed (at most)
   // Whether the kernels keep only each frame's first two rows (Vulkan: kernels/vulkan/
-  // ensemble_layout.h's SF_FRAME_ROWS_KEPT); frames() then makes the third as they do.
+  // ensemble_layout.h's SF_FRAME_ROWS_KEPT); frames() then makes the third as they do. Set
+  // before the memory checks and the buffers: their size per element and sigma point.
   bool frames_keep_two_rows_ = false;
+  std::size_t frame_numbers() const;   // DeviceBufferSizes::frame_numbers
   const char* backend_;
   const char* who_;
 

@@ -60,17 +60,18 @@ CgGroups cg_groups(int nodes, int S, std::size_t real_size, int group_size, int 
 }
 
 EnsembleMemory ensemble_memory(int nodes, int elements, int S, std::size_t real_size,
-                               std::size_t factor_nonzeros, FactorStorage storage, int factor_copies) {
+                               std::size_t factor_nonzeros, FactorStorage storage, int factor_copies,
+                               std::size_t frame_numbers) {
   // Per dof and sigma: x, v, dv, rhs, r, d, q, z unless Vulkan's blocks finish CG's step
-  // without it, and without a factor the Jacobi diagonal; per element and sigma: the frame (9),
-  // the element outputs (12) and without a factor diagonals (12).
+  // without it, and without a factor the Jacobi diagonal; per element and sigma: the frame (9,
+  // or Vulkan's 6), the element outputs (12) and without a factor diagonals (12).
   const bool factor = factor_nonzeros > 0;
   const std::size_t dof = 3 * static_cast<std::size_t>(nodes) * S;
   const std::size_t per_element = static_cast<std::size_t>(elements) * S;
   const std::size_t dof_vectors = !factor ? 9 : storage == FactorStorage::blocks ? 7 : 8;
   EnsembleMemory need;
   need.largest = 12 * per_element * real_size;
-  need.total = (dof_vectors * dof + (factor ? 21 : 33) * per_element) * real_size;
+  need.total = (dof_vectors * dof + (frame_numbers + (factor ? 12 : 24)) * per_element) * real_size;
   if (!factor) return need;
   const std::size_t rows = 3 * static_cast<std::size_t>(nodes);
   if (storage == FactorStorage::columns) {

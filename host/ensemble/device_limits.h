@@ -35,8 +35,9 @@ constexpr int kPartitionRows = 512;
 constexpr int kMostPartitions = 64;
 int cg_partitions(int nodes, int forced);
 
-// OpenCL's GPU form: how CG's work-groups lie over the rows [row S + s] (conjugate_gradient.cl,
-// SF_CG_SIGMA_LANES). A group's work-items are `sigma_lanes` sigma points side by side, so that
+// OpenCL's GPU form and Vulkan on a GPU: how CG's work-groups lie over the rows [row S + s]
+// (conjugate_gradient.cl's SF_CG_SIGMA_LANES; conjugate_gradient.comp's SF_LANE_ROWS, the
+// group size over the lanes, in its partitions' shaders). A group's work-items are `sigma_lanes` sigma points side by side, so that
 // a warp reads runs of consecutive entries; with one lane (a group per sigma point, as before)
 // every work-item reads its own 32-byte sector for 4 bytes at S = 8 and up.
 struct CgGroups {
@@ -67,10 +68,12 @@ struct EnsembleMemory {
   std::size_t total = 0;     // about: all buffers
   std::size_t largest = 0;   // the largest single buffer (12 per element and sigma point, or L)
 };
-// OpenCL's own factors (`factor_copies` = S) hold S copies of L's values.
+// OpenCL's own factors (`factor_copies` = S) hold S copies of L's values. `frame_numbers`:
+// DeviceBufferSizes::frame_numbers (Vulkan keeps 6 of each frame's 9).
 EnsembleMemory ensemble_memory(int nodes, int elements, int sigma_count, std::size_t real_size,
                                std::size_t factor_nonzeros = 0,
-                               FactorStorage storage = FactorStorage::columns, int factor_copies = 1);
+                               FactorStorage storage = FactorStorage::columns, int factor_copies = 1,
+                               std::size_t frame_numbers = 9);
 
 // The device buffers of a multigrid V-cycle (OpenClMultigrid, VulkanMultigrid: each level's
 // matrix, prolongation and restriction by rows, its smoothing's diagonal and coefficients, its

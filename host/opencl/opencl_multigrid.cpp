@@ -96,19 +96,9 @@ void OpenClMultigrid::upload(const NestedMultigrid& multigrid) {
   // The buffers are made at the first upload: later hierarchies of the same meshes have the
   // same sizes (the Galerkin products' patterns stay), and their values are written over.
   if (levels_.empty()) make_levels(multigrid);
-  for (int l = 0; l < multigrid.level_count(); ++l) {
-    const NestedMultigrid::Level& from = multigrid.level(l);
-    const Level& level = levels_[static_cast<std::size_t>(l)];
-    write_matrix(level.matrix, multigrid.launch_matrix(l));
-    if (!from.smoothing.empty()) {
-      write_reals(level.steps, multigrid.smoothing_coefficients(l));
-      write_reals(level.diagonal, std::vector<double>(from.diagonal.data(), from.diagonal.data() + from.diagonal.size()));
-    }
-    if (l + 1 < multigrid.level_count()) {
-      write_matrix(level.prolongation, from.prolongation);
-      write_matrix(level.restriction, from.restriction);
-    }
-  }
+  write_levels(
+      multigrid, levels_, [&](const Matrix& to, const RowMajorMatrix& M) { write_matrix(to, M); },
+      [&](const cl::Buffer& to, const std::vector<double>& values) { write_reals(to, values); });
 }
 
 void OpenClMultigrid::upload_shift(const std::vector<double>& shift) {

@@ -148,4 +148,26 @@ class NestedMultigrid {
   bool ready_ = false;
 };
 
+// Writes `multigrid`'s values into a device back end's `levels` (OpenClMultigrid,
+// VulkanMultigrid), made for the first hierarchy of the same meshes: each level's launch
+// matrix, its smoothing's diagonal and steps, its prolongation and restriction, by
+// `write_matrix(to, M)` and `write_reals(to, values)`.
+template <class Level, class WriteMatrix, class WriteReals>
+void write_levels(const NestedMultigrid& multigrid, const std::vector<Level>& levels, WriteMatrix write_matrix,
+                  WriteReals write_reals) {
+  for (int l = 0; l < multigrid.level_count(); ++l) {
+    const NestedMultigrid::Level& from = multigrid.level(l);
+    const Level& level = levels[static_cast<std::size_t>(l)];
+    write_matrix(level.matrix, multigrid.launch_matrix(l));
+    if (!from.smoothing.empty()) {
+      write_reals(level.diagonal, std::vector<double>(from.diagonal.data(), from.diagonal.data() + from.diagonal.size()));
+      write_reals(level.steps, multigrid.smoothing_coefficients(l));
+    }
+    if (l + 1 < multigrid.level_count()) {
+      write_matrix(level.prolongation, from.prolongation);
+      write_matrix(level.restriction, from.restriction);
+    }
+  }
+}
+
 }  // namespace sigmafem

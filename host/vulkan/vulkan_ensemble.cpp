@@ -80,20 +80,25 @@ VulkanEnsemble::VulkanEnsemble(const Model& model, EstimatedParameters estimated
               static_cast<long long>(model.element_count()) * sigma_count < options.lavapipe_serial_work) {
   // Check the memory before asking for it, to say how much is needed.
   const VulkanDeviceInfo& info = device_.info();
+  frames_keep_two_rows_ = true;   // element_rhs stores two rows of each frame (ensemble_layout.h)
   check_device_memory(info.name, info.memory, info.max_buffer, options);
-  // CG's work-groups per sigma point (conjugate_gradient.comp): by the mesh on a GPU, one on
-  // a CPU (lavapipe), where S groups already keep its few cores busy, unless a test forces it.
-  cg_partitions_ = info.type == "cpu" && options.cg_partitions == 0
-                       ? 1
-                       : cg_partitions(nodes_, options.cg_partitions);
-  // The CG shaders take S x partitions work-groups along x.
-  if (static_cast<std::uint64_t>(S_) * cg_partitions_ > device_.max_group_count())
-    throw DeviceError("Vulkan device " + info.name + " runs at most " +
-                      std::to_string(device_.max_group_count() / cg_partitions_) +
-                      " sigma points on this mesh");
   // Work-items per sigma point in CG: on a CPU (lavapipe) one SIMD register's worth, so that
   // a group's barriers cost nothing; on a GPU 64 (two warps, one wavefront).
   cg_group_ = info.type == "cpu" ? 8 : 64;
+  // CG's work-groups per sigma point (conjugate_gradient.comp): by the mesh on a GPU, with
+  // sigma points side by side in them (CgGroups, as OpenCL's GPU form), one on a CPU (lavapipe),
+  // where S groups already keep its few cores busy, unless a test forces them.
+  CgGroups groups;
+  if (info.type != "cpu" || options.cg_partitions > 0)
+    groups = sigmafem::cg_groups(nodes_, S_, real_size(options.precision), static_cast<int>(cg_group_),
+                                 options.cg_partitions, options.cg_sigma_lanes);
+  cg_partitions_ = groups.partitions;
+  // The CG shaders take ceil(S / lanes) x partitions work-groups along x.
+  const std::uint64_t sigma_blocks = (static_cast<std::uint64_t>(S_) + groups.sigma_lanes - 1) / groups.sigma_lanes;
+  if (sigma_blocks * cg_partitions_ > device_.max_group_count())
+    throw DeviceError("Vulkan device " + info.name + " runs at most " +
+                      std::to_string(device_.max_group_count() / cg_partitions_ * groups.sigma_lanes) +
+                      " sigma points on this mesh");
   // The multigrid V-cycle on a GPU, on the refinements that made the mesh.
   std::vector<RowMajorMatrix> prolongations;
   if (options.preconditioner == Preconditioner::multigrid ||
@@ -129,11 +134,14 @@ VulkanEnsemble::VulkanEnsemble(const Model& model, EstimatedParameters estimated
     }
   }
   cg_lane_rows_ = sigmafem::cg_lane_rows(options.cg_sigma_lanes_from, S_, info, !cg_partitioned_, factor_ != nullptr);
+  // The partitions' shaders with sigma points side by side: G / lanes rows at once of each.
+  if (cg_partitioned_ && groups.sigma_lanes > 1) cg_lane_rows_ = static_cast<int>(cg_group_) / groups.sigma_lanes;
   // Within llvmpipe's loop turns (cg_loop_turns): lanes over sigma points give way to a group a
   // sigma point (or a partition), which grows until its lanes' share of the nodes fits (128
   // invocations a group, Vulkan's least maximum, at most).
   const std::vector<long long> node_turns = cg_node_turns(model_);   // once: the doublings reuse it
-  if (cg_lane_rows_ > 0 && cg_loop_turns(node_turns, cg_lane_rows_) > options.cg_loop_turns) cg_lane_rows_ = 0;
+  if (cg_lane_rows_ > 0 && cg_loop_turns(node_turns, cg_lane_rows_, cg_partitions_) > options.cg_loop_turns)
+    cg_lane_rows_ = 0;
   auto group_turns = [&] { return cg_loop_turns(node_turns, static_cast<int>(cg_group_), cg_partitions_); };
   while (cg_lane_rows_ == 0 && group_turns() > options.cg_loop_turns) {
     if (cg_group_ >= 128)
@@ -147,9 +155,9 @@ VulkanEnsemble::VulkanEnsemble(const Model& model, EstimatedParameters estimated
   // The partitions' buffers are bound but unused with one partition; Jacobi's diagonals and z
   // with the factor (its *_factor shaders and its solve leave them out).
   DeviceBufferSizes sizes{0, cg_partitions_};
+  sizes.frame_numbers = frame_numbers();
   sizes.jacobi_diagonals = factor_ == nullptr;
   sizes.cg_z = factor_ == nullptr;
-  frames_keep_two_rows_ = true;   // element_rhs stores two rows of each frame (ensemble_layout.h)
   std::size_t largest = 0;
   for (const DeviceBufferSpec& spec : buffer_specs(sizes)) {
     const std::size_t bytes = take_device_bytes(spec, device_.real_size());
@@ -198,7 +206,7 @@ VulkanEnsemble::VulkanEnsemble(const Model& model, EstimatedParameters estimated
   // Lanes over sigma points two or more a sigma point add their parts by subgroup shuffles: the
   // factor's CG shaders compiled for them.
   auto lanes = [&](const char* name) { return cg_lane_rows_ > 1 ? std::string(name) + "_lanes" : std::string(name); };
-  k_cg_start_ = cg_kernel(lanes(factor_ ? "cg_start_factor" : "cg_start").c_str(), start);
+  if (!cg_partitioned_) k_cg_start_ = cg_kernel(lanes(factor_ ? "cg_start_factor" : "cg_start").c_str(), start);
   // One partition on a small mesh: two dispatches an iteration (cg_node_iteration forms q = A d
   // itself), where lavapipe's cost per dispatch outweighs their work; on a larger one the
   // three, where node_product's lanes (a node's sigma points) gather faster than
@@ -238,7 +246,7 @@ VulkanEnsemble::VulkanEnsemble(const Model& model, EstimatedParameters estimated
   s_product_cg_ = bind(k_element_product_, product);
   s_product_all_ = bind(k_element_product_, with_buffer(product, B::active, B::all_active));
   s_node_product_ = bind(k_node_product_, kernel_buffers(DeviceKernel::node_product));
-  s_cg_start_ = bind(k_cg_start_, start);
+  if (!cg_partitioned_) s_cg_start_ = bind(k_cg_start_, start);
   if (node_iteration_)
     s_cg_node_iteration_ = bind(k_cg_node_iteration_, iteration);
   else if (!cg_partitioned_)
@@ -337,7 +345,7 @@ std::size_t VulkanEnsemble::node_items() const {
 std::uint32_t VulkanEnsemble::cg_groups() const {
   const std::uint32_t S = static_cast<std::uint32_t>(S_);
   const std::uint32_t J = static_cast<std::uint32_t>(cg_lane_rows_);
-  return J > 0 ? (J * S + cg_group_ - 1) / cg_group_ : S * static_cast<std::uint32_t>(cg_partitions_);
+  return (J > 0 ? (J * S + cg_group_ - 1) / cg_group_ : S) * static_cast<std::uint32_t>(cg_partitions_);
 }
 
 void VulkanEnsemble::record_system_product(VkCommandBuffer cmd, VkDescriptorSet product_set) const {

@@ -97,9 +97,13 @@ class VulkanEnsemble : public DeviceEnsemble {
   bool node_iteration() const { return node_iteration_; }
   // Whether the element shaders take four sigma points a lane (kernels/vulkan/sigma_quads.h).
   bool sigma_quads() const { return sigma_quads_; }
-  // Whether the one-partition CG shaders take a sigma point a lane (conjugate_gradient.comp).
-  // Rows (nodes) at once of each sigma point's lanes in them; 0: a work-group a sigma point.
+  // Whether the CG shaders take sigma points side by side (conjugate_gradient.comp): rows
+  // (nodes) at once of each sigma point's lanes in them; 0: a work-group a sigma point (or
+  // partition). One partition on a CPU device (DeviceOptions::cg_sigma_lanes_from), the
+  // partitions' shaders on a GPU (CgGroups, DeviceOptions::cg_sigma_lanes).
   int cg_lane_rows() const { return cg_lane_rows_; }
+  // CG's work-groups a sigma point (or a block of sigma points side by side).
+  int cg_partitions() const { return cg_partitions_; }
   // Work-items per sigma point (or partition) in the CG shaders without lanes over sigma points
   // (specialization constant 0): 8 on a CPU device, 64 on a GPU, more where a mesh's nodes would
   // turn their loops too often.
@@ -174,7 +178,7 @@ class VulkanEnsemble : public DeviceEnsemble {
   bool node_iteration_ = false;              // CG iterations by element_product and cg_node_iteration
   bool sigma_quads_ = false;                 // element and node shaders four sigma points a lane
   bool cg_partitioned_ = false;              // CG in the partitions' shaders (P > 1, or the V-cycle)
-  int cg_lane_rows_ = 0;                     // the one-partition CG shaders' lanes a sigma point (constant 2)
+  int cg_lane_rows_ = 0;                     // the CG shaders' lanes a sigma point (constant 2; cg_lane_rows())
   int last_step_waits_ = 0;
   // The observations gathered at the end of the last advance(), until recenter() moves x.
   mutable std::vector<double> observations_cache_;

@@ -75,19 +75,9 @@ void VulkanMultigrid::make_levels(const NestedMultigrid& multigrid) {
 
 void VulkanMultigrid::upload(const NestedMultigrid& multigrid) {
   if (levels_.empty()) make_levels(multigrid);
-  for (int l = 0; l < multigrid.level_count(); ++l) {
-    const NestedMultigrid::Level& from = multigrid.level(l);
-    const Level& level = levels_[static_cast<std::size_t>(l)];
-    upload_matrix(level.matrix, multigrid.launch_matrix(l));
-    if (!from.smoothing.empty()) {
-      device_.upload_reals(level.diagonal, std::vector<double>(from.diagonal.data(), from.diagonal.data() + from.diagonal.size()));
-      device_.upload_reals(level.steps, multigrid.smoothing_coefficients(l));
-    }
-    if (l + 1 < multigrid.level_count()) {
-      upload_matrix(level.prolongation, from.prolongation);
-      upload_matrix(level.restriction, from.restriction);
-    }
-  }
+  write_levels(
+      multigrid, levels_, [&](const Matrix& to, const RowMajorMatrix& M) { upload_matrix(to, M); },
+      [&](const VulkanBuffer& to, const std::vector<double>& values) { device_.upload_reals(to, values); });
 }
 
 void VulkanMultigrid::add(const VulkanKernel& kernel, const Matrix& matrix, std::vector<VulkanBuffer> bound,

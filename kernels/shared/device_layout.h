@@ -6,6 +6,7 @@
  * (neighbouring sigma points) read neighbouring addresses:
  *   per-dof     x[(3 * node + axis) * S + s]
  *   per-element frames[(9 * e + i) * S + s],  corner outputs [(12 * e + i) * S + s]
+ * (Vulkan keeps a frame's first two rows only: frames[(SF_FRAME_TWO_ROWS * e + i) * S + s].)
  * Shared data (rest shape, element rest state, mass) is stored once for all sigma points.
  * Work-items of the element and node kernels: gid = item * S + s. */
 #ifndef SIGMAFEM_DEVICE_LAYOUT_H
@@ -17,6 +18,10 @@
  * slot (step_constants.h, SF_REGION_SCALES; a small integer held as a real), one unused. */
 #define SF_REST_STRIDE 16u
 #define SF_REST_REGION_SLOT 14u
+
+/* An element frame's numbers where a back end keeps its first two rows only (Vulkan,
+ * kernels/vulkan/ensemble_layout.h's SF_FRAME_ROWS_KEPT; the third is their cross product). */
+#define SF_FRAME_TWO_ROWS 6u
 
 /* The index helpers of the element kernels, over the buffers of the layout above. */
 /* Element e's rest state (element.h's grad[12], vlambda, vmu) and its four nodes (uint). */

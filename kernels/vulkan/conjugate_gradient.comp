@@ -40,15 +40,20 @@
  * sums, summed in partition order, and each group's own copies of its scalars keep every
  * group's bits the same and no group reading what another writes).
  *
- * Lanes over sigma points (specialization constant 2, SF_LANE_ROWS = J > 0; one partition, on
- * a CPU device): a group's G lanes are G / J sigma points, J lanes each, lane (j, s) walking
- * every J-th node of its sigma point from the j-th and summing its dot products itself, in
- * node order, the J parts then added in lane order by subgroup shuffles (J > 1: the entries
- * compiled with SF_LANE_SHUFFLES, SPIR-V 1.3; no tree, no barriers; the host dispatches
- * ceil(J S / G) groups). The lanes of a vector then take one node (J = 1) or J at once, so that
- * its loops over element corners and ligaments turn alike in its lanes, and read the node's
- * data at one address, where a group over a sigma point's nodes turns each loop as often as the
- * busiest of 8 nodes needs (bench/RESULTS.md, stop 57).
+ * Lanes over sigma points (specialization constant 2, SF_LANE_ROWS = J > 0): a group's G lanes
+ * are G / J sigma points, J lanes each, lane (j, s) walking every J-th node of its sigma point
+ * (of its partition) from the j-th and summing its dot products itself, in node order; the J
+ * parts are then added in lane order by subgroup shuffles (J > 1 in one partition on a CPU
+ * device: the entries compiled with SF_LANE_SHUFFLES, SPIR-V 1.3; no tree, no barriers) or by
+ * the group's tree stopped at the G / J sigma points (the partitions' shaders). The host
+ * dispatches ceil(J S / G) groups a partition. On a CPU device (one partition) the lanes of a
+ * vector then take one node (J = 1) or J at once, so that its loops over element corners and
+ * ligaments turn alike in its lanes, and read the node's data at one address, where a group
+ * over a sigma point's nodes turns each loop as often as the busiest of 8 nodes needs
+ * (bench/RESULTS.md, stop 57). On a GPU (partitions, since stop 63, as OpenCL's
+ * SF_CG_SIGMA_LANES) a warp's lanes read runs of G / J consecutive entries [row S + s] instead
+ * of each its own 32-byte sector for 4 bytes; a lane whose sigma point is past S or done skips
+ * its rows but keeps to the group's barriers.
  *
  * Per-sigma scalars (arrays of S): bb = b.b, rr = r.r, rz = r.z, active (1 while iterating),
  * converged (1 converged, 0 hit the cap or broke down), iterations (products done). */
@@ -87,11 +92,13 @@ const uint SF_LANE_SIGMAS = SF_SIGMA_LANES ? gl_WorkGroupSize.x / SF_LANE_ROWS :
 uint sf_lane_sigma() { return gl_LocalInvocationID.x % SF_LANE_SIGMAS; }
 uint sf_lane_part() { return gl_LocalInvocationID.x / SF_LANE_SIGMAS; }
 
-/* This invocation's sigma point (one partition), its first row (node) and the step to its next,
- * and whether it stores the sigma point's scalars: by lanes over sigma points or a group a
- * sigma point. */
+/* This invocation's partition and sigma point (group g: sigma block g / P, partition g % P),
+ * its first row (node) and the step to its next, and whether it stores the sigma point's
+ * scalars: by lanes over sigma points or a group a sigma point. */
+uint sf_partition() { return gl_WorkGroupID.x % SF_PARTITIONS; }
 uint sf_sigma_point() {
-  return SF_SIGMA_LANES ? gl_WorkGroupID.x * SF_LANE_SIGMAS + sf_lane_sigma() : gl_WorkGroupID.x;
+  uint block = gl_WorkGroupID.x / SF_PARTITIONS;
+  return SF_SIGMA_LANES ? block * SF_LANE_SIGMAS + sf_lane_sigma() : block;
 }
 uint sf_first_row() { return SF_SIGMA_LANES ? sf_lane_part() : gl_LocalInvocationID.x; }
 uint sf_row_step() { return SF_SIGMA_LANES ? SF_LANE_ROWS : gl_WorkGroupSize.x; }
@@ -107,17 +114,16 @@ void sf_scalars_read() {
 shared real scratch[gl_WorkGroupSize.x];
 
 /* Tree reduction of one value per invocation of the group, returned to every invocation; with
- * lanes over sigma points the J parts of the lane's sigma point, in lane order. */
+ * lanes over sigma points the J parts of the lane's sigma point: by shuffles, in lane order, or
+ * by the tree stopped at G / J (lane j s's partners are j' s: the same sigma point). */
 real sf_group_sum(real value) {
   if (SF_SIGMA_LANES) {
-#if defined(SF_LANE_SHUFFLES)
     if (SF_LANE_ROWS == 1u) return value;
+#if defined(SF_LANE_SHUFFLES)
     real total = real(0);
     for (uint j = 0u; j < 8u; ++j)   /* constant bounds: unrolled */
       if (j < SF_LANE_ROWS) total += subgroupShuffle(value, j * SF_LANE_SIGMAS + sf_lane_sigma());
     return total;
-#else
-    return value;   /* J = 1 without shuffles: the host's condition */
 #endif
   }
   uint lid = gl_LocalInvocationID.x;
@@ -125,12 +131,12 @@ real sf_group_sum(real value) {
   scratch[lid] = value;
   memoryBarrierShared();
   barrier();
-  for (uint stride = gl_WorkGroupSize.x / 2u; stride > 0u; stride /= 2u) {
+  for (uint stride = gl_WorkGroupSize.x / 2u; stride >= SF_LANE_SIGMAS; stride /= 2u) {
     if (lid < stride) scratch[lid] += scratch[lid + stride];
     memoryBarrierShared();
     barrier();
   }
-  return scratch[0];
+  return scratch[sf_lane_sigma()];
 }
 
 /* Partition p's nodes: [begin, end) of the push constant's node count. */
@@ -226,13 +232,14 @@ void main() {
 /* cg_start's rows, partition by partition: the partial sums. */
 void main() {
   uint S = sf_push.S;
-  uint s = gl_WorkGroupID.x / SF_PARTITIONS;
-  uint p = gl_WorkGroupID.x % SF_PARTITIONS;
+  uint s = sf_sigma_point();
+  uint p = sf_partition();
   uint begin, end;
   sf_partition_nodes(p, begin, end);
+  if (s >= S) end = begin; /* a lane past the last sigma point: no rows, the group's barriers */
   real sum_bb, sum_rr, sum_rz;
   sf_start_rows(s, S, begin, end, sum_bb, sum_rr, sum_rz);
-  if (gl_LocalInvocationID.x == 0u) {
+  if (s < S && sf_leads()) {
     partial[(SF_PARTIAL_BB * S + s) * SF_PARTITIONS + p] = sum_bb;
     partial[(SF_PARTIAL_RR * S + s) * SF_PARTITIONS + p] = sum_rr;
     partial[(SF_PARTIAL_RZ * S + s) * SF_PARTITIONS + p] = sum_rz;
@@ -392,92 +399,106 @@ void main() {
 #    endif
 }
 
-#  elif defined(SF_ENTRY_CG_PRECONDITIONED)
+#  elif defined(SF_ENTRY_CG_PRECONDITIONED) || defined(SF_ENTRY_CG_DOT) || defined(SF_ENTRY_CG_UPDATE) || \
+    defined(SF_ENTRY_CG_DIRECTION)
+/* The partitions' shaders: this lane's sigma point s, partition p, their copies' index s P + p
+ * and the partition's nodes; `going` whether its sigma point iterates (with `start`, every one
+ * that exists). A group over one sigma point returns at once when it does not (the same for
+ * the whole group: no barrier is left waiting); lanes over sigma points skip their rows and
+ * keep to the barriers. */
+struct SfPart {
+  uint s, p, own, begin, end;
+  bool going;
+};
+SfPart sf_part(bool start) {
+  SfPart at;
+  at.s = sf_sigma_point();
+  at.p = sf_partition();
+  at.own = at.s * SF_PARTITIONS + at.p;
+  at.going = at.s < sf_push.S && (start || own_active[at.own] != 0u);
+  sf_partition_nodes(at.p, at.begin, at.end);
+  if (!at.going) at.end = at.begin;
+  return at;
+}
+
+#    if defined(SF_ENTRY_CG_PRECONDITIONED)
 /* After the V-cycle's z = M^-1 r: the partition's r.z, and at the start d = z. */
 void main() {
   uint S = sf_push.S;
-  uint g = gl_WorkGroupID.x;
   bool start = sf_push.p != 0u;
-  if (!start && own_active[g] == 0u) return;
-  uint s = g / SF_PARTITIONS;
-  uint p = g % SF_PARTITIONS;
-  uint begin, end;
-  sf_partition_nodes(p, begin, end);
+  SfPart at = sf_part(start);
+  if (!SF_SIGMA_LANES && !at.going) return;
   real sum_rz = real(0);
-  for (uint n = begin + gl_LocalInvocationID.x; n < end; n += gl_WorkGroupSize.x)
+  for (uint n = at.begin + sf_first_row(); n < at.end; n += sf_row_step())
     for (uint k = 0u; k < 3u; ++k) {
-      uint row = (3u * n + k) * S + s;
+      uint row = (3u * n + k) * S + at.s;
       real z_row = z[row];
       sum_rz += r[row] * z_row;
       if (start) d[row] = z_row;
     }
   sum_rz = sf_group_sum(sum_rz);
-  if (gl_LocalInvocationID.x == 0u) partial[(SF_PARTIAL_RZ * S + s) * SF_PARTITIONS + p] = sum_rz;
+  if (at.going && sf_leads()) partial[(SF_PARTIAL_RZ * S + at.s) * SF_PARTITIONS + at.p] = sum_rz;
 }
 
-#  elif defined(SF_ENTRY_CG_DOT)
+#    elif defined(SF_ENTRY_CG_DOT)
 /* The iteration's first part after q = A d: the partition's d.q. */
 void main() {
   uint S = sf_push.S;
-  uint g = gl_WorkGroupID.x;
-  if (own_active[g] == 0u) return;
-  uint s = g / SF_PARTITIONS;
-  uint p = g % SF_PARTITIONS;
-  uint begin, end;
-  sf_partition_nodes(p, begin, end);
-  real sum_dq = sf_dq_rows(s, S, begin, end);
-  if (gl_LocalInvocationID.x == 0u) partial[(SF_PARTIAL_DQ * S + s) * SF_PARTITIONS + p] = sum_dq;
+  SfPart at = sf_part(false);
+  if (!SF_SIGMA_LANES && !at.going) return;
+  real sum_dq = sf_dq_rows(at.s, S, at.begin, at.end);
+  if (at.going && sf_leads()) partial[(SF_PARTIAL_DQ * S + at.s) * SF_PARTITIONS + at.p] = sum_dq;
 }
 
-#  elif defined(SF_ENTRY_CG_UPDATE)
+#    elif defined(SF_ENTRY_CG_UPDATE)
 /* The second part: alpha, the partition's x, r, z, and its r.r and r.z. */
 void main() {
   uint S = sf_push.S;
-  uint g = gl_WorkGroupID.x;
-  if (own_active[g] == 0u) return;
-  uint s = g / SF_PARTITIONS;
-  uint p = g % SF_PARTITIONS;
-  real sum_dq;
-  SF_PARTIALS_SUM(SF_PARTIAL_DQ, S, s, sum_dq)
-  uint begin, end;
-  sf_partition_nodes(p, begin, end);
+  SfPart at = sf_part(false);
+  if (!SF_SIGMA_LANES && !at.going) return;
+  real alpha = real(0);
+  if (at.going) {
+    real sum_dq;
+    SF_PARTIALS_SUM(SF_PARTIAL_DQ, S, at.s, sum_dq)
+    alpha = own_rz[at.own] / sum_dq;
+  }
   real sum_rr, sum_rz;
-  sf_update_rows(s, S, begin, end, own_rz[g] / sum_dq, sum_rr, sum_rz);
-  if (gl_LocalInvocationID.x == 0u) {
-    partial[(SF_PARTIAL_RR * S + s) * SF_PARTITIONS + p] = sum_rr;
-    partial[(SF_PARTIAL_RZ * S + s) * SF_PARTITIONS + p] = sum_rz;
+  sf_update_rows(at.s, S, at.begin, at.end, alpha, sum_rr, sum_rz);
+  if (at.going && sf_leads()) {
+    partial[(SF_PARTIAL_RR * S + at.s) * SF_PARTITIONS + at.p] = sum_rr;
+    partial[(SF_PARTIAL_RZ * S + at.s) * SF_PARTITIONS + at.p] = sum_rz;
   }
 }
 
-#  elif defined(SF_ENTRY_CG_DIRECTION)
-/* The third part: the stop test, the group's copies (and group (s, 0) the scalars), and the
+#    else /* SF_ENTRY_CG_DIRECTION */
+/* The third part: the stop test, the lane's copies (and partition 0's the scalars), and the
  * partition's d = z + beta d. */
 void main() {
   uint S = sf_push.S;
-  uint g = gl_WorkGroupID.x;
-  if (own_active[g] == 0u) return;
-  uint s = g / SF_PARTITIONS;
-  uint p = g % SF_PARTITIONS;
-  int count = own_iterations[g] + 1;
-  real rz_old = own_rz[g];
-  real sum_rr, sum_rz;
-  SF_PARTIALS_SUM(SF_PARTIAL_RR, S, s, sum_rr)
-  SF_PARTIALS_SUM(SF_PARTIAL_RZ, S, s, sum_rz)
-  bool done = sf_done(s, sum_rr);
-  bool stop = sf_stop(done, sum_rr, count);
+  SfPart at = sf_part(false);
+  if (!SF_SIGMA_LANES && !at.going) return;
+  int count = 0;
+  real rz_old = real(1), sum_rr = real(0), sum_rz = real(0);
+  bool done = false, stop = true;
+  if (at.going) {
+    count = own_iterations[at.own] + 1;
+    rz_old = own_rz[at.own];
+    SF_PARTIALS_SUM(SF_PARTIAL_RR, S, at.s, sum_rr)
+    SF_PARTIALS_SUM(SF_PARTIAL_RZ, S, at.s, sum_rz)
+    done = sf_done(at.s, sum_rr);
+    stop = sf_stop(done, sum_rr, count);
+  }
   memoryBarrierBuffer();
   barrier(); /* everyone has read the old copies before they change */
-  if (gl_LocalInvocationID.x == 0u) {
-    own_iterations[g] = count;
-    own_rz[g] = sum_rz;
-    if (stop) own_active[g] = 0u;
-    if (p == 0u) sf_store_scalars(s, count, sum_rr, sum_rz, done, stop);
+  if (at.going && sf_leads()) {
+    own_iterations[at.own] = count;
+    own_rz[at.own] = sum_rz;
+    if (stop) own_active[at.own] = 0u;
+    if (at.p == 0u) sf_store_scalars(at.s, count, sum_rr, sum_rz, done, stop);
   }
-  if (stop) return;
-  uint begin, end;
-  sf_partition_nodes(p, begin, end);
-  sf_direction_rows(s, S, begin, end, sum_rz / rz_old);
+  if (!stop) sf_direction_rows(at.s, S, at.begin, at.end, sum_rz / rz_old);
 }
+#    endif
 
 #  else
 #    error "conjugate_gradient.comp: define one of the SF_ENTRY_CG_* entry points"

@@ -34,16 +34,17 @@
  * storage-buffer store costs llvmpipe a loop over its lanes (without the third row's stores
  * element_rhs took ~12% less on the 4768 liver at S = 16; bench/RESULTS.md, stop 61), and the
  * third row is their cross product (sf_frame_third_row), made again where a frame is read.
- * element_rhs makes its frame so before using it too: every shader of a step sees the same one. */
+ * element_rhs makes its frame so before using it too: every shader of a step sees the same one.
+ * The buffer holds the 6 alone (since stop 63; a third less of the frames' memory). */
 /* (s, S): a sigma point and S; in the sigma-quad shaders a quad q and Q (sigma_quads.h), read
  * with LOAD = SF_QUAD. */
-#define SF_FRAME_ROWS_KEPT 6u
+#define SF_FRAME_ROWS_KEPT SF_FRAME_TWO_ROWS
 #define SF_LOAD_KEPT_FRAME(LOAD, frames, e, s, S, frame)                                    \
   SF_UNROLL for (uint i_ = 0u; i_ < SF_FRAME_ROWS_KEPT; ++i_)                               \
-    frame[i_] = LOAD(frames, (9u * (e) + i_) * (S) + (s));                                  \
+    frame[i_] = LOAD(frames, (SF_FRAME_ROWS_KEPT * (e) + i_) * (S) + (s));                  \
   sf_frame_third_row(frame);
 #define SF_STORE_KEPT_FRAME(frames, e, s, S, frame) \
-  SF_UNROLL for (uint i_ = 0u; i_ < SF_FRAME_ROWS_KEPT; ++i_) frames[(9u * (e) + i_) * (S) + (s)] = frame[i_];
+  SF_UNROLL for (uint i_ = 0u; i_ < SF_FRAME_ROWS_KEPT; ++i_) frames[(SF_FRAME_ROWS_KEPT * (e) + i_) * (S) + (s)] = frame[i_];
 
 /* The arrays a shader only reads, declared with SF_READ_REALS/INTS/UINTS(binding, name) and
  * read with SF_LOAD(name, index) (dialect.h): storage buffers, or, in the shaders compiled

@@ -69,7 +69,7 @@ struct BackendCase {
   // DeviceOptions::node_iteration_work: 0 for Vulkan's CG in three dispatches an iteration
   // (what larger meshes run) on the meshes that would take two.
   long long node_iteration_work = kNodeIterationWork;
-  int cg_sigma_lanes = 0;   // DeviceOptions::cg_sigma_lanes (OpenCL's GPU form)
+  int cg_sigma_lanes = 0;   // DeviceOptions::cg_sigma_lanes (the GPU forms' partitions)
 };
 
 // The back ends to check: OpenCL device 0 and Vulkan device 0, each in single and, where the
@@ -141,6 +141,16 @@ std::vector<BackendCase> backend_cases() {
   // large meshes), forced on whatever device is there.
   cases.push_back({"vulkan", Precision::single, "VulkanSingleGpuFormPartitions", SolveLaunch::automatic,
                    KernelForm::gpu, 3});
+  // Its partitions' shaders with sigma points side by side (CgGroups, as OpenCL's, since stop
+  // 63), S = 4: 2 lanes, two blocks of sigma points, in three partitions (lavapipe's groups of 8:
+  // each sigma point's 4 row lanes added by the group's tree); 8 lanes in two partitions, half
+  // of them past the last sigma point.
+  cases.push_back({"vulkan", Precision::single, "VulkanSingleGpuFormTwoLanes", SolveLaunch::automatic,
+                   KernelForm::gpu, 3, Preconditioner::jacobi, DeviceOptions{}.own_factors_bytes, 4, true,
+                   kNodeIterationWork, 2});
+  cases.push_back({"vulkan", Precision::single, "VulkanSingleGpuFormEightLanes", SolveLaunch::automatic,
+                   KernelForm::gpu, 2, Preconditioner::jacobi, DeviceOptions{}.own_factors_bytes, 4, true,
+                   kNodeIterationWork, 8});
   cases.push_back({"vulkan", Precision::double_precision, "VulkanDouble"});
   return cases;
 }

@@ -49,6 +49,9 @@ TEST(EnsembleMemory, CountsTheStateTheElementsAndAFactor) {
   const EnsembleMemory plain = ensemble_memory(nodes, elements, S, real);
   EXPECT_EQ(plain.total, (9 * 3 * nodes * S + 33 * elements * S) * real);
   EXPECT_EQ(plain.largest, 12u * elements * S * real);
+  // Vulkan's frames: their first two rows, 6 numbers of 9.
+  EXPECT_EQ(plain.total - ensemble_memory(nodes, elements, S, real, 0, FactorStorage::columns, 1, 6).total,
+            3u * elements * S * real);
 
   // With a factor no Jacobi diagonals (3 N S and 12 E S reals) but L's values and row indices,
   // its column starts and ordering, a work vector per sigma point.

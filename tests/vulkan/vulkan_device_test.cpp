@@ -14,6 +14,7 @@
 #include <thread>
 #include <vector>
 
+#include "device_layout.h"
 #include "host/engine/make_ensemble.h"
 #include "host/ensemble/device_limits.h"
 #include "host/model/model.h"
@@ -498,7 +499,7 @@ TEST_F(VulkanDeviceTest, TheMemoryCheckCountsTheFactorsBlocks) {
     ASSERT_EQ(ensemble.factorisations(), 1);
     const double estimate = static_cast<double>(
         ensemble_memory(model.node_count(), model.element_count(), S, sizeof(float),
-                        ensemble.factor_nonzeros(), FactorStorage::blocks).total);
+                        ensemble.factor_nonzeros(), FactorStorage::blocks, 1, SF_FRAME_TWO_ROWS).total);
     const double held = static_cast<double>(ensemble.device_bytes());
     EXPECT_GT(held, 0.8 * estimate) << "S = " << S;
     EXPECT_LT(held, 1.25 * estimate) << "S = " << S;

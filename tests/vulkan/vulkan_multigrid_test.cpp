@@ -8,7 +8,9 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <iostream>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "host/common/device_error.h"
@@ -83,16 +85,22 @@ TEST_F(VulkanMultigridTest, TheDeviceVCycleIsTheHostsForEverySigmaPointInBothFor
 
 // lavapipe, float32: 6 steps of the refined liver with each sigma point's ligaments apart,
 // Jacobi against the V-cycle (asked: a CPU device takes the factor by default), in one CG
-// partition and in three.
+// partition, in three, and in three with two sigma points side by side in a group (a GPU's
+// choice: its cg_preconditioned too).
 TEST_F(VulkanMultigridTest, TheEnsemblesCgFollowsJacobiInAFifthOfItsIterationsOrFewer) {
   const int S = kVulkanMultigridSigmaPoints;
   const Eigen::MatrixXd theta = test::spread_log_stiffness(scenario_, model_, S, 0.5);
-  const auto run = [&](Preconditioner preconditioner, int partitions, long& iterations, int& makings) {
+  const auto run = [&](Preconditioner preconditioner, int partitions, long& iterations, int& makings,
+                       int lanes = 0) {
     DeviceOptions options;
     options.preconditioner = preconditioner;
     options.cg_partitions = partitions;
+    options.cg_sigma_lanes = lanes;
     VulkanEnsemble ensemble(model_, scenario_.filter->estimate, scenario_.observations.observed, S, options);
     EXPECT_EQ(ensemble.multigrid(), preconditioner == Preconditioner::multigrid);
+    if (lanes > 1) {
+      EXPECT_EQ(ensemble.cg_lane_rows(), static_cast<int>(ensemble.cg_group_size()) / lanes);
+    }
     const Eigen::MatrixXd x = test::run_steps(ensemble, scenario_, theta, 6, iterations);
     makings = ensemble.factorisations();
     return x;
@@ -100,15 +108,16 @@ TEST_F(VulkanMultigridTest, TheEnsemblesCgFollowsJacobiInAFifthOfItsIterationsOr
   long jacobi_iterations = 0;
   int jacobi_makings = 0;
   const Eigen::MatrixXd jacobi = run(Preconditioner::jacobi, 0, jacobi_iterations, jacobi_makings);
-  for (int partitions : {1, 3}) {
+  for (const auto& [partitions, lanes] : {std::pair{1, 0}, std::pair{3, 0}, std::pair{3, 2}}) {
     long iterations = 0;
     int makings = 0;
-    const Eigen::MatrixXd multigrid = run(Preconditioner::multigrid, partitions, iterations, makings);
+    const Eigen::MatrixXd multigrid = run(Preconditioner::multigrid, partitions, iterations, makings, lanes);
     // Each CG stops within 1e-6 of |b| from its own preconditioner (measured 1.5e-8 m), in
     // 5618 Jacobi iterations against 331.
-    EXPECT_LE((multigrid - jacobi).cwiseAbs().maxCoeff(), 1e-6) << partitions << " partitions";
-    EXPECT_LE(5 * iterations, jacobi_iterations) << partitions << " partitions";
+    EXPECT_LE((multigrid - jacobi).cwiseAbs().maxCoeff(), 1e-6) << partitions << " partitions, " << lanes << " lanes";
+    EXPECT_LE(5 * iterations, jacobi_iterations) << partitions << " partitions, " << lanes << " lanes";
     EXPECT_GE(makings, 1);
+    std::cout << partitions << " partitions, " << lanes << " lanes: " << iterations << " CG iterations\n";
   }
 }
 
