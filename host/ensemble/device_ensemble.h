@@ -111,7 +111,8 @@ class DeviceEnsemble : public SimulationEnsemble {
   Eigen::SparseMatrix<double> representative_system() const;
   // ... its inputs (the mean state, the parameters, the effects) read now and the matrix
   // assembled when called: on a background making's thread (host/reference/background_making.h),
-  // so that the step that starts it does not stop for the assembly (~60 ms on the 38k liver).
+  // so that the step that starts it does not stop for the assembly (8 ms on the 38k liver, 35
+  // on the 117k box here: bench/multigrid_making_bench.cpp).
   // The representative simulation it assembles with must not be used elsewhere meanwhile.
   std::function<Eigen::SparseMatrix<double>()> representative_system_later() const;
   // ligament_k_ with every sigma point's estimated ligaments at the representative's

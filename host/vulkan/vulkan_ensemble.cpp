@@ -432,8 +432,6 @@ void VulkanEnsemble::hand_over_making(bool made) {
 }
 
 void VulkanEnsemble::refresh_factor(const std::vector<double>& constants) {
-  // A matrix that is not positive definite (a diverged state?) leaves the last factor in
-  // place, and the next step tries again.
   // A large factor in the background where the device has one to step on meanwhile (as
   // OpenClEnsemble's): a failed making leaves that one in place.
   if (factor_makings_ > 0 && preconditioner_making_.takes(factor_->factorisation_in_solves())) {
@@ -441,6 +439,8 @@ void VulkanEnsemble::refresh_factor(const std::vector<double>& constants) {
     preconditioner_making_.start([this, system = representative_system_later()] { return factor_->factorise(system()); });
     return;
   }
+  // A matrix that is not positive definite (a diverged state?) leaves the last factor in
+  // place, and the next step tries again.
   const Eigen::SparseMatrix<double> A = representative_system();
   if (!factor_->factorise(A)) {
     if (!factor_solve_->ready()) {
