@@ -8,6 +8,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <memory>
 #include <string>
 
 #include "host/ensemble/cpu_ensemble.h"
@@ -161,6 +162,18 @@ TEST_F(OpenClFactorTest, AFactorMadeInTheBackgroundGivesTheSameBitsEveryRun) {
   };
   const test::MakingRun waited = run_with(0);
   test::expect_background_making_repeats(waited, run_with(3), run_with(3), kPositionTolerance);
+}
+
+TEST_F(OpenClFactorTest, AFactorMadeInTheBackgroundKeepsTheSpringsOfItsStep) {
+  test::expect_the_making_steps_springs(
+      [&](int lag) {
+        DeviceOptions options;   // corrected for the sigma points' springs, as by default
+        options.background_making_solves = 0.0;
+        options.background_making_steps = lag;
+        return std::make_unique<OpenClEnsemble>(model_, scenario_.filter->estimate, scenario_.observations.observed,
+                                                kSigmaPoints, options);
+      },
+      scenario_, theta_);
 }
 
 TEST_F(OpenClFactorTest, TheGpuFormRefusesIt) {

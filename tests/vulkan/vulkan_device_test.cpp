@@ -10,6 +10,7 @@
 #include <cmath>
 #include <cstdint>
 #include <cstdlib>
+#include <memory>
 #include <string>
 #include <thread>
 #include <vector>
@@ -442,6 +443,23 @@ TEST_F(VulkanDeviceTest, AFactorMadeInTheBackgroundGivesTheSameBitsEveryRun) {
   const test::MakingRun waited = run_with(0);
   if (waited.x.size() == 0) GTEST_SKIP() << "Vulkan's factor is a CPU device's";
   test::expect_background_making_repeats(waited, run_with(3), run_with(3), 1e-6);
+}
+
+// As OpenCL's (OpenClFactorTest.AFactorMadeInTheBackgroundKeepsTheSpringsOfItsStep).
+TEST_F(VulkanDeviceTest, AFactorMadeInTheBackgroundKeepsTheSpringsOfItsStep) {
+  const Scenario scenario = load_scenario(kScenarios + "liver.json");
+  const Model model = make_model(scenario);
+  const int S = 4;
+  test::expect_the_making_steps_springs(
+      [&](int lag) {
+        DeviceOptions options;   // the factor, corrected for the sigma points' springs, as by default
+        options.preconditioner = Preconditioner::factorised;
+        options.background_making_solves = 0.0;
+        options.background_making_steps = lag;
+        return std::make_unique<VulkanEnsemble>(model, scenario.filter->estimate, scenario.observations.nodes, S,
+                                                options);
+      },
+      scenario, test::spread_log_stiffness(scenario, model, S, 0.3));
 }
 
 // The 38k liver's filter (S = 4, the factor): its 2 lanes a sigma point would turn the CG
