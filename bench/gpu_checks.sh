@@ -5,7 +5,7 @@
 # (`sigmafem devices`, first line of devices.txt); no GPU is needed to build or test.
 # Usage: bench/gpu_checks.sh [BUILD [OUT]]   (defaults: build, BUILD/gpu)
 # Each part has a time limit (seconds: SIGMAFEM_GPU_TEST_LIMIT, SIGMAFEM_GPU_LANES_LIMIT,
-# SIGMAFEM_GPU_BENCH_LIMIT, SIGMAFEM_GPU_DIAGNOSE_LIMIT; 220 + 50 + 230 + 100 s by default, under
+# SIGMAFEM_GPU_BENCH_LIMIT, SIGMAFEM_GPU_DIAGNOSE_LIMIT; 220 + 80 + 200 + 100 s by default, under
 # a 10-minute call) so that a lease of a few minutes always brings its logs back. On the H200
 # the conformance part took about 170 s and the liver diagnoses 78 s.
 set -u
@@ -41,16 +41,17 @@ grep -E 'tests ran|FAILED TEST' "$out/conformance.log"
 # CG with sigma points side by side in its groups (OpenCL's since stop 62, Vulkan's partitions'
 # since stop 63, the defaults) against a sigma point a group, on the large meshes, first: the
 # A/B that PoCL and lavapipe could only stand in for; S = 16, where stop 32 profiled an
-# iteration (S = 64 runs in the benchmarks' part).
-echo "== CG sigma lanes (limit ${SIGMAFEM_GPU_LANES_LIMIT:-50} s)"
-timeout "${SIGMAFEM_GPU_LANES_LIMIT:-50}" "$build/bench/sigmafem_bench" \
-  --benchmark_filter='BM_ensemble_step/(opencl(_gpu_form_one_lane)?|vulkan(_one_lane)?)_(liver_fine_38144|box_large_117240)/16/' \
+# iteration (S = 64 runs in the benchmarks' part). Then the hierarchy made often, at once and
+# in the background (stop 63): the slowest step against the mean (BM_steps_with_makings).
+echo "== CG sigma lanes, makings (limit ${SIGMAFEM_GPU_LANES_LIMIT:-80} s)"
+timeout "${SIGMAFEM_GPU_LANES_LIMIT:-80}" "$build/bench/sigmafem_bench" \
+  --benchmark_filter='BM_ensemble_step/(opencl(_gpu_form_one_lane)?|vulkan(_one_lane)?)_(liver_fine_38144|box_large_117240)/16/|BM_steps_with_makings/(opencl|vulkan)_[a-z_]*_liver_fine_38144' \
   --benchmark_min_time=0.3 >"$out/lanes.log" 2>&1
 echo "lanes exit $?"
 cat "$out/lanes.log"
 
-echo "== benchmarks (limit ${SIGMAFEM_GPU_BENCH_LIMIT:-230} s)"
-timeout "${SIGMAFEM_GPU_BENCH_LIMIT:-230}" "$build/bench/sigmafem_bench" \
+echo "== benchmarks (limit ${SIGMAFEM_GPU_BENCH_LIMIT:-200} s)"
+timeout "${SIGMAFEM_GPU_BENCH_LIMIT:-200}" "$build/bench/sigmafem_bench" \
   --benchmark_filter='BM_ensemble_step/(opencl|vulkan)_(liver_4768|liver_596|liver_fine_38144|box_large_117240)/|BM_ensemble_step/(opencl|vulkan)_polar_liver_4768/|BM_ensemble_step/cpu_liver_(596|4768)/16/|BM_filter_step/(opencl|vulkan|cpu)/|BM_filter_step/(opencl|vulkan|opencl_multigrid|vulkan_multigrid)_liver_fine_38144/|BM_ensemble_step/(opencl|vulkan)_multigrid_(liver_4768|liver_fine_38144|box_large_117240)/|BM_filter_step_parameters/(opencl|vulkan)/|BM_filter_step/vulkan_(texel|storage)_reads/|BM_ensemble_step/vulkan_(texel|storage)_reads_liver_4768/' \
   --benchmark_min_time=0.3 --benchmark_out="$out/bench.json" --benchmark_out_format=json \
   >"$out/bench.log" 2>&1

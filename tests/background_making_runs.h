@@ -1,7 +1,8 @@
-// The background making's check, shared by the back ends that have it (OpenClFactorTest,
-// VulkanDeviceTest; OpenClMultigridTest, VulkanMultigridTest): three runs of the same steps, the
-// first waiting for each making of the factor or the multigrid hierarchy, the other two making
-// it in the background (host/reference/background_making.h).
+// The background making's checks, shared by the back ends that have it (OpenClFactorTest,
+// VulkanDeviceTest; OpenClMultigridTest, VulkanMultigridTest; host/reference/
+// background_making.h): three runs of the same steps, the first waiting for each making of the
+// factor or the multigrid hierarchy, the other two making it in the background; and a factor
+// made in the background corrected against the springs of the step its making began at.
 #pragma once
 
 #include <gtest/gtest.h>
