@@ -65,9 +65,10 @@ constexpr double kBackgroundMakingSolves = 200.0;
 constexpr int kBackgroundMakingSteps = 20;
 // The least work (in V-cycles) of a making of the multigrid hierarchy that goes to the
 // background: any after the first. Its host work stops a GPU's step of a few milliseconds for
-// as long as it takes (the 38k liver's: ~110 ms here on PoCL, against the 16 V-cycles of a
-// step; bench/RESULTS.md, stop 63), and the hierarchy is made seldom (once in 190 steps there),
-// so that 20 more steps on the last one cost little.
+// as long as it takes (the 38k liver's: 8 ms of assembly and 59 of hierarchy here,
+// bench/multigrid_making_bench.cpp; bench/RESULTS.md, stop 63), and the hierarchy is made
+// seldom (once in about 190 steps there on PoCL), so that 20 more steps on the last one cost
+// little.
 constexpr double kBackgroundMultigridCycles = 0.0;
 inline bool spring_correction_fits(std::size_t spring_rows, int sigma_count) {
   return spring_rows > 0 && spring_rows * static_cast<std::size_t>(sigma_count) <= kSpringRowsTimesSigmaPoints;

@@ -147,7 +147,7 @@ OpenClEnsemble::OpenClEnsemble(const Model& model, EstimatedParameters estimated
                         "(a scenario's mesh.refine makes one)");
     multigrid_ = std::make_unique<NestedMultigrid>(std::move(prolongations));
     shift_rows_ = SpringCorrection(estimated_spring_rows(model_, estimated_));
-    multigrid_making_cycles_ = options.multigrid_making_cycles;
+    multigrid_refresh_.fix_cost(options.multigrid_making_cycles);
     preconditioner_making_.set_rule(options.background_making_steps, kBackgroundMultigridCycles);
   }
   cg_partitioned_ = cg_per_group_ && (cg_partitions_ > 1 || multigrid_);
@@ -316,7 +316,7 @@ std::vector<double> OpenClEnsemble::read_reals(DeviceBuffer id, std::size_t coun
 void OpenClEnsemble::upload_ligament_k() {
   write_reals(DeviceBuffer::ligament_k, ligament_k_);
   coupling_stale_ = springs_.prepared();   // the springs' corrections follow the stiffnesses
-  shift_stale_ = multigrid_on_device_;
+  shift_stale_ = multigrid_makings_ > 0;
 }
 
 void OpenClEnsemble::run(cl::Kernel& kernel, std::size_t items, std::size_t local) const {
@@ -395,7 +395,7 @@ void OpenClEnsemble::conjugate_gradient() {
 
 void OpenClEnsemble::precondition_outside(bool start) {
   // Until a hierarchy has gone down, the Jacobi z that cg_start_partials and cg_update made.
-  if (!multigrid_on_device_) return;
+  if (multigrid_makings_ == 0) return;
   device_multigrid_->enqueue(buffer(DeviceBuffer::r), buffer(DeviceBuffer::z));
   k_cg_preconditioned_.setArg(2, static_cast<cl_uint>(start ? 1 : 0));
   run_partitions(k_cg_preconditioned_);
@@ -505,34 +505,30 @@ void OpenClEnsemble::hand_over_making(bool made) {
     if (made) upload_factor(making_springs_);
     return;
   }
-  multigrid_refresh_.made(made, multigrid_making_cost());
+  multigrid_refresh_.made(made, multigrid_->setup_in_cycles());
   if (made) upload_multigrid(making_springs_);
 }
 
 void OpenClEnsemble::refresh_multigrid(const std::vector<double>& constants) {
   // Made in the background where the device has a hierarchy to step on meanwhile; a failed
   // making leaves that one in place, and the rule asks again at the next step.
-  if (multigrid_on_device_ && preconditioner_making_.takes(multigrid_->setup_in_cycles())) {
+  if (multigrid_makings_ > 0 && preconditioner_making_.takes(multigrid_->setup_in_cycles())) {
     making_springs_ = factorised_springs(shift_rows_, constants);
     preconditioner_making_.start([this, system = representative_system_later()] { return multigrid_->set_matrix(system()); });
     return;
   }
   const bool made = multigrid_->set_matrix(representative_system());
-  multigrid_refresh_.made(made, multigrid_making_cost());
+  multigrid_refresh_.made(made, multigrid_->setup_in_cycles());
   // Else the last hierarchy stays, or Jacobi until one is made.
   if (made) upload_multigrid(factorised_springs(shift_rows_, constants));
 }
 
-double OpenClEnsemble::multigrid_making_cost() const {
-  return multigrid_making_cycles_ > 0.0 ? multigrid_making_cycles_ : multigrid_->setup_in_cycles();
-}
-
 void OpenClEnsemble::upload_multigrid(const std::vector<double>& springs) {
-  if (!multigrid_on_device_)   // later makings are written into the same buffers
-    check_more_device_memory(multigrid_memory(*multigrid_, S_, device_.real_size()), "the multigrid levels");
+  // The first making's buffers: later ones are written into them.
+  const bool first = multigrid_makings_ == 0;
+  if (first) check_more_device_memory(multigrid_memory(*multigrid_, S_, device_.real_size()), "the multigrid levels");
   device_multigrid_->upload(*multigrid_);
-  if (!multigrid_on_device_) device_bytes_ += device_multigrid_->device_bytes();
-  multigrid_on_device_ = true;
+  if (first) device_bytes_ += device_multigrid_->device_bytes();
   ++multigrid_makings_;
   multigrid_springs_ = springs;
   shift_stale_ = true;

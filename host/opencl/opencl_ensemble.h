@@ -120,8 +120,6 @@ class OpenClEnsemble : public DeviceEnsemble {
   // The hierarchy just made goes down, with its system's `springs` at the estimated ligaments'
   // rows (factorised_springs at the step it was made at), against which the shifts are taken.
   void upload_multigrid(const std::vector<double>& springs);
-  // A making in the hierarchy's refresh rule, in V-cycles (DeviceOptions::multigrid_making_cycles).
-  double multigrid_making_cost() const;
   // At the step a background making is handed over: its factor or hierarchy goes down where it
   // was made (`made`); a failed one leaves the last in place.
   void hand_over_making(bool made);
@@ -174,18 +172,16 @@ class OpenClEnsemble : public DeviceEnsemble {
   FactorOnDevice on_device_ = FactorOnDevice::none;
   int factor_makings_ = 0;   // successful factorisations (not read from factor_ while it is made)
   // CG's preconditioner on the GPU form where the mesh is a refinement (opencl_uses_multigrid):
-  // the hierarchy of the representative's system, its copy on the device (once one has been
-  // made), when to make it again, the estimated ligaments' rows with the hierarchy's springs
-  // there, and whether the sigma points' shifts are out of date.
+  // the hierarchy of the representative's system, its copy on the device, its makings gone
+  // down (0: none on the device yet), when to make it again, the estimated ligaments' rows
+  // with the hierarchy's springs there, and whether the sigma points' shifts are out of date.
   std::unique_ptr<NestedMultigrid> multigrid_;
   std::unique_ptr<OpenClMultigrid> device_multigrid_;
-  bool multigrid_on_device_ = false;
   int multigrid_makings_ = 0;
   RefreshRule multigrid_refresh_;
   SpringCorrection shift_rows_;
   std::vector<double> multigrid_springs_;
   bool shift_stale_ = false;
-  double multigrid_making_cycles_ = 0.0;   // DeviceOptions::multigrid_making_cycles
   // A large shared factor, or the multigrid hierarchy, made again in the background
   // (DeviceOptions::background_making_steps), and its system's springs at the step it began
   // (the sigma points' parameters move on before the hand-over); factor_ or multigrid_ is the

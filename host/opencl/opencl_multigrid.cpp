@@ -1,10 +1,8 @@
 #include "host/opencl/opencl_multigrid.h"
 
 #include <algorithm>
-#include <string>
 
 #include "device_layout.h"
-#include "host/common/device_error.h"
 #include "host/ensemble/device_readout.h"
 
 namespace sigmafem {
@@ -54,10 +52,7 @@ void OpenClMultigrid::write_reals(const cl::Buffer& to, const std::vector<double
 }
 
 void OpenClMultigrid::write_matrix(const Matrix& to, const RowMajorMatrix& M) {
-  if (static_cast<cl_uint>(M.rows()) != to.rows || static_cast<std::size_t>(M.nonZeros()) != to.nonzeros)
-    throw DeviceError("a multigrid level of " + std::to_string(M.rows()) + " rows and " +
-                      std::to_string(M.nonZeros()) + " entries where the first had " + std::to_string(to.rows) +
-                      " and " + std::to_string(to.nonzeros));
+  check_level_size(M, to.rows, to.nonzeros);
   write(to.row_start, M.outerIndexPtr(), (static_cast<std::size_t>(M.rows()) + 1) * sizeof(cl_int));
   write(to.columns, M.innerIndexPtr(), to.nonzeros * sizeof(cl_int));
   write_reals(to.values, std::vector<double>(M.valuePtr(), M.valuePtr() + M.nonZeros()));

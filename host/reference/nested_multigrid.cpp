@@ -5,6 +5,9 @@
 #include <array>
 #include <cmath>
 #include <stdexcept>
+#include <string>
+
+#include "host/common/device_error.h"
 
 namespace sigmafem {
 namespace {
@@ -110,6 +113,13 @@ std::vector<NestedMultigrid::ChebyshevStep> chebyshev_steps(double lambda_max, i
 }
 
 }  // namespace
+
+void check_level_size(const RowMajorMatrix& M, std::size_t rows, std::size_t nonzeros) {
+  if (static_cast<std::size_t>(M.rows()) != rows || static_cast<std::size_t>(M.nonZeros()) != nonzeros)
+    throw DeviceError("a multigrid level of " + std::to_string(M.rows()) + " rows and " +
+                      std::to_string(M.nonZeros()) + " entries where the first had " + std::to_string(rows) +
+                      " and " + std::to_string(nonzeros));
+}
 
 std::vector<RowMajorMatrix> nested_prolongations(const Model& model) {
   std::vector<RowMajorMatrix> prolongations;

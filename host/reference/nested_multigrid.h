@@ -21,6 +21,7 @@
 
 #include <Eigen/Core>
 #include <Eigen/SparseCore>
+#include <cstddef>
 #include <vector>
 
 #include "host/model/model.h"
@@ -147,6 +148,10 @@ class NestedMultigrid {
   double setup_in_cycles_ = 0.0;
   bool ready_ = false;
 };
+
+// A device back end's level made for a matrix of `rows` rows and `nonzeros` entries (the first
+// hierarchy's) and `M` of a later one: throws DeviceError where they differ.
+void check_level_size(const RowMajorMatrix& M, std::size_t rows, std::size_t nonzeros);
 
 // Writes `multigrid`'s values into a device back end's `levels` (OpenClMultigrid,
 // VulkanMultigrid), made for the first hierarchy of the same meshes: each level's launch

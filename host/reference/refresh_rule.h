@@ -15,12 +15,16 @@ namespace sigmafem {
 
 class RefreshRule {
  public:
-  // After a making: `ok` whether it succeeded, `cost` its work in applications.
+  // After a making: `ok` whether it succeeded, `cost` its work in applications (or the fixed
+  // cost, where one is set).
   void made(bool ok, double cost) {
     fresh_ = true;
     ok_ = ok;
-    cost_ = cost;
+    cost_ = fixed_cost_ > 0.0 ? fixed_cost_ : cost;
   }
+  // Every making counted as `cost` applications, whatever its work (> 0; tests make it small to
+  // make the preconditioner again within a few steps: DeviceOptions::multigrid_making_cycles).
+  void fix_cost(double cost) { fixed_cost_ = cost; }
   // Whether to make it before the next step; not between a making and the record() of its
   // first step.
   bool due() const { return !fresh_ && (after_ < 0 || excess_ >= cost_); }
@@ -41,6 +45,7 @@ class RefreshRule {
   int after_ = -1;       // iterations of the first step after the making (-1: none yet)
   double excess_ = 0.0;  // beyond after_, summed over the steps since
   double cost_ = 0.0;
+  double fixed_cost_ = 0.0;   // 0: each making's own
 };
 
 }  // namespace sigmafem

@@ -110,7 +110,7 @@ VulkanEnsemble::VulkanEnsemble(const Model& model, EstimatedParameters estimated
                         "(a scenario's mesh.refine makes one)");
     multigrid_ = std::make_unique<NestedMultigrid>(std::move(prolongations));
     shift_rows_ = SpringCorrection(estimated_spring_rows(model_, estimated_));
-    multigrid_making_cycles_ = options.multigrid_making_cycles;
+    multigrid_refresh_.fix_cost(options.multigrid_making_cycles);
     preconditioner_making_.set_rule(options.background_making_steps, kBackgroundMultigridCycles);
   }
   cg_partitioned_ = cg_partitions_ > 1 || multigrid_;
@@ -402,13 +402,9 @@ void VulkanEnsemble::refresh_multigrid(const std::vector<double>& constants) {
     return;
   }
   const bool made = multigrid_->set_matrix(representative_system());
-  multigrid_refresh_.made(made, multigrid_making_cost());
+  multigrid_refresh_.made(made, multigrid_->setup_in_cycles());
   // Else the last hierarchy stays, or Jacobi until one is made.
   if (made) upload_multigrid(factorised_springs(shift_rows_, constants));
-}
-
-double VulkanEnsemble::multigrid_making_cost() const {
-  return multigrid_making_cycles_ > 0.0 ? multigrid_making_cycles_ : multigrid_->setup_in_cycles();
 }
 
 void VulkanEnsemble::upload_multigrid(const std::vector<double>& springs) {
@@ -427,7 +423,7 @@ void VulkanEnsemble::hand_over_making(bool made) {
     if (made) upload_factor(making_springs_);
     return;
   }
-  multigrid_refresh_.made(made, multigrid_making_cost());
+  multigrid_refresh_.made(made, multigrid_->setup_in_cycles());
   if (made) upload_multigrid(making_springs_);
 }
 

@@ -151,8 +151,6 @@ class VulkanEnsemble : public DeviceEnsemble {
   // The hierarchy just made goes down, with its system's `springs` at the estimated ligaments'
   // rows (factorised_springs at the step it was made at), against which the shifts are taken.
   void upload_multigrid(const std::vector<double>& springs);
-  // A making in the hierarchy's refresh rule, in V-cycles (DeviceOptions::multigrid_making_cycles).
-  double multigrid_making_cost() const;
   // At the step a background making is handed over: its factor or hierarchy goes down where it
   // was made (`made`); a failed one leaves the last in place.
   void hand_over_making(bool made);
@@ -217,7 +215,6 @@ class VulkanEnsemble : public DeviceEnsemble {
   SpringCorrection shift_rows_;
   std::vector<double> multigrid_springs_;
   bool shift_stale_ = false;
-  double multigrid_making_cycles_ = 0.0;   // DeviceOptions::multigrid_making_cycles
   // A large factor, or the multigrid hierarchy, made again in the background (as
   // OpenClEnsemble's; declared after factor_ and multigrid_: destroyed first, waiting for a
   // making still running), and its system's springs at the step it began.

@@ -31,10 +31,7 @@ VulkanMultigrid::Matrix VulkanMultigrid::make_matrix(const RowMajorMatrix& M) {
 }
 
 void VulkanMultigrid::upload_matrix(const Matrix& to, const RowMajorMatrix& M) {
-  if (static_cast<std::uint32_t>(M.rows()) != to.rows || static_cast<std::size_t>(M.nonZeros()) != to.nonzeros)
-    throw DeviceError("a multigrid level of " + std::to_string(M.rows()) + " rows and " +
-                      std::to_string(M.nonZeros()) + " entries where the first had " + std::to_string(to.rows) +
-                      " and " + std::to_string(to.nonzeros));
+  check_level_size(M, to.rows, to.nonzeros);
   device_.upload(to.row_start, M.outerIndexPtr(), 4 * (static_cast<std::size_t>(M.rows()) + 1));
   device_.upload(to.columns, M.innerIndexPtr(), 4 * to.nonzeros);
   device_.upload_reals(to.values, std::vector<double>(M.valuePtr(), M.valuePtr() + M.nonZeros()));
